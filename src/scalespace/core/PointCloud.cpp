@@ -1,0 +1,145 @@
+#include "scalespace/core/PointCloud.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+const char* scalarTypeName(ScalarType type) {
+  switch (type) {
+    case ScalarType::Int8: return "int8";
+    case ScalarType::UInt8: return "uint8";
+    case ScalarType::Int16: return "int16";
+    case ScalarType::UInt16: return "uint16";
+    case ScalarType::Int32: return "int32";
+    case ScalarType::UInt32: return "uint32";
+    case ScalarType::Float32: return "float32";
+    case ScalarType::Float64: return "float64";
+  }
+  return "unknown";
+}
+
+std::size_t scalarTypeSize(ScalarType type) {
+  switch (type) {
+    case ScalarType::Int8:
+    case ScalarType::UInt8: return 1;
+    case ScalarType::Int16:
+    case ScalarType::UInt16: return 2;
+    case ScalarType::Int32:
+    case ScalarType::UInt32:
+    case ScalarType::Float32: return 4;
+    case ScalarType::Float64: return 8;
+  }
+  return 0;
+}
+
+bool isIntegerType(ScalarType type) {
+  return type != ScalarType::Float32 && type != ScalarType::Float64;
+}
+
+void PointCloud::setAbsolutePositions(const std::vector<Vec3>& absolute) {
+  Vec3 lo = Vec3::Constant(0), hi = Vec3::Constant(0);
+  bool first = true;
+  for (const Vec3& p : absolute) {
+    if (!p.allFinite()) continue;  // readers reject non-finite points; be defensive here
+    if (first) {
+      lo = hi = p;
+      first = false;
+    } else {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  // An integer origin keeps p - origin exact (both are multiples of ulp(p) and |p - o| <= |p|
+  // whenever the cloud does not straddle far from its centre); small clouds keep origin 0.
+  const Vec3 centre = 0.5 * (lo + hi);
+  origin_ = centre.cwiseAbs().maxCoeff() < 1e3 ? Vec3::Zero() : Vec3(centre.array().round());
+  positions_.resize(absolute.size());
+  for (std::size_t i = 0; i < absolute.size(); ++i) positions_[i] = absolute[i] - origin_;
+  resizeColumns();
+}
+
+void PointCloud::setRelativePositions(std::vector<Vec3> relative, const Vec3& origin) {
+  positions_ = std::move(relative);
+  origin_ = origin;
+  resizeColumns();
+}
+
+void PointCloud::setNormals(std::vector<Vec3> normals) {
+  if (!normals.empty() && normals.size() != positions_.size())
+    throw Error("PointCloud::setNormals: " + std::to_string(normals.size()) + " normals for " +
+                std::to_string(positions_.size()) + " points");
+  normals_ = std::move(normals);
+}
+
+const AttributeColumn* PointCloud::findAttribute(const std::string& name) const {
+  for (const auto& a : attributes_)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+AttributeColumn* PointCloud::findAttribute(const std::string& name) {
+  for (auto& a : attributes_)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+AttributeColumn& PointCloud::addAttribute(const std::string& name, ScalarType type, double fill) {
+  if (AttributeColumn* existing = findAttribute(name)) {
+    existing->type = type;
+    existing->values.resize(size(), fill);
+    return *existing;
+  }
+  attributes_.push_back(AttributeColumn{name, type, std::vector<double>(size(), fill)});
+  return attributes_.back();
+}
+
+bool PointCloud::removeAttribute(const std::string& name) {
+  auto it = std::find_if(attributes_.begin(), attributes_.end(),
+                         [&](const AttributeColumn& a) { return a.name == name; });
+  if (it == attributes_.end()) return false;
+  attributes_.erase(it);
+  return true;
+}
+
+PointCloud PointCloud::subset(const std::vector<Index>& indices) const {
+  PointCloud out;
+  std::vector<Vec3> pos(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) pos[k] = positions_.at(indices[k]);
+  out.setRelativePositions(std::move(pos), origin_);
+  if (hasNormals()) {
+    std::vector<Vec3> nrm(indices.size());
+    for (std::size_t k = 0; k < indices.size(); ++k) nrm[k] = normals_[indices[k]];
+    out.setNormals(std::move(nrm));
+  }
+  for (const auto& a : attributes_) {
+    AttributeColumn& c = out.addAttribute(a.name, a.type);
+    for (std::size_t k = 0; k < indices.size(); ++k) c.values[k] = a.values[indices[k]];
+  }
+  return out;
+}
+
+void PointCloud::bounds(Vec3& lo, Vec3& hi) const {
+  lo = hi = Vec3::Zero();
+  if (positions_.empty()) return;
+  lo = hi = positions_[0];
+  for (const Vec3& p : positions_) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
+
+double PointCloud::boundingBoxDiagonal() const {
+  Vec3 lo, hi;
+  bounds(lo, hi);
+  return (hi - lo).norm();
+}
+
+void PointCloud::resizeColumns() {
+  if (!normals_.empty()) normals_.resize(positions_.size(), Vec3::UnitZ());
+  for (auto& a : attributes_) a.values.resize(positions_.size(), 0.0);
+}
+
+}  // namespace scalespace

@@ -1,0 +1,77 @@
+#pragma once
+// Contract between the per-point fits (fit/) and the drivers that run them over a cloud
+// (fit/CurvatureEstimation, scales/). One call estimates the differential quantities of the
+// surface near x at scale t from the samples within distance t (Sec. 1.2.1, 1.4).
+#include <string>
+#include <vector>
+
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+/// Which estimator computes normals and curvatures (Sec. 1.4.3, Table 1.1 rows).
+enum class EstimatorKind {
+  W3,       // APSS + complete shape operator, Eq. 1.36-1.38 ("Sphere 3")
+  W2,       // APSS + approximate shape operator, Eq. 1.35 ("Sphere 2", Ponca)
+  W1,       // APSS + simple shape operator, Eq. 1.31 ("Sphere 1"): umbilic, k1 = k2 = H
+  Plane,    // weighted PCA plane, H = 8d/t^2
+  Mean,     // weighted barycentre + mean normal, H = 8d/t^2
+  Quadric,  // PSS (Alexa 2001): weighted height-field quadric over the PCA plane
+  Jet       // osculating jet of degree 2 (Cazals 2005), CGAL Monge fitting
+};
+
+/// "w3", "w2", "w1", "plane", "mean", "quadric", "jet"; parse throws OptionError on anything else.
+const char* estimatorName(EstimatorKind kind);
+EstimatorKind parseEstimator(const std::string& name);
+
+struct FitOptions {
+  EstimatorKind estimator = EstimatorKind::W3;
+  /// MLS projection (Eq. 1.12): re-fit at the projected point until the step is below
+  /// mlsTolerance * t or mlsMaxSteps fits were made (Sec. 1.4.3: 20 steps, 0.001 t).
+  bool mls = false;
+  int mlsMaxSteps = 20;
+  double mlsTolerance = 1e-3;
+  /// Robust re-weighting (RIMLS, Oztireli 2009): per fit, `robustIterations` re-weightings.
+  bool robust = false;
+  int robustIterations = 5;
+  /// Fits with fewer neighbours are invalid (NOTES.md: < 6).
+  int minNeighbors = 6;
+};
+
+/// Everything one fit tells about the surface near the evaluation point. When valid is false the
+/// numeric fields are zero (never NaN) and only `neighbors` is meaningful.
+struct LocalFit {
+  bool valid = false;
+  int neighbors = 0;              // samples with non-zero weight in the last fit
+  Vec3 projection = Vec3::Zero(); // where the point lands on the fitted surface (same frame as x)
+  Vec3 normal = Vec3::Zero();     // unit, oriented like the input normals
+  double meanCurvature = 0;       // H = (kMax + kMin)/2, > 0 on a sphere with outward normals
+  double kMax = 0, kMin = 0;      // principal curvatures, kMax >= kMin
+  Vec3 dirMax = Vec3::Zero(), dirMin = Vec3::Zero();  // unit, orthogonal, tangent
+  // GLS parameters (Mellado 2012): u_c, u_l, u_q divided by sqrt(Delta) (Sec. 1.3.2).
+  double tau = 0, kappa = 0;
+  double fitness = 0;             // Delta of Eq. 1.11 (Pratt norm)
+  double anisotropy = 0;          // 1 - |u_l| (Theorem 1, Eq. 1.20)
+  double geometricVariation = 0;  // nu from scale derivatives of the GLS parameters
+  int mlsSteps = 0;
+};
+
+/// The samples a fit reads: positions and normals (same frame as x) and an index over positions.
+struct SurfaceSamples {
+  const std::vector<Vec3>& positions;
+  const std::vector<Vec3>& normals;  // may be empty only for estimators that do not need them
+  const SpatialIndex& index;
+};
+
+/// Per-thread scratch memory, reused across calls to avoid allocations in the hot loop.
+struct FitWorkspace {
+  std::vector<Neighbor> neighbors;
+  std::vector<double> weights;
+};
+
+/// Estimates the differential quantities at x with support radius t.
+LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const FitOptions& options,
+               FitWorkspace& workspace);
+
+}  // namespace scalespace
