@@ -1,0 +1,69 @@
+#include "scalespace/io/AtomicFile.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+namespace {
+
+std::string temporaryPathFor(const std::string& path) {
+  // pid + random suffix: two processes (or two threads) writing the same target never share a
+  // temporary file.
+  std::random_device device;
+  std::ostringstream name;
+  name << path << ".tmp-" << ::getpid() << '-' << std::hex << device() << device();
+  return name.str();
+}
+
+/// fsync so that the rename never exposes a file whose content is still only in the page cache.
+void syncFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  namespace fs = std::filesystem;
+  const std::string temporary = temporaryPathFor(path);
+  std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+  if (!out)
+    throw FileError(path, "", "cannot create the temporary file " + temporary,
+                    "check that the output folder exists and is writable");
+  const auto removeTemporary = [&] {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+  };
+  try {
+    write(out);
+    out.flush();
+    if (!out) throw FileError(path, "", "writing failed", "check free disk space and permissions");
+    out.close();
+    if (out.fail())
+      throw FileError(path, "", "closing the file failed", "check free disk space and permissions");
+  } catch (...) {
+    if (out.is_open()) out.close();
+    removeTemporary();
+    throw;
+  }
+  syncFile(temporary);
+  std::error_code ec;
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    removeTemporary();
+    throw FileError(path, "", "cannot replace the file: " + ec.message(),
+                    "check that the path is not a folder and that it is writable");
+  }
+}
+
+}  // namespace scalespace

@@ -1,0 +1,59 @@
+#include "scalespace/io/MeshCloud.hpp"
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/io/CloudBuilder.hpp"
+#include "scalespace/io/TextParsing.hpp"
+
+namespace scalespace::io_detail {
+
+PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOptions& options,
+                       ReadReport* report, const std::string& formatDescription) {
+  const bool normals = mesh.normals.size() == mesh.vertices.size() && !mesh.vertices.empty();
+  if (options.meshSamples == 0) {
+    CloudBuilder builder(file, options);
+    if (normals) builder.enableNormals();
+    builder.reserve(mesh.vertices.size());
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+      builder.addPoint(mesh.vertices[v], normals ? mesh.normals[v] : Vec3::Zero(), nullptr,
+                       [&] { return lineWhere(mesh.vertexLines[v]); });
+    return builder.finish(report, formatDescription);
+  }
+
+  // Sampling: a non-finite vertex is an error, or (dropNonFinite) removes its faces.
+  std::vector<bool> bad(mesh.vertices.size(), false);
+  std::size_t dropped = 0;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (mesh.vertices[v].allFinite()) continue;
+    if (!options.dropNonFinite)
+      throw FileError(file, lineWhere(mesh.vertexLines[v]),
+                      "vertex " + std::to_string(v + 1) + " has a NaN or infinite coordinate",
+                      "pass --drop-invalid (ReadOptions::dropNonFinite) to skip its faces");
+    bad[v] = true;
+    ++dropped;
+  }
+  if (dropped > 0) {
+    std::vector<std::array<Index, 3>> kept;
+    for (const auto& t : mesh.triangles)
+      if (!bad[t[0]] && !bad[t[1]] && !bad[t[2]]) kept.push_back(t);
+    mesh.triangles = std::move(kept);
+  }
+  if (mesh.triangles.empty())
+    throw FileError(
+        file, "",
+        "the mesh has no faces to sample " + std::to_string(options.meshSamples) + " points from",
+        "read its vertices instead (no mesh sampling)");
+  PointCloud cloud;
+  try {
+    cloud = sampleMesh(mesh, options.meshSamples, options.seed);
+  } catch (const OptionError& e) {
+    throw FileError(file, "", e.what(), "check that the faces are not all degenerate");
+  }
+  if (report) {
+    report->droppedNonFinite = dropped;
+    report->format =
+        formatDescription + ", " + std::to_string(options.meshSamples) + " area samples";
+  }
+  return cloud;
+}
+
+}  // namespace scalespace::io_detail

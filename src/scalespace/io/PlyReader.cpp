@@ -1,0 +1,370 @@
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/io/ByteReader.hpp"
+#include "scalespace/io/CloudBuilder.hpp"
+#include "scalespace/io/PlyFormat.hpp"
+#include "scalespace/io/TextParsing.hpp"
+
+namespace scalespace {
+
+namespace {
+
+using namespace io_detail;
+
+struct PlyProperty {
+  std::string name;
+  ScalarType type = ScalarType::Float32;  // the item type for a list
+  bool isList = false;
+  ScalarType countType = ScalarType::UInt8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::size_t count = 0;
+  std::size_t line = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  PlyEncoding encoding = PlyEncoding::Ascii;
+  std::vector<PlyElement> elements;
+  std::size_t dataOffset = 0;  // first byte after end_header
+  std::size_t dataLine = 0;    // line number of end_header
+};
+
+std::optional<ScalarType> plyType(std::string_view name) {
+  static const std::array<std::pair<const char*, ScalarType>, 16> types = {{
+      {"char", ScalarType::Int8},
+      {"int8", ScalarType::Int8},
+      {"uchar", ScalarType::UInt8},
+      {"uint8", ScalarType::UInt8},
+      {"short", ScalarType::Int16},
+      {"int16", ScalarType::Int16},
+      {"ushort", ScalarType::UInt16},
+      {"uint16", ScalarType::UInt16},
+      {"int", ScalarType::Int32},
+      {"int32", ScalarType::Int32},
+      {"uint", ScalarType::UInt32},
+      {"uint32", ScalarType::UInt32},
+      {"float", ScalarType::Float32},
+      {"float32", ScalarType::Float32},
+      {"double", ScalarType::Float64},
+      {"float64", ScalarType::Float64},
+  }};
+  for (const auto& [n, t] : types)
+    if (name == n) return t;
+  return std::nullopt;
+}
+
+const char* encodingName(PlyEncoding e) {
+  switch (e) {
+    case PlyEncoding::Ascii:
+      return "ascii";
+    case PlyEncoding::BinaryLittleEndian:
+      return "binary_little_endian";
+    case PlyEncoding::BinaryBigEndian:
+      return "binary_big_endian";
+  }
+  return "";
+}
+
+PlyHeader parseHeader(std::string_view data, const std::string& file) {
+  LineScanner lines(data);
+  std::string_view line;
+  if (!lines.next(line) || trim(line) != "ply")
+    throw FileError(file, "line 1", "expected the PLY magic line 'ply'",
+                    "this is not a PLY file: check the file extension");
+  PlyHeader header;
+  bool haveFormat = false;
+  std::vector<std::string_view> tokens;
+  while (true) {
+    if (!lines.next(line))
+      throw FileError(file, lineWhere(lines.lineNumber()), "the header has no end_header line",
+                      "the file is truncated or not a PLY file");
+    const std::string where = lineWhere(lines.lineNumber());
+    splitWhitespace(line, tokens);
+    if (tokens.empty()) continue;
+    const std::string_view keyword = tokens[0];
+    if (keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "end_header") break;
+    if (keyword == "format") {
+      if (tokens.size() != 3 || tokens[2] != "1.0")
+        throw FileError(file, where, "expected 'format <encoding> 1.0'");
+      if (tokens[1] == "ascii")
+        header.encoding = PlyEncoding::Ascii;
+      else if (tokens[1] == "binary_little_endian")
+        header.encoding = PlyEncoding::BinaryLittleEndian;
+      else if (tokens[1] == "binary_big_endian")
+        header.encoding = PlyEncoding::BinaryBigEndian;
+      else
+        throw FileError(file, where, "unknown PLY encoding '" + std::string(tokens[1]) + "'",
+                        "expected ascii, binary_little_endian or binary_big_endian");
+      haveFormat = true;
+    } else if (keyword == "element") {
+      const auto count = tokens.size() == 3 ? parseUnsigned(tokens[2]) : std::nullopt;
+      if (!count) throw FileError(file, where, "expected 'element <name> <count>'");
+      for (const auto& e : header.elements)
+        if (e.name == tokens[1])
+          throw FileError(file, where, "element '" + e.name + "' is declared twice");
+      header.elements.push_back(
+          PlyElement{std::string(tokens[1]), std::size_t(*count), lines.lineNumber(), {}});
+    } else if (keyword == "property") {
+      if (header.elements.empty())
+        throw FileError(file, where, "property declared before any element");
+      PlyProperty property;
+      if (tokens.size() == 5 && tokens[1] == "list") {
+        const auto countType = plyType(tokens[2]);
+        const auto itemType = plyType(tokens[3]);
+        if (!countType || !itemType || !isIntegerType(*countType))
+          throw FileError(file, where, "bad list property types",
+                          "expected 'property list <integer type> <type> <name>'");
+        property = PlyProperty{std::string(tokens[4]), *itemType, true, *countType};
+      } else if (tokens.size() == 3) {
+        const auto type = plyType(tokens[1]);
+        if (!type)
+          throw FileError(file, where, "unknown property type '" + std::string(tokens[1]) + "'",
+                          "expected char, uchar, short, ushort, int, uint, float, double or "
+                          "int8 ... float64");
+        property = PlyProperty{std::string(tokens[2]), *type, false, ScalarType::UInt8};
+      } else {
+        throw FileError(file, where, "expected 'property <type> <name>'");
+      }
+      for (const auto& p : header.elements.back().properties)
+        if (p.name == property.name)
+          throw FileError(file, where, "property '" + p.name + "' is declared twice");
+      header.elements.back().properties.push_back(property);
+    } else {
+      throw FileError(file, where, "unknown header keyword '" + std::string(keyword) + "'",
+                      "expected format, element, property, comment, obj_info or end_header");
+    }
+  }
+  if (!haveFormat) throw FileError(file, "", "the header has no 'format' line");
+  header.dataOffset = lines.offset();
+  header.dataLine = lines.lineNumber();
+  return header;
+}
+
+/// How each vertex property is used.
+struct VertexLayout {
+  std::array<int, 3> position{-1, -1, -1};
+  std::array<int, 3> normal{-1, -1, -1};
+  std::vector<int> column;  // per property: attribute column index or -1
+};
+
+VertexLayout planVertex(const PlyElement& vertex, const std::string& file, CloudBuilder& builder) {
+  VertexLayout layout;
+  layout.column.assign(vertex.properties.size(), -1);
+  static const char* positionNames[3] = {"x", "y", "z"};
+  static const char* normalNames[3] = {"nx", "ny", "nz"};
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    if (vertex.properties[i].isList) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (vertex.properties[i].name == positionNames[k]) layout.position[k] = int(i);
+      if (vertex.properties[i].name == normalNames[k]) layout.normal[k] = int(i);
+    }
+  }
+  for (int k = 0; k < 3; ++k)
+    if (layout.position[k] < 0)
+      throw FileError(
+          file, lineWhere(vertex.line),
+          std::string("the vertex element has no scalar property '") + positionNames[k] + "'",
+          "a point cloud needs x, y and z");
+  const bool normals = layout.normal[0] >= 0 && layout.normal[1] >= 0 && layout.normal[2] >= 0;
+  if (normals)
+    builder.enableNormals();
+  else
+    layout.normal = {-1, -1, -1};  // a partial normal is kept as plain attributes
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    const PlyProperty& p = vertex.properties[i];
+    const bool used = int(i) == layout.position[0] || int(i) == layout.position[1] ||
+                      int(i) == layout.position[2] || int(i) == layout.normal[0] ||
+                      int(i) == layout.normal[1] || int(i) == layout.normal[2];
+    if (!p.isList && !used) layout.column[i] = int(builder.addColumn(p.name, p.type));
+  }
+  return layout;
+}
+
+/// Stores property `i`'s value into the point being assembled.
+struct VertexAssembler {
+  const VertexLayout& layout;
+  Vec3 position = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();
+  std::vector<double> values;
+
+  explicit VertexAssembler(const VertexLayout& l, std::size_t columns)
+      : layout(l), values(columns, 0.0) {}
+  void set(std::size_t i, double value) {
+    for (int k = 0; k < 3; ++k) {
+      if (layout.position[k] == int(i)) position[k] = value;
+      if (layout.normal[k] == int(i)) normal[k] = value;
+    }
+    if (layout.column[i] >= 0) values[std::size_t(layout.column[i])] = value;
+  }
+};
+
+void readBinary(const PlyHeader& header, std::string_view data, const std::string& file,
+                CloudBuilder& builder, const VertexLayout* layout, std::size_t vertexIndex) {
+  const bool big = header.encoding == PlyEncoding::BinaryBigEndian;
+  ByteReader in(data, file);
+  in.seek(header.dataOffset, "the end of the header");
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    const PlyElement& element = header.elements[e];
+    if (element.properties.empty()) continue;  // nothing stored, whatever the count
+    // Each instance takes at least `minimum` bytes: check the declared count against what the
+    // file holds before looping or allocating.
+    std::size_t minimum = 0;
+    bool fixed = true;
+    for (const auto& p : element.properties) {
+      minimum += scalarTypeSize(p.isList ? p.countType : p.type);
+      fixed = fixed && !p.isList;
+    }
+    std::size_t needed = 0;
+    if (!multiplyChecked(element.count, minimum, needed) || needed > in.remaining())
+      throw FileError(file, byteWhere(in.offset()),
+                      "element '" + element.name + "' declares " + std::to_string(element.count) +
+                          " items of at least " + std::to_string(minimum) + " bytes but only " +
+                          std::to_string(in.remaining()) + " bytes remain",
+                      "the file is truncated or its header count is wrong");
+    if (e != vertexIndex) {
+      if (fixed) {
+        in.skip(needed, element.name.c_str());
+        continue;
+      }
+      for (std::size_t n = 0; n < element.count; ++n)
+        for (const auto& p : element.properties) {
+          if (!p.isList) {
+            in.skip(scalarTypeSize(p.type), "a property");
+            continue;
+          }
+          const double count = in.readScalar(p.countType, big, "a list count");
+          if (count < 0)
+            throw FileError(file, byteWhere(in.offset()),
+                            "negative list length in '" + p.name + "'");
+          std::size_t bytes = 0;
+          if (!multiplyChecked(std::size_t(count), scalarTypeSize(p.type), bytes))
+            throw FileError(file, byteWhere(in.offset()), "list too long");
+          in.skip(bytes, "list items");
+        }
+      continue;
+    }
+    builder.reserve(element.count);
+    VertexAssembler vertex(*layout, builder.columnCount());
+    for (std::size_t n = 0; n < element.count; ++n) {
+      const std::size_t start = in.offset();
+      for (std::size_t i = 0; i < element.properties.size(); ++i) {
+        const PlyProperty& p = element.properties[i];
+        if (p.isList) {
+          const double count = in.readScalar(p.countType, big, "a list count");
+          if (count < 0)
+            throw FileError(file, byteWhere(in.offset()),
+                            "negative list length in '" + p.name + "'");
+          std::size_t bytes = 0;
+          if (!multiplyChecked(std::size_t(count), scalarTypeSize(p.type), bytes))
+            throw FileError(file, byteWhere(in.offset()), "list too long");
+          in.skip(bytes, "list items");
+        } else {
+          vertex.set(i, in.readScalar(p.type, big, "a vertex property"));
+        }
+      }
+      builder.addPoint(vertex.position, vertex.normal, vertex.values.data(),
+                       [&] { return byteWhere(start); });
+    }
+  }
+}
+
+void readAscii(const PlyHeader& header, std::string_view data, const std::string& file,
+               CloudBuilder& builder, const VertexLayout* layout, std::size_t vertexIndex) {
+  LineScanner lines(data.substr(header.dataOffset));
+  const std::size_t lineBase = header.dataLine;
+  std::vector<std::string_view> tokens;
+  std::string_view line;
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    const PlyElement& element = header.elements[e];
+    if (element.properties.empty()) continue;
+    // Every item is a line of at least one character plus its newline.
+    if (element.count > lines.remainingBytes() / 2 + 1)
+      throw FileError(file, lineWhere(lineBase + lines.lineNumber() + 1),
+                      "element '" + element.name + "' declares " + std::to_string(element.count) +
+                          " items but the file has only " + std::to_string(lines.remainingBytes()) +
+                          " bytes left",
+                      "the file is truncated or its header count is wrong");
+    VertexAssembler* vertex = nullptr;
+    std::optional<VertexAssembler> storage;
+    if (e == vertexIndex) {
+      builder.reserve(element.count);
+      storage.emplace(*layout, builder.columnCount());
+      vertex = &*storage;
+    }
+    for (std::size_t n = 0; n < element.count; ++n) {
+      do {
+        if (!lines.next(line))
+          throw FileError(file, lineWhere(lineBase + lines.lineNumber() + 1),
+                          "unexpected end of file: element '" + element.name + "' declares " +
+                              std::to_string(element.count) + " items, found " + std::to_string(n),
+                          "the file is truncated or its header count is wrong");
+        splitWhitespace(line, tokens);
+      } while (tokens.empty());
+      const std::size_t lineNumber = lineBase + lines.lineNumber();
+      std::size_t t = 0;
+      auto nextNumber = [&](ScalarType type, const std::string& name) {
+        if (t >= tokens.size())
+          throw FileError(file, lineWhere(lineNumber),
+                          "too few values: property '" + name + "' is missing");
+        const auto value = parseNumber(tokens[t]);
+        if (!value || !fitsScalarType(*value, type))
+          throw FileError(file, lineWhere(lineNumber),
+                          "'" + std::string(tokens[t]) + "' is not a valid " +
+                              scalarTypeName(type) + " for property '" + name + "'");
+        ++t;
+        return *value;
+      };
+      for (std::size_t i = 0; i < element.properties.size(); ++i) {
+        const PlyProperty& p = element.properties[i];
+        if (p.isList) {
+          const double count = nextNumber(p.countType, p.name);
+          if (count < 0 || count > double(tokens.size() - t))
+            throw FileError(file, lineWhere(lineNumber),
+                            "list '" + p.name + "' declares " + formatNumber(count) +
+                                " items but the line has fewer values");
+          for (std::size_t k = 0; k < std::size_t(count); ++k) nextNumber(p.type, p.name);
+        } else {
+          const double value = nextNumber(p.type, p.name);
+          if (vertex) vertex->set(i, value);
+        }
+      }
+      if (t != tokens.size())
+        throw FileError(
+            file, lineWhere(lineNumber),
+            "expected " + std::to_string(t) + " values, found " + std::to_string(tokens.size()),
+            "each " + element.name + " must be on its own line");
+      if (vertex)
+        builder.addPoint(vertex->position, vertex->normal, vertex->values.data(),
+                         [&] { return lineWhere(lineNumber); });
+    }
+  }
+}
+
+}  // namespace
+
+PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options,
+                   ReadReport* report) {
+  const PlyHeader header = parseHeader(data, file);
+  std::size_t vertexIndex = header.elements.size();
+  for (std::size_t e = 0; e < header.elements.size(); ++e)
+    if (header.elements[e].name == "vertex") vertexIndex = e;
+  if (vertexIndex == header.elements.size())
+    throw FileError(file, lineWhere(header.dataLine), "the header declares no 'vertex' element",
+                    "a point cloud PLY needs 'element vertex <count>' with x, y, z properties");
+  CloudBuilder builder(file, options);
+  const VertexLayout layout = planVertex(header.elements[vertexIndex], file, builder);
+  if (header.encoding == PlyEncoding::Ascii)
+    readAscii(header, data, file, builder, &layout, vertexIndex);
+  else
+    readBinary(header, data, file, builder, &layout, vertexIndex);
+  return builder.finish(report, std::string("ply (") + encodingName(header.encoding) + ")");
+}
+
+}  // namespace scalespace

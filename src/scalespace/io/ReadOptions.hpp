@@ -1,0 +1,25 @@
+#pragma once
+// Options and report shared by every reader (see CloudIO.hpp).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace scalespace {
+
+struct ReadOptions {
+  /// OFF/OBJ: 0 = the cloud is the mesh vertices; N > 0 = N points sampled uniformly by area with
+  /// interpolated vertex normals (Sec. 3.4.1).
+  std::size_t meshSamples = 0;
+  std::uint64_t seed = 1;  // mesh sampling
+  /// NaN/Inf coordinates: false -> FileError naming the first bad point; true -> the point is
+  /// skipped and counted in ReadReport::droppedNonFinite. Attributes and normals are never checked
+  /// (NaN is a legitimate "no value" there).
+  bool dropNonFinite = false;
+};
+
+struct ReadReport {
+  std::size_t droppedNonFinite = 0;
+  std::string format;  // "ply (binary_little_endian)", "las 1.4 format 6", ...
+};
+
+}  // namespace scalespace
