@@ -29,9 +29,9 @@ void BruteForceIndex::knnSearch(const Vec3& q, std::size_t k, std::vector<Neighb
 
 }  // namespace scalespace
 
+#include "scalespace/core/KdTreeIndex.hpp"
 namespace scalespace {
-// Replaced by the kd-tree once core/KdTreeIndex lands.
 std::unique_ptr<SpatialIndex> makeSpatialIndex(const std::vector<Vec3>& points) {
-  return std::make_unique<BruteForceIndex>(points);
+  return std::make_unique<KdTreeIndex>(points);
 }
 }  // namespace scalespace

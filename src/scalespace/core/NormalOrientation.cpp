@@ -1,0 +1,286 @@
+#include "scalespace/core/NormalOrientation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace scalespace {
+namespace {
+
+constexpr Index kNone = std::numeric_limits<Index>::max();
+
+bool usable(const Vec3& n) { return n.allFinite() && n.squaredNorm() > 0.0; }
+
+struct Edge {
+  float cost;  // 1 - |n_a . n_b| [Hoppe 1992]
+  Index a, b;  // a < b; a == kNone marks an empty slot
+  bool operator<(const Edge& o) const {
+    if (cost != o.cost) return cost < o.cost;
+    if (a != o.a) return a < o.a;
+    return b < o.b;
+  }
+  bool operator==(const Edge& o) const { return a == o.a && b == o.b; }
+};
+
+// Union-find with path halving and union by size (Kruskal).
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n), size_(n, 1) {
+    for (std::size_t i = 0; i < n; ++i) parent_[i] = Index(i);
+  }
+  Index find(Index x) {
+    while (parent_[x] != x) {
+      parent_[x] = parent_[parent_[x]];
+      x = parent_[x];
+    }
+    return x;
+  }
+  bool unite(Index a, Index b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    if (size_[a] < size_[b] || (size_[a] == size_[b] && a > b)) std::swap(a, b);
+    parent_[b] = a;
+    size_[a] += size_[b];
+    return true;
+  }
+
+ private:
+  std::vector<Index> parent_;
+  std::vector<Index> size_;
+};
+
+void checkCancel(const ProgressCallback& progress, double fraction, const char* stage) {
+  if (progress && !progress(fraction, stage)) throw Cancelled();
+}
+
+NormalOrientationResult orientByViewpoint(const std::vector<Vec3>& points,
+                                          std::vector<Vec3>& normals,
+                                          const std::vector<std::uint8_t>& valid,
+                                          const NormalOrientationOptions& options,
+                                          const ProgressCallback& progress) {
+  const std::size_t n = points.size();
+  NormalOrientationResult result;
+  result.reliable.assign(n, 0);
+  std::vector<std::uint8_t> flipped(n, 0);
+  std::vector<Vec3> oriented = normals;
+  ProgressTracker tracker(progress, "normal orientation (viewpoint)", n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      if (tracker.cancelled()) return;
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        Vec3& nrm = oriented[i];
+                        if (!usable(nrm)) continue;
+                        const Vec3 view = options.viewpoint - points[i];
+                        const double d = nrm.dot(view);
+                        if (d < 0.0) {
+                          nrm = -nrm;
+                          flipped[i] = 1;
+                        }
+                        const double scale = view.norm() * nrm.norm();
+                        const bool ok = (valid.empty() || valid[i]) && scale > 0.0 &&
+                                        std::abs(d) >= options.grazingThreshold * scale;
+                        result.reliable[i] = ok ? 1 : 0;
+                      }
+                      tracker.advance(range.size());
+                    });
+  tracker.finish();
+  normals.swap(oriented);
+  for (std::size_t i = 0; i < n; ++i) {
+    result.flippedCount += flipped[i];
+    result.unreliableCount += result.reliable[i] ? 0 : 1;
+  }
+  return result;
+}
+
+NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector<Vec3>& normals,
+                                    const SpatialIndex& index,
+                                    const std::vector<std::uint8_t>& valid,
+                                    const NormalOrientationOptions& options,
+                                    const ProgressCallback& progress) {
+  const std::size_t n = points.size();
+  const std::size_t k = options.k;
+  NormalOrientationResult result;
+  result.reliable.assign(n, 0);
+  std::vector<Vec3> oriented = normals;
+  std::vector<std::uint8_t> inGraph(n);
+  for (std::size_t i = 0; i < n; ++i)
+    inGraph[i] = usable(oriented[i]) && (valid.empty() || valid[i]) ? 1 : 0;
+
+  // 1. Riemannian graph: k slots per point, edge stored as (min, max) so that sorting brings the
+  //    two copies of a mutual-neighbour edge together for unique(). Points outside the graph
+  //    record their nearest graph neighbour to copy its orientation at the end.
+  std::vector<Edge> edges(n * k, Edge{0.0f, kNone, kNone});
+  std::vector<Index> adopter(n, kNone);
+  {
+    ProgressTracker tracker(progress, "orientation graph", n);
+    tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        if (tracker.cancelled()) return;
+                        std::vector<Neighbor>& nbrs = scratch.local();
+                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                          if (!usable(oriented[i])) continue;
+                          index.knnSearch(points[i], k + 1, nbrs);
+                          std::size_t slot = 0;
+                          for (const Neighbor& nb : nbrs) {
+                            const Index j = nb.index;
+                            if (j == i || !inGraph[j]) continue;
+                            if (!inGraph[i]) {  // first (nearest) graph neighbour adopts this point
+                              adopter[i] = j;
+                              break;
+                            }
+                            if (slot == k) break;
+                            const double c = std::abs(oriented[i].dot(oriented[j])) /
+                                             (oriented[i].norm() * oriented[j].norm());
+                            edges[i * k + slot++] = Edge{float(1.0 - std::min(1.0, c)),
+                                                         Index(std::min<std::size_t>(i, j)),
+                                                         Index(std::max<std::size_t>(i, j))};
+                          }
+                        }
+                        tracker.advance(range.size());
+                      });
+    tracker.finish();
+  }
+  // Empty slots sort last with a cost above any real one.
+  tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t e) {
+    if (edges[e].a == kNone) edges[e].cost = 2.0f;
+  });
+  checkCancel(progress, 0.0, "orientation sort");
+  tbb::parallel_sort(edges.begin(), edges.end());
+  checkCancel(progress, 1.0, "orientation sort");
+
+  // 2. Kruskal: minimum spanning forest. Duplicate edges are adjacent after the sort (same cost,
+  //    same ends) and the second copy is rejected by the union-find anyway.
+  DisjointSets sets(n);
+  std::vector<Index> treeA, treeB;
+  treeA.reserve(n);
+  treeB.reserve(n);
+  for (const Edge& e : edges) {
+    if (e.a == kNone) break;
+    if (sets.unite(e.a, e.b)) {
+      treeA.push_back(e.a);
+      treeB.push_back(e.b);
+    }
+  }
+  std::vector<Edge>().swap(edges);
+  checkCancel(progress, 0.5, "orientation tree");
+
+  // 3. Tree adjacency (CSR) and one seed per component: the highest point (largest z).
+  std::vector<std::size_t> start(n + 1, 0);
+  for (std::size_t e = 0; e < treeA.size(); ++e) {
+    ++start[treeA[e] + 1];
+    ++start[treeB[e] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<Index> adjacent(start[n]);
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t e = 0; e < treeA.size(); ++e) {
+      adjacent[fill[treeA[e]]++] = treeB[e];
+      adjacent[fill[treeB[e]]++] = treeA[e];
+    }
+  }
+  std::vector<Index> seedOf(n, kNone);  // indexed by the component's root
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!inGraph[i]) continue;
+    const Index root = sets.find(Index(i));
+    const Index s = seedOf[root];
+    if (s == kNone || points[i].z() > points[s].z()) seedOf[root] = Index(i);
+  }
+
+  // 4. Propagation from each seed (breadth first), seeds in increasing index order.
+  std::vector<std::uint8_t> flipped(n, 0), visited(n, 0);
+  std::vector<Index> queue;
+  queue.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!inGraph[i] || sets.find(Index(i)) != Index(i)) continue;
+    const Index seed = seedOf[i];
+    ++result.componentCount;
+    if (oriented[seed].z() < 0.0) {  // seed oriented towards +z (file comment)
+      oriented[seed] = -oriented[seed];
+      flipped[seed] = 1;
+    }
+    visited[seed] = 1;
+    // A lone point has nothing to agree with: its +z orientation is a guess.
+    result.reliable[seed] = start[seed + 1] > start[seed] ? 1 : 0;
+    queue.clear();
+    queue.push_back(seed);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const Index p = queue[head];
+      for (std::size_t a = start[p]; a < start[p + 1]; ++a) {
+        const Index c = adjacent[a];
+        if (visited[c]) continue;
+        visited[c] = 1;
+        const double d = oriented[c].dot(oriented[p]);
+        if (d < 0.0) {
+          oriented[c] = -oriented[c];
+          flipped[c] = 1;
+        }
+        const double cosine = std::abs(d) / (oriented[c].norm() * oriented[p].norm());
+        result.reliable[c] = cosine >= options.creaseThreshold ? 1 : 0;
+        queue.push_back(c);
+      }
+    }
+  }
+  checkCancel(progress, 1.0, "orientation tree");
+
+  // 5. Points outside the graph follow their nearest graph neighbour; never reliable.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (inGraph[i] || adopter[i] == kNone) continue;
+    if (oriented[i].dot(oriented[adopter[i]]) < 0.0) {
+      oriented[i] = -oriented[i];
+      flipped[i] = 1;
+    }
+  }
+  normals.swap(oriented);
+  for (std::size_t i = 0; i < n; ++i) {
+    result.flippedCount += flipped[i];
+    result.unreliableCount += result.reliable[i] ? 0 : 1;
+  }
+  return result;
+}
+
+}  // namespace
+
+NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vector<Vec3>& normals,
+                                      const SpatialIndex& index,
+                                      const NormalOrientationOptions& options,
+                                      const std::vector<std::uint8_t>& valid,
+                                      const ProgressCallback& progress) {
+  if (normals.size() != points.size())
+    throw OptionError("orientNormals: " + std::to_string(normals.size()) + " normals for " +
+                      std::to_string(points.size()) + " points");
+  if (!valid.empty() && valid.size() != points.size())
+    throw OptionError("orientNormals: " + std::to_string(valid.size()) + " validity flags for " +
+                      std::to_string(points.size()) + " points");
+  if (options.method == OrientationMethod::Viewpoint) {
+    if (!options.viewpoint.allFinite())
+      throw OptionError("orientNormals: the viewpoint must have finite coordinates");
+    return orientByViewpoint(points, normals, valid, options, progress);
+  }
+  if (options.k < 1) throw OptionError("orientNormals: k must be >= 1 (default 10)");
+  if (index.size() != points.size())
+    throw OptionError("orientNormals: the index holds " + std::to_string(index.size()) +
+                      " points but " + std::to_string(points.size()) + " were given");
+  return orientByMst(points, normals, index, valid, options, progress);
+}
+
+NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vector<Vec3>& normals,
+                                      const NormalOrientationOptions& options,
+                                      const std::vector<std::uint8_t>& valid,
+                                      const ProgressCallback& progress) {
+  if (options.method == OrientationMethod::Viewpoint) {
+    const BruteForceIndex unused(points);  // the viewpoint method makes no queries
+    return orientNormals(points, normals, unused, options, valid, progress);
+  }
+  const auto index = makeSpatialIndex(points);
+  return orientNormals(points, normals, *index, options, valid, progress);
+}
+
+}  // namespace scalespace

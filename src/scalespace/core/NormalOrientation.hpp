@@ -1,0 +1,62 @@
+#pragma once
+// Consistent orientation of unoriented normals (e.g. from estimateNormals()).
+//
+// MinimumSpanningTree [Hoppe 1992, §3.3]: the Riemannian graph is the symmetric k-nearest-neighbour
+// graph (edge i-j when j is among the k nearest of i or i among those of j) with cost
+// 1 - |n_i . n_j|; a minimum spanning forest is built (Kruskal, edges sorted in parallel). In each
+// connected component the seed is the point with the largest z (ties: smaller index), whose normal
+// is oriented towards +z (the top of a scanned scene or of a closed object faces up and out); the
+// orientation is then propagated from the seed along the tree, flipping a child when
+// n_child . n_parent < 0.
+//
+// Reliability (result.reliable[i] == 0) is documented per method:
+//  - both: the input normal was flagged invalid (`valid` argument) or is not a finite non-zero
+//    vector. Such points take no part in the graph; an invalid normal is flipped to agree with its
+//    nearest neighbour that has a valid one (a non-finite normal is left as it is).
+//  - MST: |n_child . n_parent| < creaseThreshold along the tree edge that oriented the point (a
+//    sharp crease: the sign decision is a guess), or the point is alone in its component.
+//  - Viewpoint: flipped so that n . (viewpoint - p) >= 0; unreliable when the view ray grazes the
+//    surface, |cos(n, viewpoint - p)| < grazingThreshold, or p == viewpoint.
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+enum class OrientationMethod { MinimumSpanningTree, Viewpoint };
+
+struct NormalOrientationOptions {
+  OrientationMethod method = OrientationMethod::MinimumSpanningTree;
+  std::size_t k = 10;              // neighbours of the Riemannian graph (MST)
+  Vec3 viewpoint = Vec3::Zero();   // scanner position, same frame as the points (Viewpoint)
+  double creaseThreshold = 0.3;    // MST: |cos| below which the propagated sign is unreliable
+  double grazingThreshold = 0.05;  // Viewpoint: |cos| below which the sign is unreliable
+};
+
+struct NormalOrientationResult {
+  std::size_t flippedCount = 0;        // normals whose sign was changed
+  std::size_t unreliableCount = 0;     // number of zeros in `reliable`
+  std::size_t componentCount = 0;      // MST: connected components of the graph (0 for Viewpoint)
+  std::vector<std::uint8_t> reliable;  // one per point, see the file comment
+};
+
+/// Orients `normals` (one per point, modified in place) with `index` built on `points`. `valid`
+/// (empty = all valid) is e.g. NormalEstimationResult::valid. Deterministic for any thread count.
+/// Throws OptionError on size mismatches or k < 1, Cancelled if `progress` returns false (the
+/// normals are then left unchanged).
+NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vector<Vec3>& normals,
+                                      const SpatialIndex& index,
+                                      const NormalOrientationOptions& options = {},
+                                      const std::vector<std::uint8_t>& valid = {},
+                                      const ProgressCallback& progress = {});
+
+/// Same, building the default index internally when the method needs one.
+NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vector<Vec3>& normals,
+                                      const NormalOrientationOptions& options = {},
+                                      const std::vector<std::uint8_t>& valid = {},
+                                      const ProgressCallback& progress = {});
+
+}  // namespace scalespace
