@@ -75,7 +75,9 @@ TriangleMesh parseOff(std::string_view data, const std::string& file) {
     double values[6];
     for (std::size_t k = 0; k < needed; ++k) {
       const auto value = parseNumber(tokens[k]);
-      if (!value) throw FileError(file, where, "'" + std::string(tokens[k]) + "' is not a number");
+      if (!value)
+        throw FileError(file, where,
+                        "'" + std::string(tokens[k].substr(0, 32)) + "' is not a number");
       values[k] = *value;
     }
     mesh.vertices.emplace_back(values[0], values[1], values[2]);

@@ -273,7 +273,7 @@ PointCloud readPcd(std::string_view data, const std::string& file, const ReadOpt
               packed = std::uint32_t(std::int64_t(*value));
             }
           }
-          store(targets[f][c], *value, packed, field.name == "rgba");
+          store(targets[f][c], toStoredValue(*value, field.scalar), packed, field.name == "rgba");
         }
       }
       builder.addPoint(position, normal, values.data(), [&] { return lineWhere(lineNumber); });
