@@ -23,7 +23,7 @@ void splitFields(std::string_view line, std::vector<std::string_view>& fields) {
 
 bool isComment(std::string_view line) {
   line = trim(line);
-  return line.empty() || line.front() == '#' || line.substr(0, 2) == "//";
+  return line.empty() || line.front() == '#';
 }
 
 /// Column roles: 0..2 position, 3..5 normal, -1 attribute.
@@ -103,7 +103,7 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
     if (!started) {
       started = true;
       bool header = false;
-      for (auto f : fields) header = header || !parseNumber(f);
+      for (auto f : fields) header = header || (!f.empty() && !parseNumber(f));
       layout = header ? layoutFromHeader(fields, file, lineNumber) : layoutFromCount(fields.size());
       if (layout.role.size() < 3)
         throw FileError(
@@ -177,7 +177,9 @@ void writeXyz(const PointCloud& cloud, std::ostream& out, char separator) {
         line += separator;
       }
     for (const auto& column : cloud.attributes()) {
-      line += formatScalar(column.values[i], column.type);
+      // Text keeps no type: write the stored value with all its double digits, so it reads back
+      // (as float64) to exactly the same number.
+      line += formatNumber(toStoredValue(column.values[i], column.type));
       line += separator;
     }
     line.back() = '\n';
