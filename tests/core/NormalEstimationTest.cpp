@@ -1,0 +1,157 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <limits>
+
+#include "core/CoreTestClouds.hpp"
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/Parallel.hpp"
+
+using namespace scalespace;
+using scalespace::testclouds::angleDegrees;
+
+namespace {
+
+template <class Truth>
+double maxAngle(const std::vector<Vec3>& points, const NormalEstimationResult& r, Truth truth) {
+  double worst = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_TRUE(r.valid[i]) << i;
+    EXPECT_NEAR(r.normals[i].norm(), 1.0, 1e-12);
+    worst = std::max(worst, angleDegrees(r.normals[i], truth(points[i])));
+  }
+  return worst;
+}
+
+bool allUnitAndFinite(const NormalEstimationResult& r) {
+  for (std::size_t i = 0; i < r.normals.size(); ++i)
+    if (!r.normals[i].allFinite() || std::abs(r.normals[i].norm() - 1.0) > 1e-12 ||
+        !std::isfinite(r.surfaceVariation[i]))
+      return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(NormalEstimation, TiltedPlaneIsExact) {
+  const Mat3 rotation = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  std::vector<Vec3> points = testclouds::plane(4000, 1.0, 21);
+  for (Vec3& p : points) p = rotation * p + Vec3(5, -3, 2);
+  const Vec3 truth = rotation * Vec3::UnitZ();
+  const auto r = estimateNormals(points);
+  EXPECT_EQ(r.invalidCount, 0u);
+  EXPECT_LT(maxAngle(points, r, [&](const Vec3&) { return truth; }), 1e-5);
+  for (double v : r.surfaceVariation) EXPECT_LT(v, 1e-12);
+  // Radius neighbourhoods give the same normals.
+  NormalEstimationOptions byRadius;
+  byRadius.radius = 0.05;
+  const auto rr = estimateNormals(points, byRadius);
+  EXPECT_LT(maxAngle(points, rr, [&](const Vec3&) { return truth; }), 1e-5);
+}
+
+TEST(NormalEstimation, SphereAndCylinderWithinTwoDegrees) {
+  // Evenly sampled sphere: every normal within 2 degrees.
+  const auto even = testclouds::fibonacciSphere(20000);
+  const auto re = estimateNormals(even);
+  EXPECT_EQ(re.invalidCount, 0u);
+  EXPECT_LT(maxAngle(even, re, [](const Vec3& p) { return p; }), 2.0);
+  for (double v : re.surfaceVariation) EXPECT_GT(v, 0.0);  // curved everywhere
+
+  // Random (clumpy) sampling: a few one-sided 10-NN neighbourhoods tilt more, the bulk is within
+  // 2 degrees.
+  auto fractionBelow2 = [](const std::vector<Vec3>& points, const NormalEstimationResult& r,
+                           auto truth) {
+    std::size_t good = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      good += angleDegrees(r.normals[i], truth(points[i])) < 2.0 ? 1 : 0;
+    return double(good) / double(points.size());
+  };
+  const auto sphere = testclouds::sphere(20000, 1.0, 22);
+  const auto rs = estimateNormals(sphere);
+  EXPECT_EQ(rs.invalidCount, 0u);
+  EXPECT_GT(fractionBelow2(sphere, rs, [](const Vec3& p) { return p; }), 0.99);
+  EXPECT_LT(maxAngle(sphere, rs, [](const Vec3& p) { return p; }), 10.0);
+
+  const auto cyl = testclouds::cylinder(20000, 1.0, 2.0, 23);
+  const auto rc = estimateNormals(cyl);
+  EXPECT_EQ(rc.invalidCount, 0u);
+  const auto radial = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0); };
+  EXPECT_GT(fractionBelow2(cyl, rc, radial), 0.99);
+  EXPECT_LT(maxAngle(cyl, rc, radial), 10.0);
+}
+
+TEST(NormalEstimation, DegenerateNeighbourhoodsAreFlaggedNeverNaN) {
+  // Colinear: every neighbourhood is a segment; the normal is orthogonal to it but flagged.
+  std::vector<Vec3> line;
+  for (int i = 0; i < 50; ++i) line.emplace_back(0.1 * i, 0.2 * i, 0.3 * i);
+  const auto rl = estimateNormals(line);
+  EXPECT_EQ(rl.invalidCount, line.size());
+  EXPECT_TRUE(allUnitAndFinite(rl));
+  for (const Vec3& n : rl.normals) EXPECT_NEAR(n.dot(Vec3(1, 2, 3).normalized()), 0.0, 1e-6);
+
+  // All identical points, and a 2-point cloud.
+  const auto rd = estimateNormals(std::vector<Vec3>(20, Vec3(1, 1, 1)));
+  EXPECT_EQ(rd.invalidCount, 20u);
+  EXPECT_TRUE(allUnitAndFinite(rd));
+  const auto r2 = estimateNormals({Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  EXPECT_EQ(r2.invalidCount, 2u);
+  EXPECT_TRUE(allUnitAndFinite(r2));
+  EXPECT_EQ(estimateNormals(std::vector<Vec3>{}).normals.size(), 0u);
+
+  // Only 2 distinct points among the 10 nearest (duplicates): flagged.
+  std::vector<Vec3> dup(8, Vec3(0, 0, 0));
+  dup.insert(dup.end(), 8, Vec3(1, 0, 0));
+  const auto rdup = estimateNormals(dup);
+  EXPECT_EQ(rdup.invalidCount, dup.size());
+
+  // A non-finite point is flagged; its neighbours are unaffected.
+  std::vector<Vec3> plane = testclouds::plane(500, 1.0, 24);
+  plane[7] = Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0);
+  const auto rp = estimateNormals(plane);
+  EXPECT_EQ(rp.invalidCount, 1u);
+  EXPECT_FALSE(rp.valid[7]);
+  EXPECT_TRUE(allUnitAndFinite(rp));
+}
+
+TEST(NormalEstimation, IdenticalForOneAndTwoThreads) {
+  const auto points = testclouds::sphere(8000, 2.0, 25);
+  NormalEstimationResult one, two;
+  {
+    ThreadLimit limit(1);
+    one = estimateNormals(points);
+  }
+  {
+    ThreadLimit limit(2);
+    two = estimateNormals(points);
+  }
+  ASSERT_EQ(one.normals.size(), two.normals.size());
+  for (std::size_t i = 0; i < one.normals.size(); ++i) {
+    EXPECT_EQ(one.normals[i], two.normals[i]);
+    EXPECT_EQ(one.surfaceVariation[i], two.surfaceVariation[i]);
+  }
+  EXPECT_EQ(one.valid, two.valid);
+}
+
+TEST(NormalEstimation, OptionsAndCancellation) {
+  const auto points = testclouds::plane(3000, 1.0, 26);
+  NormalEstimationOptions bad;
+  bad.k = 2;
+  EXPECT_THROW(estimateNormals(points, bad), OptionError);
+  bad.k = 10;
+  bad.radius = -1;
+  EXPECT_THROW(estimateNormals(points, bad), OptionError);
+  const std::vector<Vec3> other(5, Vec3::Zero());
+  const BruteForceIndex wrong(other);
+  EXPECT_THROW(estimateNormals(points, wrong), OptionError);
+
+  const ProgressCallback stop = [](double, std::string_view) { return false; };
+  EXPECT_THROW(estimateNormals(points, {}, stop), Cancelled);
+  double last = -1;
+  const ProgressCallback record = [&](double f, std::string_view) {
+    last = f;
+    return true;
+  };
+  estimateNormals(points, {}, record);
+  EXPECT_EQ(last, 1.0);
+}

@@ -1,0 +1,211 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/CoreTestClouds.hpp"
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/Parallel.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+double fractionWhere(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,
+                     bool (*ok)(const Vec3& p, const Vec3& n)) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) count += ok(points[i], normals[i]) ? 1 : 0;
+  return double(count) / double(points.size());
+}
+
+// Noisy height field with a ridge: an open, scan-like surface.
+std::vector<Vec3> noisyTerrain(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 2.0);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<Vec3> p(n);
+  for (Vec3& x : p) {
+    const double a = u(rng), b = u(rng);
+    x = Vec3(a, b,
+             0.15 * std::sin(3 * a) * std::cos(2 * b) + 0.2 * std::exp(-20 * (a - 1) * (a - 1)) +
+                 noise(rng));
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(NormalOrientation, MstOrientsAClosedSphereOutward) {
+  const auto points = testclouds::sphere(20000, 1.0, 31, Vec3(0.3, -0.2, 0.1));
+  auto estimate = estimateNormals(points);
+  auto normals = estimate.normals;
+  const auto r = orientNormals(points, normals, {}, estimate.valid);
+  std::size_t outward = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    outward += normals[i].dot(points[i] - Vec3(0.3, -0.2, 0.1)) > 0 ? 1 : 0;
+  EXPECT_GT(double(outward) / double(points.size()), 0.99);
+  EXPECT_EQ(outward, points.size());  // clean dense data: every single one
+  EXPECT_EQ(r.componentCount, 1u);
+  EXPECT_EQ(r.unreliableCount, 0u);
+  EXPECT_EQ(r.reliable.size(), points.size());
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    changed += normals[i] == estimate.normals[i] ? 0 : 1;
+  EXPECT_EQ(r.flippedCount, changed);
+}
+
+TEST(NormalOrientation, MstRestoresRandomlyFlippedNormalsOfTwoSpheres) {
+  auto points = testclouds::sphere(5000, 1.0, 32);
+  const auto second = testclouds::sphere(5000, 1.0, 33, Vec3(5, 0, 0));
+  points.insert(points.end(), second.begin(), second.end());
+  std::vector<Vec3> truth(points.size()), normals(points.size());
+  std::mt19937_64 rng(34);
+  std::size_t flippedIn = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    truth[i] = (i < 5000 ? points[i] : points[i] - Vec3(5, 0, 0)).normalized();
+    const bool flip = rng() % 2;
+    flippedIn += flip;
+    normals[i] = flip ? -truth[i] : truth[i];
+  }
+  const auto r = orientNormals(points, normals);
+  EXPECT_EQ(r.componentCount, 2u);
+  for (std::size_t i = 0; i < points.size(); ++i) ASSERT_EQ(normals[i], truth[i]) << i;
+  EXPECT_EQ(r.flippedCount, flippedIn);
+}
+
+TEST(NormalOrientation, MstMakesANoisyOpenSurfaceConsistent) {
+  const auto points = noisyTerrain(20000, 35);
+  auto estimate = estimateNormals(points);
+  auto normals = estimate.normals;
+  const auto r = orientNormals(points, normals, {}, estimate.valid);
+  EXPECT_EQ(r.componentCount, 1u);
+  // A height field seen from above: every normal points up.
+  EXPECT_GT(fractionWhere(points, normals, [](const Vec3&, const Vec3& n) { return n.z() > 0; }),
+            0.99);
+  // Neighbours agree: n_i . n_j > 0 over the 10-NN graph.
+  const auto index = makeSpatialIndex(points);
+  std::vector<Neighbor> nbrs;
+  std::size_t agree = 0, total = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    index->knnSearch(points[i], 10, nbrs);
+    for (const Neighbor& nb : nbrs) {
+      ++total;
+      agree += normals[i].dot(normals[nb.index]) > 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(double(agree) / double(total), 0.99);
+  EXPECT_LT(r.unreliableCount, points.size() / 100);
+}
+
+TEST(NormalOrientation, SharpCreaseAndLonePointsAreUnreliable) {
+  // An L-shaped fold: the floor z = 0 (x > 0) and the wall x = 0 (z > 0), exact normals. The tree
+  // must cross the 90-degree crease once, and that sign is a guess.
+  std::vector<Vec3> points, normals;
+  for (int i = 1; i <= 20; ++i)
+    for (int j = 0; j < 20; ++j) {
+      points.emplace_back(0.05 * i, 0.05 * j, 0.0);
+      normals.emplace_back(0, 0, (i + j) % 2 ? 1 : -1);
+      points.emplace_back(0.0, 0.05 * j, 0.05 * i);
+      normals.emplace_back((i * j) % 3 ? 1 : -1, 0, 0);
+    }
+  const auto r = orientNormals(points, normals);
+  EXPECT_EQ(r.componentCount, 1u);
+  EXPECT_GE(r.unreliableCount, 1u);
+  EXPECT_LE(r.unreliableCount, 5u);
+  // Each face is consistent with itself.
+  int floorUp = 0, wallPlus = 0;
+  for (std::size_t i = 0; i < points.size(); i += 2) floorUp += normals[i].z() > 0 ? 1 : -1;
+  for (std::size_t i = 1; i < points.size(); i += 2) wallPlus += normals[i].x() > 0 ? 1 : -1;
+  EXPECT_EQ(std::abs(floorUp), 400);
+  EXPECT_EQ(std::abs(wallPlus), 400);
+}
+
+TEST(NormalOrientation, InvalidAndDegenerateNormalsAreFlaggedWithoutNaN) {
+  auto points = testclouds::plane(400, 1.0, 36);
+  std::vector<Vec3> normals(points.size(), Vec3(0, 0, -1));
+  std::vector<std::uint8_t> valid(points.size(), 1);
+  valid[3] = 0;
+  normals[3] = Vec3(0, 0, 1);  // invalid estimate: follows its neighbours, flagged
+  normals[4] = Vec3::Zero();   // unusable: left as is, flagged
+  const auto r = orientNormals(points, normals, {}, valid);
+  EXPECT_FALSE(r.reliable[3]);
+  EXPECT_FALSE(r.reliable[4]);
+  EXPECT_EQ(r.unreliableCount, 2u);
+  EXPECT_EQ(normals[3], Vec3(0, 0, 1));
+  EXPECT_EQ(normals[4], Vec3::Zero());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_TRUE(normals[i].allFinite());
+    if (i != 4) {
+      EXPECT_EQ(normals[i], Vec3(0, 0, 1));
+    }
+  }
+
+  // A single valid point is its own component: oriented +z, but unreliable.
+  std::vector<std::uint8_t> onlyOne(points.size(), 0);
+  onlyOne[0] = 1;
+  std::vector<Vec3> down(points.size(), Vec3(0, 0, -1));
+  const auto lone = orientNormals(points, down, {}, onlyOne);
+  EXPECT_EQ(lone.componentCount, 1u);
+  EXPECT_EQ(lone.unreliableCount, points.size());
+  EXPECT_EQ(down[0], Vec3(0, 0, 1));
+
+  // Empty input, and colinear input whose estimates are all flagged.
+  std::vector<Vec3> none;
+  EXPECT_EQ(orientNormals(none, none).reliable.size(), 0u);
+  std::vector<Vec3> line;
+  for (int i = 0; i < 30; ++i) line.emplace_back(i, 0, 0);
+  auto est = estimateNormals(line);
+  const auto rl = orientNormals(line, est.normals, {}, est.valid);
+  EXPECT_EQ(rl.unreliableCount, line.size());
+  for (const Vec3& n : est.normals) EXPECT_TRUE(n.allFinite());
+}
+
+TEST(NormalOrientation, Viewpoint) {
+  const auto points = testclouds::plane(1000, 1.0, 37);
+  std::mt19937_64 rng(38);
+  std::vector<Vec3> normals(points.size());
+  for (Vec3& n : normals) n = rng() % 2 ? Vec3(0, 0, 1) : Vec3(0, 0, -1);
+  NormalOrientationOptions options;
+  options.method = OrientationMethod::Viewpoint;
+  options.viewpoint = Vec3(0.5, 0.5, 10);
+  auto up = normals;
+  const auto r = orientNormals(points, up, options);
+  for (const Vec3& n : up) EXPECT_EQ(n, Vec3(0, 0, 1));
+  EXPECT_EQ(r.unreliableCount, 0u);
+  options.viewpoint = Vec3(0.5, 0.5, -10);
+  auto down = normals;
+  orientNormals(points, down, options);
+  for (const Vec3& n : down) EXPECT_EQ(n, Vec3(0, 0, -1));
+  // Seen from the plane itself, every ray is tangent: all unreliable.
+  options.viewpoint = Vec3(20, 20, 0);
+  auto grazing = normals;
+  EXPECT_EQ(orientNormals(points, grazing, options).unreliableCount, points.size());
+  options.viewpoint = Vec3(0, 0, std::nan(""));
+  EXPECT_THROW(orientNormals(points, grazing, options), OptionError);
+}
+
+TEST(NormalOrientation, DeterministicAcrossThreadsAndCancellable) {
+  const auto points = noisyTerrain(6000, 39);
+  const auto estimate = estimateNormals(points);
+  std::vector<Vec3> one = estimate.normals, two = estimate.normals;
+  NormalOrientationResult r1, r2;
+  {
+    ThreadLimit limit(1);
+    r1 = orientNormals(points, one, {}, estimate.valid);
+  }
+  {
+    ThreadLimit limit(2);
+    r2 = orientNormals(points, two, {}, estimate.valid);
+  }
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(r1.reliable, r2.reliable);
+  EXPECT_EQ(r1.flippedCount, r2.flippedCount);
+
+  std::vector<Vec3> untouched = estimate.normals;
+  const ProgressCallback stop = [](double, std::string_view) { return false; };
+  EXPECT_THROW(orientNormals(points, untouched, {}, estimate.valid, stop), Cancelled);
+  EXPECT_EQ(untouched, estimate.normals);
+  std::vector<Vec3> wrongSize(3);
+  EXPECT_THROW(orientNormals(points, wrongSize), OptionError);
+}
