@@ -51,9 +51,7 @@ TriangleMesh parseObj(std::string_view data, const std::string& file) {
       for (int k = 0; k < 3; ++k) {
         const auto value = parseNumber(tokens[std::size_t(k) + 1]);
         if (!value)
-          throw FileError(
-              file, where,
-              "'" + std::string(tokens[std::size_t(k) + 1].substr(0, 32)) + "' is not a number");
+          throw FileError(file, where, quoted(tokens[std::size_t(k) + 1]) + " is not a number");
         values[k] = *value;
       }
       if (keyword == "v") {
@@ -75,9 +73,8 @@ TriangleMesh parseObj(std::string_view data, const std::string& file) {
         std::size_t vertex = 0;
         if (!resolveIndex(corner.substr(0, slash), mesh.vertices.size(), vertex))
           throw FileError(file, where,
-                          "vertex reference '" + std::string(corner.substr(0, 32)) +
-                              "' is not one of the " + std::to_string(mesh.vertices.size()) +
-                              " vertices defined so far");
+                          "vertex reference " + quoted(corner) + " is not one of the " +
+                              std::to_string(mesh.vertices.size()) + " vertices defined so far");
         polygon.push_back(Index(vertex));
         const std::size_t second =
             slash == std::string_view::npos ? std::string_view::npos : corner.find('/', slash + 1);
@@ -85,9 +82,8 @@ TriangleMesh parseObj(std::string_view data, const std::string& file) {
         std::size_t normal = 0;
         if (!resolveIndex(corner.substr(second + 1), fileNormals.size(), normal))
           throw FileError(file, where,
-                          "normal reference in '" + std::string(corner.substr(0, 32)) +
-                              "' is not one of the " + std::to_string(fileNormals.size()) +
-                              " normals defined so far");
+                          "normal reference in " + quoted(corner) + " is not one of the " +
+                              std::to_string(fileNormals.size()) + " normals defined so far");
         facesReferenceNormals = true;
         long& current = normalOf[vertex];
         if (current == kNoNormal)

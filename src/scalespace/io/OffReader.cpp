@@ -34,8 +34,7 @@ TriangleMesh parseOff(std::string_view data, const std::string& file) {
   const std::string_view keyword = tokens[0];
   if (keyword != "OFF" && keyword != "NOFF" && keyword != "COFF" && keyword != "CNOFF")
     throw FileError(file, lineWhere(lines.lineNumber()),
-                    "expected the header OFF, NOFF, COFF or CNOFF, found '" +
-                        std::string(keyword.substr(0, 32)) + "'",
+                    "expected the header OFF, NOFF, COFF or CNOFF, found " + quoted(keyword),
                     "not an OFF file: check the file extension");
   const bool withNormals = keyword == "NOFF" || keyword == "CNOFF";
   tokens.erase(tokens.begin());
@@ -75,9 +74,7 @@ TriangleMesh parseOff(std::string_view data, const std::string& file) {
     double values[6];
     for (std::size_t k = 0; k < needed; ++k) {
       const auto value = parseNumber(tokens[k]);
-      if (!value)
-        throw FileError(file, where,
-                        "'" + std::string(tokens[k].substr(0, 32)) + "' is not a number");
+      if (!value) throw FileError(file, where, quoted(tokens[k]) + " is not a number");
       values[k] = *value;
     }
     mesh.vertices.emplace_back(values[0], values[1], values[2]);
@@ -94,16 +91,15 @@ TriangleMesh parseOff(std::string_view data, const std::string& file) {
     const auto corners = parseUnsigned(tokens[0]);
     if (!corners || *corners < 3 || *corners > tokens.size() - 1)
       throw FileError(file, where,
-                      "expected '<n >= 3> <n vertex indices>', found '" +
-                          std::string(tokens[0].substr(0, 32)) + "' with " +
-                          std::to_string(tokens.size() - 1) + " values after it");
+                      "expected '<n >= 3> <n vertex indices>', found " + quoted(tokens[0]) +
+                          " with " + std::to_string(tokens.size() - 1) + " values after it");
     std::vector<Index> polygon(*corners);
     for (std::size_t k = 0; k < *corners; ++k) {
       const auto index = parseUnsigned(tokens[k + 1]);
       if (!index || *index >= mesh.vertices.size())
         throw FileError(file, where,
-                        "vertex index '" + std::string(tokens[k + 1].substr(0, 32)) +
-                            "' is not in [0, " + std::to_string(mesh.vertices.size()) + ")");
+                        "vertex index " + quoted(tokens[k + 1]) + " is not in [0, " +
+                            std::to_string(mesh.vertices.size()) + ")");
       polygon[k] = Index(*index);
     }
     // Fan triangulation of the (assumed convex) polygon.

@@ -58,7 +58,7 @@ PcdHeader parseHeader(std::string_view data, const std::string& file) {
   bool haveVersion = false;
   while (true) {
     if (!lines.next(line))
-      throw FileError(file, lineWhere(lines.lineNumber()),
+      throw FileError(file, lineWhere(std::max<std::size_t>(1, lines.lineNumber())),
                       lines.lineNumber() == 0 ? "empty file: expected a PCD header"
                                               : "the header has no DATA line",
                       "the file is truncated or not a PCD file");
@@ -107,8 +107,7 @@ PcdHeader parseHeader(std::string_view data, const std::string& file) {
                         "expected ascii, binary or binary_compressed");
       break;
     } else {
-      throw FileError(file, where,
-                      "unknown header keyword '" + std::string(key.substr(0, 32)) + "'");
+      throw FileError(file, where, "unknown header keyword " + quoted(key));
     }
   }
   header.dataOffset = lines.offset();
@@ -123,11 +122,13 @@ PcdHeader parseHeader(std::string_view data, const std::string& file) {
   if (!width) throw FileError(file, where, "the header has no WIDTH");
   const unsigned long long h = height ? *height : 1;
   unsigned long long total = 0;
-  if (__builtin_mul_overflow(*width, h, &total) || (points && *points != total))
+  const std::string product =
+      "WIDTH * HEIGHT (" + std::to_string(*width) + " * " + std::to_string(h) + ")";
+  if (__builtin_mul_overflow(*width, h, &total))
+    throw FileError(file, where, product + " overflows");
+  if (points && *points != total)
     throw FileError(file, where,
-                    "WIDTH * HEIGHT (" + std::to_string(*width) + " * " + std::to_string(h) +
-                        ") does not equal POINTS (" + (points ? std::to_string(*points) : "") +
-                        ")");
+                    product + " does not equal POINTS (" + std::to_string(*points) + ")");
   header.points = std::size_t(total);
   for (std::size_t f = 0; f < names.size(); ++f) {
     PcdField field;
@@ -262,8 +263,8 @@ PointCloud readPcd(std::string_view data, const std::string& file, const ReadOpt
           const auto value = parseNumber(tokens[t]);
           if (!value || !fitsScalarType(*value, field.scalar))
             throw FileError(file, lineWhere(lineNumber),
-                            "'" + std::string(tokens[t].substr(0, 32)) + "' is not a valid " +
-                                scalarTypeName(field.scalar) + " for field '" + field.name + "'");
+                            quoted(tokens[t]) + " is not a valid " + scalarTypeName(field.scalar) +
+                                " for field '" + field.name + "'");
           std::uint32_t packed = 0;
           if (targets[f][c].kind == Target::PackedColour) {
             if (field.type == 'F') {

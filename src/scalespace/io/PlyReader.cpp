@@ -100,8 +100,7 @@ PlyHeader parseHeader(std::string_view data, const std::string& file) {
       else if (tokens[1] == "binary_big_endian")
         header.encoding = PlyEncoding::BinaryBigEndian;
       else
-        throw FileError(file, where,
-                        "unknown PLY encoding '" + std::string(tokens[1].substr(0, 32)) + "'",
+        throw FileError(file, where, "unknown PLY encoding " + quoted(tokens[1]),
                         "expected ascii, binary_little_endian or binary_big_endian");
       haveFormat = true;
     } else if (keyword == "element") {
@@ -126,8 +125,7 @@ PlyHeader parseHeader(std::string_view data, const std::string& file) {
       } else if (tokens.size() == 3) {
         const auto type = plyType(tokens[1]);
         if (!type)
-          throw FileError(file, where,
-                          "unknown property type '" + std::string(tokens[1].substr(0, 32)) + "'",
+          throw FileError(file, where, "unknown property type " + quoted(tokens[1]),
                           "expected char, uchar, short, ushort, int, uint, float, double or "
                           "int8 ... float64");
         property = PlyProperty{std::string(tokens[2]), *type, false, ScalarType::UInt8};
@@ -139,8 +137,7 @@ PlyHeader parseHeader(std::string_view data, const std::string& file) {
           throw FileError(file, where, "property '" + p.name + "' is declared twice");
       header.elements.back().properties.push_back(property);
     } else {
-      throw FileError(file, where,
-                      "unknown header keyword '" + std::string(keyword.substr(0, 32)) + "'",
+      throw FileError(file, where, "unknown header keyword " + quoted(keyword),
                       "expected format, element, property, comment, obj_info or end_header");
     }
   }
@@ -319,8 +316,8 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
         const auto value = parseNumber(tokens[t]);
         if (!value || !fitsScalarType(*value, type))
           throw FileError(file, lineWhere(lineNumber),
-                          "'" + std::string(tokens[t].substr(0, 32)) + "' is not a valid " +
-                              scalarTypeName(type) + " for property '" + name + "'");
+                          quoted(tokens[t]) + " is not a valid " + scalarTypeName(type) +
+                              " for property '" + name + "'");
         ++t;
         return toStoredValue(*value, type);  // a float property holds a float
       };

@@ -53,8 +53,19 @@ std::optional<double> parseNumber(std::string_view token) {
   if (token.empty() || token.front() == '+') return std::nullopt;
   double value = 0.0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  // Out-of-range decimal text (1e999) is reported by from_chars as an error: reject it too.
-  if (ec != std::errc() || end != token.data() + token.size()) return std::nullopt;
+  if (end != token.data() + token.size()) return std::nullopt;
+  if (ec == std::errc::result_out_of_range) {
+    // A well-formed number beyond the double range: overflow gives +-inf (then rejected as a
+    // non-finite coordinate, or kept in an attribute), underflow (negative exponent) +-0, as
+    // strtod would.
+    const bool negative = token.front() == '-';
+    const std::size_t e = token.find_first_of("eE");
+    const bool underflow =
+        e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
+    const double magnitude = underflow ? 0.0 : std::numeric_limits<double>::infinity();
+    return negative ? -magnitude : magnitude;
+  }
+  if (ec != std::errc()) return std::nullopt;
   return value;
 }
 
@@ -149,6 +160,14 @@ std::string formatScalar(double value, ScalarType type) {
     return std::string(buffer, result.ptr);
   }
   return formatNumber(stored);
+}
+
+std::string quoted(std::string_view token) {
+  std::string out = "'";
+  for (std::size_t i = 0; i < token.size() && i < 32; ++i)
+    out += token[i] >= 32 && token[i] < 127 ? token[i] : '?';
+  if (token.size() > 32) out += "...";
+  return out + "'";
 }
 
 std::string toLower(std::string_view s) {

@@ -51,5 +51,8 @@ std::string formatScalar(double value, ScalarType type);
 double toStoredValue(double value, ScalarType type);
 
 std::string toLower(std::string_view s);
+/// `token` in single quotes for an error message: at most 32 characters, non-printable bytes
+/// shown as '?', so binary garbage never ends up in a terminal.
+std::string quoted(std::string_view token);
 
 }  // namespace scalespace::io_detail

@@ -128,9 +128,9 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
     for (std::size_t c = 0; c < fields.size(); ++c) {
       const auto value = parseNumber(fields[c]);
       if (!value)
-        throw FileError(file, lineWhere(lineNumber),
-                        "field " + std::to_string(c + 1) + " '" +
-                            std::string(fields[c].substr(0, 32)) + "' is not a number");
+        throw FileError(
+            file, lineWhere(lineNumber),
+            "field " + std::to_string(c + 1) + " " + quoted(fields[c]) + " is not a number");
       const int role = layout.role[c];
       if (role < 0)
         values[column++] = *value;
