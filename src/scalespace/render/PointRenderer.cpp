@@ -1,0 +1,147 @@
+#include "scalespace/render/PointRenderer.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/render/ColorMap.hpp"
+
+namespace scalespace {
+
+Vec3 viewDirection(const std::string& view) {
+  if (view == "front") return Vec3::UnitY();
+  if (view == "top") return -Vec3::UnitZ();
+  if (view == "iso") return Vec3(-1, 1, -1).normalized();
+  std::stringstream in(view);
+  Vec3 d;
+  char c1 = 0, c2 = 0;
+  if (in >> d.x() >> c1 >> d.y() >> c2 >> d.z() && c1 == ',' && c2 == ',' &&
+      (in >> std::ws).eof() && d.allFinite() && d.norm() > 0)
+    return d.normalized();
+  throw OptionError("--view '" + view +
+                    "' is not front, top, iso or a direction X,Y,Z (e.g. 1,0,-1)");
+}
+
+namespace {
+const AttributeColumn& requireAttribute(const PointCloud& cloud, const std::string& name) {
+  const AttributeColumn* column = cloud.findAttribute(name);
+  if (!column) {
+    std::string known;
+    for (const auto& a : cloud.attributes()) known += (known.empty() ? "" : ", ") + a.name;
+    throw OptionError("the cloud has no attribute '" + name +
+                      "' (it has: " + (known.empty() ? "none" : known) + ")");
+  }
+  return *column;
+}
+}  // namespace
+
+std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& options) {
+  const std::size_t n = cloud.size();
+  if (!options.colors.empty()) {
+    if (options.colors.size() != n)
+      throw OptionError("render colours: " + std::to_string(options.colors.size()) +
+                        " colours for " + std::to_string(n) + " points");
+    return options.colors;
+  }
+  if (!options.labelAttribute.empty())
+    return colorizeLabels(requireAttribute(cloud, options.labelAttribute).values);
+  if (!options.colorAttribute.empty()) {
+    const auto& values = requireAttribute(cloud, options.colorAttribute).values;
+    return colorizeScalars(values, robustRange(values));
+  }
+  const AttributeColumn* r = cloud.findAttribute("red");
+  const AttributeColumn* g = cloud.findAttribute("green");
+  const AttributeColumn* b = cloud.findAttribute("blue");
+  if (r && g && b) {
+    // 16-bit colour channels (LAS) are scaled down to 8 bits.
+    double top = 0;
+    for (const auto* c : {r, g, b})
+      for (double v : c->values) top = std::max(top, v);
+    const double scale = top > 255 ? 1.0 / 257.0 : 1.0;
+    std::vector<Rgb> colors(n);
+    auto byte = [&](double v) {
+      return std::uint8_t(std::clamp(std::lround(v * scale), 0L, 255L));
+    };
+    for (std::size_t i = 0; i < n; ++i)
+      colors[i] = {byte(r->values[i]), byte(g->values[i]), byte(b->values[i])};
+    return colors;
+  }
+  return std::vector<Rgb>(n, Rgb{200, 200, 200});
+}
+
+Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
+  if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
+    throw OptionError("--size must be between 1x1 and 16384x16384");
+  if (options.margin < 0 || options.margin >= 0.5)
+    throw OptionError("render margin must be in [0, 0.5)");
+  const Vec3 forward = viewDirection(options.view);
+  const Vec3 upHint = std::abs(forward.z()) > 0.99 ? Vec3::UnitY() : Vec3::UnitZ();
+  const Vec3 right = forward.cross(upHint).normalized();
+  const Vec3 up = right.cross(forward);
+
+  Image image(options.width, options.height, options.background);
+  if (cloud.empty()) return image;
+  const std::vector<Rgb> colors = pointColors(cloud, options);
+
+  // Framing: the projected corners of the bounding box fill the image minus the margin.
+  Vec3 lo, hi;
+  cloud.bounds(lo, hi);
+  double minX = 1e300, maxX = -1e300, minY = 1e300, maxY = -1e300;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                      (c & 4) ? hi.z() : lo.z());
+    minX = std::min(minX, corner.dot(right));
+    maxX = std::max(maxX, corner.dot(right));
+    minY = std::min(minY, corner.dot(up));
+    maxY = std::max(maxY, corner.dot(up));
+  }
+  const double usable = 1.0 - 2.0 * options.margin;
+  const double spanX = maxX - minX, spanY = maxY - minY;
+  double scale = 1.0;  // pixels per unit; a single point (zero span) keeps 1
+  if (spanX > 0 || spanY > 0)
+    scale = std::min(spanX > 0 ? usable * options.width / spanX : 1e300,
+                     spanY > 0 ? usable * options.height / spanY : 1e300);
+  const double centreX = 0.5 * (minX + maxX), centreY = 0.5 * (minY + maxY);
+
+  int radius = options.pointRadius;
+  if (radius < 0) {
+    // Half the mean spacing of the points over the framed area, so a dense surface looks closed.
+    const double area = std::max(1.0, spanX * scale) * std::max(1.0, spanY * scale);
+    radius = int(std::clamp(std::lround(0.5 * std::sqrt(area / double(cloud.size()))), 0L, 8L));
+  }
+
+  std::vector<float> depth(image.pixels.size(), std::numeric_limits<float>::infinity());
+  const auto& positions = cloud.positions();
+  const bool shade = options.shading && cloud.hasNormals();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = positions[i];
+    const double sx = 0.5 * options.width + (p.dot(right) - centreX) * scale;
+    const double sy = 0.5 * options.height - (p.dot(up) - centreY) * scale;
+    const float z = float(p.dot(forward));  // smaller = nearer to the camera
+    if (!std::isfinite(sx) || !std::isfinite(sy)) continue;
+    const int px = int(std::floor(sx)), py = int(std::floor(sy));
+    Rgb c = colors[i];
+    if (shade) {
+      // Two-sided headlight: normals of unoriented clouds may point either way.
+      const double s = 0.35 + 0.65 * std::min(1.0, std::abs(cloud.normals()[i].dot(forward)));
+      c = {std::uint8_t(c.r * s), std::uint8_t(c.g * s), std::uint8_t(c.b * s)};
+    }
+    for (int dy = -radius; dy <= radius; ++dy)
+      for (int dx = -radius; dx <= radius; ++dx) {
+        if (dx * dx + dy * dy > radius * radius) continue;
+        const int x = px + dx, y = py + dy;
+        if (x < 0 || y < 0 || x >= options.width || y >= options.height) continue;
+        float& zb = depth[std::size_t(y) * options.width + x];
+        if (z < zb) {  // z-buffer: the nearest splat wins
+          zb = z;
+          image.at(x, y) = c;
+        }
+      }
+  }
+  return image;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,155 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/render/ColorMap.hpp"
+#include "scalespace/render/PngWriter.hpp"
+#include "scalespace/render/PointRenderer.hpp"
+
+using namespace scalespace;
+
+namespace {
+PointCloud cloudOf(const std::vector<Vec3>& points) {
+  PointCloud cloud;
+  cloud.setAbsolutePositions(points);
+  return cloud;
+}
+std::string tempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("scalespace_render_" + name)).string();
+}
+}  // namespace
+
+TEST(ColorMap, ViridisEndsAndRobustRange) {
+  EXPECT_EQ(viridis(0.0), (Rgb{68, 1, 84}));
+  EXPECT_EQ(viridis(1.0), (Rgb{253, 231, 37}));
+  EXPECT_EQ(viridis(-3.0), viridis(0.0));
+  EXPECT_EQ(viridis(0.5), (Rgb{33, 144, 141}));
+  // Perceptual map: luminance increases monotonically.
+  double previous = -1;
+  for (int k = 0; k <= 100; ++k) {
+    const Rgb c = viridis(k / 100.0);
+    const double luminance = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+    EXPECT_GE(luminance, previous - 0.5);
+    previous = luminance;
+  }
+  std::vector<double> values;
+  for (int i = 0; i <= 100; ++i) values.push_back(i);
+  values.push_back(1e9);  // outlier
+  values.push_back(std::nan(""));
+  const ScalarRange r = robustRange(values);
+  EXPECT_NEAR(r.lo, 2, 1.01);
+  EXPECT_NEAR(r.hi, 98, 1.01);
+  const auto colors = colorizeScalars(values, r);
+  EXPECT_EQ(colors.back(), kUnlabelledGrey);
+  EXPECT_EQ(colors[101], viridis(1.0));
+}
+
+TEST(ColorMap, LabelColoursAreDistinct) {
+  EXPECT_EQ(labelColor(-1), kUnlabelledGrey);
+  for (int a = 0; a < 20; ++a)
+    for (int b = a + 1; b < 20; ++b) {
+      const Rgb x = labelColor(a), y = labelColor(b);
+      const int d = std::abs(x.r - y.r) + std::abs(x.g - y.g) + std::abs(x.b - y.b);
+      EXPECT_GT(d, 20) << a << " vs " << b;
+    }
+}
+
+TEST(PointRenderer, SingleRedPointAtTheCentre) {
+  PointCloud cloud = cloudOf({Vec3(3, 4, 5)});
+  cloud.addAttribute("red", ScalarType::UInt8, 255);
+  cloud.addAttribute("green", ScalarType::UInt8, 0);
+  cloud.addAttribute("blue", ScalarType::UInt8, 0);
+  RenderOptions opt;
+  opt.width = 64;
+  opt.height = 48;
+  opt.pointRadius = 0;
+  opt.view = "front";
+  const Image image = renderPoints(cloud, opt);
+  int red = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (image.at(x, y) == Rgb{255, 0, 0}) {
+        ++red;
+        EXPECT_EQ(x, 32);
+        EXPECT_EQ(y, 24);
+      } else {
+        EXPECT_EQ(image.at(x, y), opt.background);
+      }
+  EXPECT_EQ(red, 1);
+}
+
+TEST(PointRenderer, DepthTestNearPointHidesFarPoint) {
+  // Two points on the same line of sight (front view looks along +y): y = -1 is nearer.
+  // A third point frames the picture so both land on the same pixel.
+  for (bool nearFirst : {true, false}) {
+    std::vector<Vec3> pts = nearFirst ? std::vector<Vec3>{Vec3(0, -1, 0), Vec3(0, 1, 0)}
+                                      : std::vector<Vec3>{Vec3(0, 1, 0), Vec3(0, -1, 0)};
+    pts.push_back(Vec3(2, 0, 2));
+    PointCloud cloud = cloudOf(pts);
+    RenderOptions opt;
+    opt.width = opt.height = 21;
+    opt.margin = 0;
+    opt.pointRadius = 2;
+    opt.view = "front";
+    const Vec3 nearPoint(0, -1, 0);
+    opt.colors.resize(3);
+    for (int i = 0; i < 3; ++i)
+      opt.colors[std::size_t(i)] =
+          pts[std::size_t(i)] == nearPoint ? Rgb{0, 0, 255} : Rgb{0, 255, 0};
+    const Image image = renderPoints(cloud, opt);
+    // The pair projects to the bottom-left corner area; its splat must be blue, never green.
+    int blue = 0;
+    for (int y = 15; y < 21; ++y)
+      for (int x = 0; x < 6; ++x) {
+        EXPECT_NE(image.at(x, y), (Rgb{0, 255, 0})) << x << "," << y;
+        blue += image.at(x, y) == Rgb{0, 0, 255};
+      }
+    EXPECT_GT(blue, 0);
+  }
+}
+
+TEST(PointRenderer, ViewsAndLabels) {
+  EXPECT_NEAR((viewDirection("top") - Vec3(0, 0, -1)).norm(), 0, 1e-15);
+  EXPECT_NEAR((viewDirection("2,0,0") - Vec3(1, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_THROW(viewDirection("side"), OptionError);
+  EXPECT_THROW(viewDirection("1,2"), OptionError);
+  EXPECT_THROW(viewDirection("0,0,0"), OptionError);
+  PointCloud cloud = cloudOf({Vec3(0, 0, 0), Vec3(1, 0, 1)});
+  cloud.addAttribute("plane_id", ScalarType::Int32).values = {-1, 3};
+  RenderOptions opt;
+  opt.labelAttribute = "plane_id";
+  const auto colors = pointColors(cloud, opt);
+  EXPECT_EQ(colors[0], kUnlabelledGrey);
+  EXPECT_EQ(colors[1], labelColor(3));
+  opt.labelAttribute = "missing";
+  EXPECT_THROW(renderPoints(cloud, opt), OptionError);
+  opt.labelAttribute.clear();
+  opt.width = 0;
+  EXPECT_THROW(renderPoints(cloud, opt), OptionError);
+}
+
+TEST(PngWriter, RoundTripIsExact) {
+  Image image(7, 5);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 7; ++x) image.at(x, y) = {std::uint8_t(x * 30), std::uint8_t(y * 50), 17};
+  const std::string path = tempPath("roundtrip.png");
+  writePng(image, path);
+  const Image back = readPng(path);
+  ASSERT_EQ(back.width, 7);
+  ASSERT_EQ(back.height, 5);
+  EXPECT_TRUE(back.pixels == image.pixels);
+  // Not a PNG: a clear error naming the file.
+  { std::ofstream(path) << "hello"; }
+  try {
+    readPng(path);
+    FAIL() << "expected FileError";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
+  }
+  std::remove(path.c_str());
+  EXPECT_THROW(writePng(Image(), path), Error);
+  EXPECT_THROW(writePng(image, "/nonexistent_dir_xyz/out.png"), FileError);
+}
