@@ -104,3 +104,29 @@ TEST(Xyz, OutOfRangeNumbersOverflowToInfinityAndUnderflowToZero) {
 
 }  // namespace
 }  // namespace scalespace
+
+namespace scalespace {
+namespace {
+
+TEST(Xyz, PtsCountLineIsSkipped) {
+  const PointCloud cloud = readXyz("2\n1 2 3 10 255 0 0\n4 5 6 20 0 255 0\n", "scan.pts");
+  EXPECT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.attributes().size(), 4u);
+}
+
+TEST(Xyz, NormalNamesAsAttributes) {
+  // A partial normal stays an attribute and survives a round trip ...
+  PointCloud cloud = readXyz("x y z nx\n1 2 3 0.5\n", "p.xyz");
+  ASSERT_FALSE(cloud.hasNormals());
+  std::ostringstream out;
+  writeXyz(cloud, out);
+  EXPECT_EQ(readXyz(out.str(), "p.xyz").findAttribute("nx")->values[0], 0.5);
+  // ... but three normal-named attributes would come back as normals: refused.
+  cloud.addAttribute("NY", ScalarType::Float32);
+  cloud.addAttribute("normal_z", ScalarType::Float32);
+  std::ostringstream out2;
+  EXPECT_THROW(writeXyz(cloud, out2), Error);
+}
+
+}  // namespace
+}  // namespace scalespace

@@ -32,8 +32,8 @@ const char* pcdType(ScalarType type) {
 
 void writePcd(const PointCloud& cloud, std::ostream& out, bool ascii) {
   // rgb/rgba would be read back as packed colour, "_" as padding.
-  checkAttributeNames(cloud, "PCD",
-                      {"x", "y", "z", "normal_x", "normal_y", "normal_z", "rgb", "rgba", "_"});
+  checkAttributeNames(cloud, "PCD", {"x", "y", "z", "rgb", "rgba", "_"},
+                      {"normal_x", "normal_y", "normal_z"});
   const ScalarType positionType = positionTypeFor(cloud);
   const bool normals = cloud.hasNormals();
   std::vector<std::string> names = {"x", "y", "z"};

@@ -37,7 +37,7 @@ const char* plyTypeName(ScalarType type) {
 }  // namespace
 
 void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) {
-  checkAttributeNames(cloud, "PLY", {"x", "y", "z", "nx", "ny", "nz"});
+  checkAttributeNames(cloud, "PLY", {"x", "y", "z"}, {"nx", "ny", "nz"});
   const ScalarType positionType = positionTypeFor(cloud);
   const bool normals = cloud.hasNormals();
 

@@ -1,6 +1,7 @@
 #include "scalespace/io/WriteHelpers.hpp"
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/io/TextParsing.hpp"
 
 namespace scalespace::io_detail {
 
@@ -17,13 +18,23 @@ ScalarType positionTypeFor(const PointCloud& cloud) {
 }
 
 void checkAttributeNames(const PointCloud& cloud, const char* format,
-                         std::initializer_list<const char*> reserved) {
+                         std::initializer_list<const char*> reserved,
+                         std::initializer_list<const char*> normalNames, bool caseInsensitive) {
+  auto same = [&](const std::string& name, const char* r) {
+    return caseInsensitive ? toLower(name) == r : name == r;
+  };
+  std::size_t normalColumns = 0;
   for (const auto& column : cloud.attributes()) {
     bool bad = column.name.empty();
     for (char c : column.name)
       if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == ',') bad = true;
     for (const char* r : reserved)
-      if (column.name == r) bad = true;
+      if (same(column.name, r)) bad = true;
+    for (const char* r : normalNames)
+      if (same(column.name, r)) {
+        bad = bad || cloud.hasNormals();
+        ++normalColumns;
+      }
     if (bad)
       throw Error(std::string("cannot write attribute '") + column.name + "' to " + format +
                   ": names must be non-empty, without spaces or commas, and not a position or "
@@ -32,6 +43,9 @@ void checkAttributeNames(const PointCloud& cloud, const char* format,
       throw Error("attribute '" + column.name + "' has " + std::to_string(column.values.size()) +
                   " values for " + std::to_string(cloud.size()) + " points");
   }
+  if (normalColumns >= 3)
+    throw Error(std::string("cannot write attributes named like the normals to ") + format +
+                ": they would be read back as normals (rename them or set them as normals)");
 }
 
 }  // namespace scalespace::io_detail

@@ -101,6 +101,8 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
     const std::size_t lineNumber = lines.lineNumber();
     splitFields(line, fields);
     if (!started) {
+      // Leica PTS files start with a line holding only the point count: skip it.
+      if (fields.size() == 1 && parseUnsigned(fields[0])) continue;
       started = true;
       bool header = false;
       for (auto f : fields) header = header || (!f.empty() && !parseNumber(f));
@@ -145,8 +147,9 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
 }
 
 void writeXyz(const PointCloud& cloud, std::ostream& out, char separator) {
-  checkAttributeNames(cloud, "XYZ",
-                      {"x", "y", "z", "nx", "ny", "nz", "normal_x", "normal_y", "normal_z"});
+  checkAttributeNames(cloud, "XYZ", {"x", "y", "z"},
+                      {"nx", "ny", "nz", "normal_x", "normal_y", "normal_z"},
+                      /*caseInsensitive=*/true);
   const bool normals = cloud.hasNormals();
   std::string line = "x";
   line += separator;

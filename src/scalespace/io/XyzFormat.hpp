@@ -2,7 +2,8 @@
 // Text columns (.xyz .txt .csv .pts): one point per line, "x y z [nx ny nz] [more columns]".
 //
 // Fields are separated by whitespace, or by commas when the line holds a comma. Blank lines and
-// lines starting with '#' are skipped. If the first data line holds a token that is not a
+// lines starting with '#' are skipped, and so is a first line holding a single integer (the
+// point count of Leica .pts files). If the first data line holds a token that is not a
 // number, it is a header naming the columns (case-insensitive x/y/z, nx/ny/nz or
 // normal_x/normal_y/normal_z; a leading "//" as CloudCompare writes it is ignored); x, y and z
 // must all be named. Without a header the column count decides, and only these counts:
