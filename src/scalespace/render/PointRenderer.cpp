@@ -49,7 +49,15 @@ std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& optio
   if (!options.labelAttribute.empty())
     return colorizeLabels(requireAttribute(cloud, options.labelAttribute).values);
   if (!options.colorAttribute.empty()) {
-    const auto& values = requireAttribute(cloud, options.colorAttribute).values;
+    const std::string& name = options.colorAttribute;
+    // "x", "y", "z" colour by a coordinate unless the cloud has a column of that name.
+    if (!cloud.findAttribute(name) && (name == "x" || name == "y" || name == "z")) {
+      std::vector<double> values(n);
+      const int axis = name[0] - 'x';
+      for (std::size_t i = 0; i < n; ++i) values[i] = cloud.absolutePosition(i)[axis];
+      return colorizeScalars(values, robustRange(values));
+    }
+    const auto& values = requireAttribute(cloud, name).values;
     return colorizeScalars(values, robustRange(values));
   }
   const AttributeColumn* r = cloud.findAttribute("red");

@@ -16,8 +16,8 @@ struct RenderOptions {
   /// direction the camera looks along. Up is +z (or +y when looking along z).
   std::string view = "iso";
   /// Colour source, first match wins: `colors` (one per point), `labelAttribute` (distinct hues,
-  /// -1 grey), `colorAttribute` (viridis over the 2nd-98th percentile), the cloud's
-  /// red/green/blue columns, else light grey.
+  /// -1 grey), `colorAttribute` (viridis over the 2nd-98th percentile; x, y, z = coordinates), the
+  /// cloud's red/green/blue columns, else light grey.
   std::vector<Rgb> colors;
   std::string labelAttribute;
   std::string colorAttribute;
