@@ -203,7 +203,7 @@ void benchSurface(const std::string& name, const std::vector<Vec3>& input, std::
       sortedTree.radiusSearch(q, radius, b);
       mismatches += a.size() != b.size();
     }
-    // The kd-tree on the same (scattered, cache-cold) queries, one thread, best of 20 runs.
+    // The kd-tree on the same scattered queries, one thread, best of 20 runs (so warm caches).
     double tTree = 1e30;
     for (int rep = 0; rep < 20; ++rep) {
       t0 = Clock::now();
