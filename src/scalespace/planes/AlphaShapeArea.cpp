@@ -1,0 +1,109 @@
+#include "scalespace/planes/AlphaShapeArea.hpp"
+
+#include <CGAL/Alpha_shape_2.h>
+#include <CGAL/Alpha_shape_face_base_2.h>
+#include <CGAL/Alpha_shape_vertex_base_2.h>
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <Eigen/Eigenvalues>
+#include <map>
+
+namespace scalespace {
+
+namespace {
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Alpha_shape_vertex_base_2<Kernel>;
+using Fb = CGAL::Alpha_shape_face_base_2<Kernel>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
+using Alpha = CGAL::Alpha_shape_2<Delaunay>;
+}  // namespace
+
+AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withOutlines) {
+  AlphaShape result;
+  if (points.size() < 3 || !(alpha > 0)) return result;
+  std::vector<Kernel::Point_2> cgalPoints;
+  cgalPoints.reserve(points.size());
+  for (const Vec2& p : points) cgalPoints.emplace_back(p.x(), p.y());
+  Alpha shape(cgalPoints.begin(), cgalPoints.end(), Kernel::FT(alpha), Alpha::REGULARIZED);
+
+  for (auto f = shape.finite_faces_begin(); f != shape.finite_faces_end(); ++f) {
+    if (shape.classify(f) != Alpha::INTERIOR) continue;
+    result.area += std::abs(CGAL::to_double(Kernel().compute_area_2_object()(
+        f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point())));
+  }
+  if (!withOutlines) return result;
+
+  // Regular edges bound the interior; orient each one counter-clockwise around its interior
+  // face, then chain them into loops by their start vertex.
+  std::multimap<std::pair<double, double>, std::pair<double, double>> next;
+  for (auto e = shape.alpha_shape_edges_begin(); e != shape.alpha_shape_edges_end(); ++e) {
+    auto face = e->first;
+    int i = e->second;
+    if (shape.classify(face) != Alpha::INTERIOR) {
+      const auto opposite = face->neighbor(i);
+      i = opposite->index(face);
+      face = opposite;
+    }
+    const auto& a = face->vertex(Delaunay::ccw(i))->point();
+    const auto& b = face->vertex(Delaunay::cw(i))->point();
+    next.emplace(std::make_pair(a.x(), a.y()), std::make_pair(b.x(), b.y()));
+  }
+  while (!next.empty()) {
+    std::vector<Vec2> loop;
+    auto it = next.begin();
+    const auto start = it->first;
+    auto current = it->first;
+    while (it != next.end()) {
+      loop.emplace_back(current.first, current.second);
+      const auto to = it->second;
+      next.erase(it);
+      if (to == start) break;
+      current = to;
+      it = next.find(current);
+    }
+    result.outlines.push_back(std::move(loop));
+  }
+  return result;
+}
+
+PlaneFit fitPlane(const std::vector<Vec3>& positions, const std::vector<Index>& indices) {
+  PlaneFit fit;
+  if (indices.size() < 3) return fit;
+  Vec3 c = Vec3::Zero();
+  for (Index i : indices) c += positions[i];
+  c /= double(indices.size());
+  Mat3 cov = Mat3::Zero();
+  for (Index i : indices) {
+    const Vec3 d = positions[i] - c;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+  fit.centroid = c;
+  fit.normal = eig.eigenvectors().col(0).normalized();
+  fit.axisU = eig.eigenvectors().col(2).normalized();
+  fit.axisV = fit.normal.cross(fit.axisU);
+  fit.offset = fit.normal.dot(c);
+  // The smallest eigenvalue is the sum of squared distances to the plane.
+  fit.rms = std::sqrt(std::max(0.0, eig.eigenvalues()(0)) / double(indices.size()));
+  fit.valid = true;
+  return fit;
+}
+
+std::vector<Vec2> projectOnPlane(const PlaneFit& plane, const std::vector<Vec3>& positions,
+                                 const std::vector<Index>& indices) {
+  std::vector<Vec2> out;
+  out.reserve(indices.size());
+  for (Index i : indices) {
+    const Vec3 d = positions[i] - plane.centroid;
+    out.emplace_back(d.dot(plane.axisU), d.dot(plane.axisV));
+  }
+  return out;
+}
+
+Vec3 liftFromPlane(const PlaneFit& plane, const Vec2& p) {
+  return plane.centroid + p.x() * plane.axisU + p.y() * plane.axisV;
+}
+
+}  // namespace scalespace

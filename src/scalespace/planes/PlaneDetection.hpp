@@ -1,0 +1,36 @@
+#pragma once
+// The automatic part of Chapter 2 (Fig. 2.4): per-scale segmentation and filtering, the region
+// graph and its components, with the time spent in each step (Table 2.1 columns).
+#include <vector>
+
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/planes/PlaneComponent.hpp"
+#include "scalespace/planes/RegionGraph.hpp"
+
+namespace scalespace {
+
+struct PlaneDetectionOptions {
+  RegionGrowingOptions growing;  // theta = 5 degrees
+  double alphaFactor = 2.0;      // alpha-shape radius and minimum extent: 2t
+  double minJaccard = 0.5;       // Sec. 2.3.2
+  bool outlines = true;
+};
+
+struct PlaneDetectionTimings {
+  double segmentation = 0, filtering = 0, graph = 0, components = 0;  // seconds
+};
+
+struct PlaneDetection {
+  RegionGraph graph;
+  std::vector<PlaneComponent> components;  // same ids as graph.components
+  PlaneDetectionTimings timings;
+  int scaleCount() const { return int(graph.levels.size()); }
+};
+
+/// Runs Sec. 2.3 on precomputed scale features (increasing t) and the k-NN graph of `positions`.
+PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                            const std::vector<ScaleFeatures>& scales,
+                            const PlaneDetectionOptions& options = {},
+                            const ProgressCallback& progress = {});
+
+}  // namespace scalespace

@@ -1,0 +1,109 @@
+#include "scalespace/planes/RegionGraph.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <unordered_map>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b) {
+  std::size_t common = 0;
+  for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+    if (a[i] < b[j])
+      ++i;
+    else if (b[j] < a[i])
+      ++j;
+    else
+      ++common, ++i, ++j;
+  }
+  const std::size_t unionSize = a.size() + b.size() - common;
+  return unionSize == 0 ? 0.0 : double(common) / double(unionSize);
+}
+
+namespace {
+std::vector<int> regionLabels(const RegionLevel& level, std::size_t pointCount) {
+  std::vector<int> labels(pointCount, -1);
+  for (std::size_t r = 0; r < level.regions.size(); ++r)
+    for (Index i : level.regions[r].points) {
+      if (i >= pointCount) throw OptionError("region graph: a region holds a point out of range");
+      if (labels[i] >= 0) throw OptionError("region graph: regions of one level overlap");
+      labels[i] = int(r);
+    }
+  return labels;
+}
+}  // namespace
+
+std::vector<int> RegionGraph::componentLabels(int level) const {
+  std::vector<int> labels(pointCount, -1);
+  const auto& regions = levels.at(std::size_t(level)).regions;
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    for (Index i : regions[r].points) labels[i] = componentOf[std::size_t(level)][r];
+  return labels;
+}
+
+RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
+                             double minJaccard) {
+  if (!(minJaccard >= 0.5 && minJaccard < 1))
+    throw OptionError("the Jaccard threshold must be in [0.5, 1): below 0.5 links are ambiguous");
+  RegionGraph graph;
+  graph.pointCount = pointCount;
+  graph.levels = std::move(levels);
+  const std::size_t m = graph.levels.size();
+  graph.successor.resize(m);
+  graph.componentOf.resize(m);
+  std::vector<std::vector<int>> predecessor(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    graph.successor[j].assign(graph.levels[j].regions.size(), -1);
+    graph.componentOf[j].assign(graph.levels[j].regions.size(), -1);
+    predecessor[j].assign(graph.levels[j].regions.size(), -1);
+  }
+  // Edges between consecutive levels: the candidates of region r at level j are the regions of
+  // level j+1 holding its points; J > 0.5 holds for at most one of them (and, symmetrically, for
+  // at most one region of level j per region of level j+1).
+  for (std::size_t j = 0; j + 1 < m; ++j) {
+    const std::vector<int> nextLabels = regionLabels(graph.levels[j + 1], pointCount);
+    const auto& here = graph.levels[j].regions;
+    const auto& next = graph.levels[j + 1].regions;
+    tbb::parallel_for(std::size_t(0), here.size(), [&](std::size_t r) {
+      std::unordered_map<int, std::size_t> overlap;
+      for (Index i : here[r].points)
+        if (nextLabels[i] >= 0) ++overlap[nextLabels[i]];
+      for (const auto& [s, common] : overlap) {
+        const std::size_t unionSize =
+            here[r].points.size() + next[std::size_t(s)].points.size() - common;
+        if (double(common) > minJaccard * double(unionSize)) graph.successor[j][r] = s;  // Eq. 2.1
+      }
+    });
+    for (std::size_t r = 0; r < here.size(); ++r)
+      if (graph.successor[j][r] >= 0)
+        predecessor[j + 1][std::size_t(graph.successor[j][r])] = int(r);
+  }
+  // Chains start at the nodes without predecessor; levels and region indices increase, so the
+  // component order (birth level, then region index) is deterministic.
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t r = 0; r < graph.levels[j].regions.size(); ++r) {
+      if (predecessor[j][r] >= 0) continue;
+      GraphComponent c;
+      c.birthLevel = int(j);
+      const int id = int(graph.components.size());
+      std::size_t level = j;
+      int region = int(r);
+      while (true) {
+        c.regionAt.push_back(region);
+        graph.componentOf[level][std::size_t(region)] = id;
+        const int s = graph.successor[level][std::size_t(region)];
+        if (s < 0) break;
+        region = s;
+        ++level;
+      }
+      c.deathLevel = int(level);
+      c.birthScale = graph.levels[j].t;
+      c.deathScale = graph.levels[level].t;
+      graph.components.push_back(std::move(c));
+    }
+  return graph;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,46 @@
+#pragma once
+// Per-scale planar segmentation (Sec. 2.3.1): seeded region growing on the k-NN graph, then the
+// alpha-shape filter that drops regions smaller than the scale.
+#include <vector>
+
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/planes/ScaleFeatures.hpp"
+
+namespace scalespace {
+
+struct RegionGrowingOptions {
+  double maxAngleDegrees = 5.0;  // theta of Sec. 2.3.1, against the SEED's normal
+};
+
+/// A partition of the (valid) points at one scale: labels[i] = region of point i or -1.
+struct Segmentation {
+  std::vector<int> labels;
+  std::vector<std::vector<Index>> regions;  // point indices, increasing
+};
+
+/// Seeds by decreasing planarity 1/(k1^2 + k2^2), i.e. increasing k1^2 + k2^2 (stable, index
+/// tie-break); a region grows through the graph over unassigned valid points whose normal is
+/// within theta of the seed's normal. Invalid points stay -1. Deterministic.
+Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
+                         const RegionGrowingOptions& options = {});
+
+struct RegionFilterOptions {
+  /// The alpha-shape radius and the minimum extent are alphaFactor * t (Sec. 2.3.1: 2t); CGAL's
+  /// alpha is the squared radius.
+  double alphaFactor = 2.0;
+};
+
+/// A region kept by the filter.
+struct FilteredRegion {
+  std::vector<Index> points;  // increasing
+  double area = 0.0;          // alpha-shape area on its best-fit plane
+};
+
+/// Keeps the regions with sqrt(alpha-shape area) >= alphaFactor * t (NOTES.md reading of
+/// "a < 2t"), in their input order. Alpha shapes of different regions run in parallel.
+std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
+                                          const Segmentation& segmentation, double t,
+                                          const RegionFilterOptions& options = {},
+                                          const ProgressCallback& progress = {});
+
+}  // namespace scalespace

@@ -1,0 +1,53 @@
+#include "scalespace/planes/ScaleFeatures.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+
+namespace scalespace {
+
+KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k,
+                       const ProgressCallback& progress) {
+  if (k == 0) throw OptionError("the neighbour graph needs k >= 1");
+  const std::size_t n = positions.size();
+  KnnGraph graph;
+  graph.offsets.resize(n + 1, 0);
+  if (n == 0) return graph;
+  const std::size_t perPoint = std::min(k, n - 1);
+  graph.neighbors.resize(n * perPoint);
+  for (std::size_t i = 0; i <= n; ++i) graph.offsets[i] = i * perPoint;
+  const auto index = makeSpatialIndex(positions);
+  ProgressTracker tracker(progress, "neighbour graph", n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
+    std::vector<Neighbor> found;
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      index->knnSearch(positions[i], perPoint + 1, found);
+      std::size_t out = graph.offsets[i];
+      for (const Neighbor& nb : found) {
+        if (nb.index == i || out == graph.offsets[i + 1]) continue;
+        graph.neighbors[out++] = nb.index;
+      }
+      // Duplicated points may push i itself out of its own k+1 list: fill with the farthest.
+      while (out < graph.offsets[i + 1]) graph.neighbors[out++] = found.back().index;
+    }
+    tracker.advance(range.size());
+  });
+  tracker.finish();
+  return graph;
+}
+
+void checkScaleFeatures(const std::vector<ScaleFeatures>& scales, std::size_t pointCount) {
+  for (std::size_t j = 0; j < scales.size(); ++j) {
+    const ScaleFeatures& s = scales[j];
+    if (s.normals.size() != pointCount || s.kMax.size() != pointCount ||
+        s.kMin.size() != pointCount || s.valid.size() != pointCount)
+      throw OptionError("scale " + std::to_string(j) + " has features for a different number of " +
+                        "points than the cloud (" + std::to_string(pointCount) + ")");
+    if (!(s.t > 0) || (j > 0 && !(s.t > scales[j - 1].t)))
+      throw OptionError("scales must be positive and strictly increasing (scale " +
+                        std::to_string(j) + ")");
+  }
+}
+
+}  // namespace scalespace

@@ -1,0 +1,37 @@
+#pragma once
+// The input of the plane pipeline (Chapter 2): per scale, the differential quantities of every
+// input point from the multi-scale stack, plus the k-nearest-neighbour graph of the input points.
+// The stack of the scales layer is converted to this; tests build it from analytic surfaces.
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+/// One scale t_j of the stack.
+struct ScaleFeatures {
+  double t = 0.0;                   // scale value
+  std::vector<Vec3> normals;        // per input point, unit (W3 of the APSS fit)
+  std::vector<float> kMax, kMin;    // principal curvatures (Eq. 1.38)
+  std::vector<std::uint8_t> valid;  // 0 where the fit failed: such points join no region
+};
+
+/// Directed k-nearest-neighbour graph (self excluded), compressed rows: the neighbours of point i
+/// are neighbors[offsets[i] .. offsets[i+1]).
+struct KnnGraph {
+  std::vector<std::size_t> offsets;
+  std::vector<Index> neighbors;
+  std::size_t size() const { return offsets.empty() ? 0 : offsets.size() - 1; }
+};
+
+/// Builds the graph with makeSpatialIndex (k = 10 in Sec. 2.3.1). Parallel; deterministic.
+KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k = 10,
+                       const ProgressCallback& progress = {});
+
+/// Throws OptionError when a scale's arrays do not have `pointCount` entries or scales are not
+/// strictly increasing.
+void checkScaleFeatures(const std::vector<ScaleFeatures>& scales, std::size_t pointCount);
+
+}  // namespace scalespace

@@ -1,0 +1,90 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "scalespace/planes/AlphaShapeArea.hpp"
+
+using namespace scalespace;
+
+namespace {
+double perimeter(const std::vector<Vec2>& loop) {
+  double p = 0;
+  for (std::size_t i = 0; i < loop.size(); ++i) p += (loop[(i + 1) % loop.size()] - loop[i]).norm();
+  return p;
+}
+double signedArea(const std::vector<Vec2>& loop) {
+  double a = 0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec2& p = loop[i];
+    const Vec2& q = loop[(i + 1) % loop.size()];
+    a += 0.5 * (p.x() * q.y() - q.x() * p.y());
+  }
+  return a;
+}
+}  // namespace
+
+TEST(AlphaShape, GridSquareHasItsAreaAndOneOutline) {
+  std::vector<Vec2> pts;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j) pts.emplace_back(i / 40.0, j / 40.0);
+  const double radius = 0.1;
+  const AlphaShape shape = alphaShape2(pts, radius * radius, true);
+  EXPECT_NEAR(shape.area, 1.0, 1e-9);
+  ASSERT_EQ(shape.outlines.size(), 1u);
+  EXPECT_NEAR(perimeter(shape.outlines[0]), 4.0, 1e-9);
+  EXPECT_NEAR(signedArea(shape.outlines[0]), 1.0, 1e-9);  // counter-clockwise, encloses the square
+}
+
+TEST(AlphaShape, RandomSquareAreaAndSeparateParts) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec2> pts;
+  for (int i = 0; i < 4000; ++i) pts.emplace_back(u(rng), u(rng));
+  // Two unit squares 5 apart: with a radius far below the gap, two parts and twice the area.
+  const std::size_t n = pts.size();
+  for (std::size_t i = 0; i < n; ++i) pts.push_back(pts[i] + Vec2(6, 0));
+  const AlphaShape shape = alphaShape2(pts, 0.1 * 0.1, true);
+  EXPECT_NEAR(shape.area, 2.0, 0.05);
+  EXPECT_LT(shape.area, 2.0 + 1e-12);  // never more than the convex hulls
+  EXPECT_EQ(shape.outlines.size(), 2u);
+  // A huge radius gives the convex hull: one part, bridging the gap.
+  const AlphaShape hull = alphaShape2(pts, 1e4, true);
+  EXPECT_GT(hull.area, 6.5);
+  EXPECT_EQ(hull.outlines.size(), 1u);
+  EXPECT_EQ(alphaShape2({Vec2(0, 0), Vec2(1, 0)}, 1.0).area, 0.0);
+}
+
+TEST(AlphaShape, AnnulusHasTwoLoops) {
+  std::vector<Vec2> pts;
+  for (int i = 0; i <= 60; ++i)
+    for (int j = 0; j <= 60; ++j) {
+      const Vec2 p(i / 20.0 - 1.5, j / 20.0 - 1.5);
+      if (p.cwiseAbs().maxCoeff() > 0.5) pts.push_back(p);  // 3x3 square minus a 1x1 hole
+    }
+  const AlphaShape shape = alphaShape2(pts, 0.08 * 0.08, true);
+  // The hole's edge points are 0.05 inside it; its corners are cut by a few half cells.
+  EXPECT_NEAR(shape.area, 9.0 - 1.1 * 1.1, 0.025);
+  EXPECT_EQ(shape.outlines.size(), 2u);
+}
+
+TEST(PlaneFit, TiltedPlaneExact) {
+  std::vector<Vec3> pts;
+  std::vector<Index> idx;
+  const Vec3 n = Vec3(1, 2, 2) / 3.0;
+  const Vec3 a = n.unitOrthogonal(), b = n.cross(a);
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      pts.push_back(Vec3(1, 1, 1) + i * 0.1 * a + j * 0.1 * b + 0.5 * n);
+      idx.push_back(Index(pts.size() - 1));
+    }
+  const PlaneFit fit = fitPlane(pts, idx);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_NEAR(std::abs(fit.normal.dot(n)), 1.0, 1e-12);
+  EXPECT_NEAR(fit.rms, 0.0, 1e-12);
+  for (Index i : idx) EXPECT_NEAR(fit.normal.dot(pts[i]), fit.offset, 1e-12);
+  const auto flat = projectOnPlane(fit, pts, idx);
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    EXPECT_NEAR((liftFromPlane(fit, flat[k]) - pts[idx[k]]).norm(), 0, 1e-12);
+  EXPECT_FALSE(fitPlane(pts, {0, 1}).valid);
+}

@@ -1,0 +1,197 @@
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <map>
+#include <set>
+
+#include "PlanesTestScenes.hpp"
+#include "scalespace/core/Error.hpp"
+#include "scalespace/planes/PlaneDetection.hpp"
+
+using namespace scalespace;
+
+namespace {
+struct BoxRun {
+  PointCloud cloud;
+  std::vector<int> gt;
+  PlaneDetection detection;
+};
+
+// Box 4 x 2 x 1 at 12 scales from 0.06 (alpha radius 0.12, above the sample spacing of ~0.07)
+// to 2 (beyond every face).
+BoxRun runBox(std::size_t points = 6000) {
+  BoxRun run;
+  SceneOptions opt;
+  opt.pointCount = points;
+  opt.boxSize = Vec3(4, 2, 1);
+  run.cloud = generateScene(SceneKind::Box, opt);
+  for (double v : run.cloud.findAttribute("gt_face")->values) run.gt.push_back(int(v));
+  const auto scales = test::boxFeatures(run.cloud, opt.boxSize, test::logScales(0.06, 2.0, 12));
+  const KnnGraph knn = buildKnnGraph(run.cloud.positions(), 10);
+  run.detection = detectPlanes(run.cloud.positions(), knn, scales);
+  return run;
+}
+
+// The component holding most of face `face`'s points at `level`, and the fraction it holds.
+std::pair<int, double> dominantComponent(const BoxRun& run, int face, int level) {
+  const std::vector<int> labels = run.detection.graph.componentLabels(level);
+  std::map<int, int> count;
+  int total = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (run.gt[i] == face) {
+      ++total;
+      if (labels[i] >= 0) ++count[labels[i]];
+    }
+  std::pair<int, double> best{-1, 0.0};
+  for (const auto& [c, k] : count)
+    if (k > best.second * total) best = {c, double(k) / total};
+  return best;
+}
+}  // namespace
+
+TEST(RegionGrowing, SeedNormalCriterionAndDeterminism) {
+  // A line of 6 points whose normals turn by 3 degrees each: with theta = 5 degrees against the
+  // SEED's normal (not the neighbour's), a region can span at most 3 consecutive points.
+  std::vector<Vec3> pts;
+  ScaleFeatures f;
+  f.t = 1;
+  for (int i = 0; i < 6; ++i) {
+    pts.emplace_back(i, 0, 0);
+    const double a = i * 3.0 * M_PI / 180.0;
+    f.normals.emplace_back(std::sin(a), 0, std::cos(a));
+    f.kMax.push_back(i == 0 ? 0.f : 1.f);  // point 0 is the most planar: the first seed
+    f.kMin.push_back(0.f);
+    f.valid.push_back(1);
+  }
+  f.valid[4] = 0;
+  const KnnGraph knn = buildKnnGraph(pts, 2);
+  const Segmentation seg = growRegions(knn, f);
+  EXPECT_EQ(seg.labels[0], 0);
+  EXPECT_EQ(seg.labels[1], 0);
+  EXPECT_NE(seg.labels[2], 0);   // 6 degrees from the seed even though 3 from its neighbour
+  EXPECT_EQ(seg.labels[4], -1);  // invalid points join nothing
+  EXPECT_EQ(seg.regions[0], (std::vector<Index>{0, 1}));
+  std::size_t assigned = 0;
+  for (const auto& r : seg.regions) assigned += r.size();
+  EXPECT_EQ(assigned, 5u);
+}
+
+TEST(RegionGraph, ChainsJaccardAndPersistence) {
+  EXPECT_DOUBLE_EQ(jaccardIndex({1, 2, 3, 4}, {3, 4, 5}), 2.0 / 5.0);
+  EXPECT_DOUBLE_EQ(jaccardIndex({}, {}), 0.0);
+  auto region = [](std::vector<Index> p) { return FilteredRegion{std::move(p), 1.0}; };
+  std::vector<RegionLevel> levels(4);
+  for (int j = 0; j < 4; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
+  levels[0].regions = {region({0, 1, 2, 3}), region({4, 5, 6, 7})};
+  levels[1].regions = {region({4, 5, 6}), region({0, 1, 2, 3, 8})};  // J = 3/4 and 4/5
+  levels[2].regions = {region({0, 1, 2, 3, 4, 5, 6, 8})};  // J with {0,1,2,3,8}: 5/8 > 0.5
+  levels[3].regions = {region({0, 1, 2, 3}), region({4, 5, 6, 8})};  // J = 4/8: not > 0.5
+  const RegionGraph g = buildRegionGraph(levels, 9);
+  EXPECT_EQ(g.successor[0], (std::vector<int>{1, 0}));
+  EXPECT_EQ(g.successor[1], (std::vector<int>{-1, 0}));
+  EXPECT_EQ(g.successor[2], (std::vector<int>{-1}));
+  ASSERT_EQ(g.components.size(), 4u);
+  EXPECT_EQ(g.components[0].birthLevel, 0);  // {0..3} -> {0..3,8} -> {0..6,8}
+  EXPECT_EQ(g.components[0].deathLevel, 2);
+  EXPECT_EQ(g.components[0].persistence(), 2);
+  EXPECT_DOUBLE_EQ(g.components[0].deathScale, 0.3);
+  EXPECT_EQ(g.components[1].persistence(), 1);  // {4..7} -> {4,5,6}
+  EXPECT_EQ(g.components[2].birthLevel, 3);
+  EXPECT_EQ(g.components[2].persistence(), 0);
+  EXPECT_EQ(g.componentLabels(1), (std::vector<int>{0, 0, 0, 0, 1, 1, 1, -1, 0}));
+  // Overlapping regions in one level are a caller bug.
+  levels[3].regions.push_back(region({0}));
+  EXPECT_THROW(buildRegionGraph(levels, 9), OptionError);
+}
+
+TEST(PlaneDetection, CleanBoxEveryFaceIsOneComponentAndPersistenceGrowsWithSize) {
+  const BoxRun run = runBox();
+  const auto& comps = run.detection.components;
+  std::set<int> faceComponents;
+  std::map<int, int> persistenceOfFace;
+  for (int face = 0; face < 6; ++face) {
+    const auto [c, fraction] = dominantComponent(run, face, 0);
+    ASSERT_GE(c, 0) << "face " << face;
+    // Points closer to an edge than ~0.9 t (bent normals) are outside: 1 - 6 * 0.055 / 2 on the
+    // smallest face.
+    EXPECT_GT(fraction, 0.8) << "face " << face;
+    EXPECT_EQ(comps[std::size_t(c)].birthLevel, 0);
+    faceComponents.insert(c);
+    persistenceOfFace[face] = comps[std::size_t(c)].persistence;
+    // The plane of the component is the face's plane.
+    const Vec3 n =
+        run.cloud
+            .normals()[std::size_t(std::find(run.gt.begin(), run.gt.end(), face) - run.gt.begin())];
+    EXPECT_GT(std::abs(comps[std::size_t(c)].plane.normal.dot(n)), 1 - 1e-9);
+    EXPECT_LT(comps[std::size_t(c)].plane.rms, 1e-7);  // eigenvalue round-off only
+  }
+  EXPECT_EQ(faceComponents.size(), 6u);  // one component per face
+  // Faces: x normal 2 x 1, y normal 4 x 1, z normal 4 x 2 (labels 0,1: x; 2,3: y; 4,5: z).
+  EXPECT_EQ(persistenceOfFace[0], persistenceOfFace[1]);
+  EXPECT_EQ(persistenceOfFace[4], persistenceOfFace[5]);
+  EXPECT_LT(persistenceOfFace[0], persistenceOfFace[2]);
+  EXPECT_LT(persistenceOfFace[2], persistenceOfFace[4]);
+  EXPECT_LT(persistenceOfFace[4], 11);  // even the largest face dies before t = 2
+  // Representative level: most points, and the area there is close to the face area minus the
+  // bent band along the edges.
+  const auto [top, f] = dominantComponent(run, 4, 0);
+  const PlaneComponent& c = comps[std::size_t(top)];
+  EXPECT_LE(c.area, 8.0 + 1e-9);
+  EXPECT_GT(c.area, 0.8 * (4 - 0.11) * (2 - 0.11));
+  EXPECT_FALSE(c.outlines.empty());
+}
+
+TEST(PlaneDetection, PointBelongsToSeveralComponentsAcrossScales) {
+  // Fig. 2.3: on stairs, a tread point is in its tread's component at small scales and in the
+  // component of the whole ramp at large scales. The ramp (area sqrt2) lives while
+  // sqrt(area) >= 2t, i.e. up to t = 0.59: the largest scale is 0.55.
+  SceneOptions opt;
+  opt.pointCount = 6000;
+  opt.stairSteps = 4;
+  const PointCloud cloud = generateScene(SceneKind::Stairs, opt);
+  const auto scales = test::stairsFeatures(cloud, 4, test::logScales(0.01, 0.55, 16));
+  const PlaneDetection det =
+      detectPlanes(cloud.positions(), buildKnnGraph(cloud.positions()), scales);
+  const auto low = det.graph.componentLabels(0);
+  const auto high = det.graph.componentLabels(det.scaleCount() - 1);
+  std::size_t several = 0;
+  std::set<int> lowComponents;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (low[i] >= 0 && high[i] >= 0 && low[i] != high[i]) {
+      ++several;
+      lowComponents.insert(low[i]);
+    }
+  EXPECT_GT(several, cloud.size() / 2);
+  EXPECT_EQ(lowComponents.size(), 8u);  // 4 treads + 4 risers at small scales
+  std::set<int> highComponents(high.begin(), high.end());
+  EXPECT_EQ(highComponents.size(), 1u);  // one ramp at the largest scale
+  const PlaneComponent& ramp = det.components[std::size_t(high[0])];
+  EXPECT_GT(ramp.persistence, 0);
+  EXPECT_NEAR(std::abs(ramp.plane.normal.dot(Vec3(0, -1, 1).normalized())), 1.0, 0.02);
+}
+
+TEST(PlaneDetection, SameResultForOneAndTwoThreads) {
+  auto run = [](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    return runBox(3000);
+  };
+  const BoxRun a = run(1), b = run(2);
+  ASSERT_EQ(a.detection.components.size(), b.detection.components.size());
+  for (int level = 0; level < a.detection.scaleCount(); ++level)
+    EXPECT_EQ(a.detection.graph.componentLabels(level), b.detection.graph.componentLabels(level));
+  for (std::size_t c = 0; c < a.detection.components.size(); ++c) {
+    EXPECT_EQ(a.detection.components[c].area, b.detection.components[c].area);
+    EXPECT_EQ(a.detection.components[c].plane.normal, b.detection.components[c].plane.normal);
+  }
+}
+
+TEST(PlaneDetection, RejectsMismatchedInputs) {
+  std::vector<Vec3> pts{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  ScaleFeatures f;
+  f.t = 1;
+  f.normals.assign(2, Vec3::UnitZ());
+  f.kMax.assign(2, 0.f);
+  f.kMin.assign(2, 0.f);
+  f.valid.assign(2, 1);
+  EXPECT_THROW(detectPlanes(pts, buildKnnGraph(pts, 2), {f}), OptionError);
+}
