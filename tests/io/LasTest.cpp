@@ -193,15 +193,15 @@ TEST(Las, WriteReadRoundTrip) {
     SCOPED_TRACE(format);
     PointCloud cloud;
     cloud.setAbsolutePositions(positions);
-    auto& intensity = cloud.addAttribute("intensity", ScalarType::UInt16);
-    auto& classification = cloud.addAttribute("classification", ScalarType::UInt8);
-    auto& returnNumber = cloud.addAttribute("return_number", ScalarType::UInt8);
-    auto& returnCount = cloud.addAttribute("number_of_returns", ScalarType::UInt8);
+    // Add every column first: addAttribute may move the columns, invalidating references.
+    for (const char* name : {"classification", "return_number", "number_of_returns"})
+      cloud.addAttribute(name, ScalarType::UInt8);
+    cloud.addAttribute("intensity", ScalarType::UInt16);
     for (std::size_t i = 0; i < 30; ++i) {
-      intensity.values[i] = double(i * 2000);
-      classification.values[i] = double(i % 32);
-      returnNumber.values[i] = double(1 + i % 5);
-      returnCount.values[i] = 5;
+      cloud.findAttribute("intensity")->values[i] = double(i * 2000);
+      cloud.findAttribute("classification")->values[i] = double(i % 32);
+      cloud.findAttribute("return_number")->values[i] = double(1 + i % 5);
+      cloud.findAttribute("number_of_returns")->values[i] = 5;
     }
     if (format == 1 || format == 3) {
       auto& time = cloud.addAttribute("gps_time", ScalarType::Float64);

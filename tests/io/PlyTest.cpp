@@ -166,3 +166,24 @@ TEST(Ply, IntegerAttributesAreSaturatedOnWrite) {
 
 }  // namespace
 }  // namespace scalespace
+
+namespace scalespace {
+namespace {
+
+TEST(Ply, AbsurdlyLargeCoordinatesAreTreatedAsInvalid) {
+  // Found by fuzz_las: a coordinate near DBL_MAX made recentring overflow to infinity.
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty "
+      "double z\nend_header\n1 2 3\n1.7e308 0 0\n";
+  EXPECT_THROW(readPly(text, "big.ply"), FileError);
+  ReadOptions options;
+  options.dropNonFinite = true;
+  ReadReport report;
+  const PointCloud cloud = readPly(text, "big.ply", options, &report);
+  EXPECT_EQ(cloud.size(), 1u);
+  EXPECT_EQ(report.droppedNonFinite, 1u);
+  EXPECT_TRUE(cloud.positions()[0].allFinite());
+}
+
+}  // namespace
+}  // namespace scalespace

@@ -20,7 +20,7 @@ void CloudBuilder::reserve(std::size_t points) {
 void CloudBuilder::rejectNonFinite(const std::string& where) const {
   throw FileError(file_, where,
                   "point " + std::to_string(positions_.size() + dropped_ + 1) +
-                      " has a NaN or infinite coordinate",
+                      " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                   "pass --drop-invalid (ReadOptions::dropNonFinite) to skip such points");
 }
 

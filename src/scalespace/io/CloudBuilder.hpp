@@ -1,7 +1,8 @@
 #pragma once
 // Accumulates the points a reader decodes (internal to the io layer) and applies the policy every
-// reader shares: non-finite coordinates throw a FileError naming the point's place in the file or,
-// with ReadOptions::dropNonFinite, skip the point and count it.
+// reader shares: non-finite (or absurdly large, see kMaxCoordinate) coordinates throw a FileError
+// naming the point's place in the file or, with ReadOptions::dropNonFinite, skip the point and
+// count it.
 #include <string>
 #include <vector>
 
@@ -10,6 +11,15 @@
 #include "scalespace/io/ReadOptions.hpp"
 
 namespace scalespace::io_detail {
+
+/// Coordinates beyond this magnitude are treated like NaN/Inf: no real cloud has them (1e100 m
+/// dwarfs the observable universe in any unit), and accepting them would let recentring and the
+/// squared distances of later layers overflow to infinity.
+constexpr double kMaxCoordinate = 1e100;
+
+inline bool isUsablePosition(const Vec3& p) {
+  return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinate;
+}
 
 class CloudBuilder {
  public:
@@ -29,7 +39,7 @@ class CloudBuilder {
   /// `where` is called only for an error message, e.g. [&] { return lineWhere(n); }.
   template <class Where>
   bool addPoint(const Vec3& position, const Vec3& normal, const double* values, Where&& where) {
-    if (!position.allFinite()) {
+    if (!isUsablePosition(position)) {
       if (dropNonFinite_) {
         ++dropped_;
         return false;

@@ -8,6 +8,7 @@
 // rejected with a FileError saying how to convert them.
 // Writing: LAS 1.2, point format 0, 1 (gps_time), 2 (red green blue) or 3 (both), coordinates
 // quantised to 0.1 mm (coarser only when the extent needs it) around the cloud's origin.
+// Normals and other attributes have no place in LAS 1.2 records and are not written.
 #include <ostream>
 #include <string>
 #include <string_view>

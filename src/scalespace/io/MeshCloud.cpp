@@ -23,10 +23,11 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
   std::vector<bool> bad(mesh.vertices.size(), false);
   std::size_t dropped = 0;
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-    if (mesh.vertices[v].allFinite()) continue;
+    if (isUsablePosition(mesh.vertices[v])) continue;
     if (!options.dropNonFinite)
       throw FileError(file, lineWhere(mesh.vertexLines[v]),
-                      "vertex " + std::to_string(v + 1) + " has a NaN or infinite coordinate",
+                      "vertex " + std::to_string(v + 1) +
+                          " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                       "pass --drop-invalid (ReadOptions::dropNonFinite) to skip its faces");
     bad[v] = true;
     ++dropped;

@@ -11,9 +11,10 @@ struct ReadOptions {
   /// interpolated vertex normals (Sec. 3.4.1).
   std::size_t meshSamples = 0;
   std::uint64_t seed = 1;  // mesh sampling
-  /// NaN/Inf coordinates: false -> FileError naming the first bad point; true -> the point is
-  /// skipped and counted in ReadReport::droppedNonFinite. Attributes and normals are never checked
-  /// (NaN is a legitimate "no value" there).
+  /// NaN/Inf coordinates (or beyond +-1e100, which only corrupt files hold): false -> FileError
+  /// naming the first bad point; true -> the point is skipped and counted in
+  /// ReadReport::droppedNonFinite. Attributes and normals are never checked (NaN is a legitimate
+  /// "no value" there).
   bool dropNonFinite = false;
 };
 
