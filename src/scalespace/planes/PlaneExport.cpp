@@ -1,0 +1,271 @@
+#include "scalespace/planes/PlaneExport.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/io/AtomicFile.hpp"
+#include "scalespace/render/ColorMap.hpp"
+
+namespace scalespace {
+
+namespace {
+// Absolute plane offset: n . (x_rel + origin) = offset_rel + n . origin.
+double absoluteOffset(const PlaneComponent& c, const Vec3& origin) {
+  return c.plane.offset + c.plane.normal.dot(origin);
+}
+}  // namespace
+
+void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std::string& input,
+                         const std::string& path) {
+  nlohmann::json root;
+  root["format"] = "scalespace-planes-1";
+  root["input"] = input;
+  root["point_count"] = model.membership.pointCount;
+  root["scales"] = model.scales;
+  root["persistence_definition"] = "death_level - birth_level";
+  nlohmann::json list = nlohmann::json::array();
+  for (const PlaneComponent& c : model.components) {
+    nlohmann::json j;
+    j["id"] = c.id;
+    j["birth_level"] = c.birthLevel;
+    j["birth_scale"] = c.birthScale;
+    j["death_level"] = c.deathLevel;
+    j["death_scale"] = c.deathScale;
+    j["persistence"] = c.persistence;
+    j["representative_level"] = c.representativeLevel;
+    j["point_count"] = c.pointCount;
+    j["normal"] = {c.plane.normal.x(), c.plane.normal.y(), c.plane.normal.z()};
+    j["offset"] = absoluteOffset(c, origin);
+    j["rms"] = c.plane.rms;
+    j["area"] = c.area;
+    j["plane_valid"] = c.plane.valid;
+    list.push_back(std::move(j));
+  }
+  root["components"] = std::move(list);
+  writeFileAtomically(path, [&](std::ostream& out) { out << root.dump(1) << '\n'; });
+}
+
+void writeComponentsCsv(const PlaneModel& model, const Vec3& origin, const std::string& path) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "id,birth_level,birth_scale,death_level,death_scale,persistence,nx,ny,nz,offset,rms,"
+           "area,point_count\n";
+    out << std::setprecision(17);
+    for (const PlaneComponent& c : model.components)
+      out << c.id << ',' << c.birthLevel << ',' << c.birthScale << ',' << c.deathLevel << ','
+          << c.deathScale << ',' << c.persistence << ',' << c.plane.normal.x() << ','
+          << c.plane.normal.y() << ',' << c.plane.normal.z() << ',' << absoluteOffset(c, origin)
+          << ',' << c.plane.rms << ',' << c.area << ',' << c.pointCount << '\n';
+  });
+}
+
+void writeOutlinesObj(const std::vector<PlaneComponent>& components, const Vec3& origin,
+                      const std::string& path) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "# scalespace plane outlines: one closed polyline per alpha-shape boundary loop\n";
+    out << std::setprecision(17);
+    std::size_t next = 1;  // OBJ vertex indices start at 1
+    for (const PlaneComponent& c : components) {
+      if (c.outlines.empty()) continue;
+      out << "g component_" << c.id << '\n';
+      for (const auto& loop : c.outlines) {
+        if (loop.size() < 2) continue;
+        for (const Vec3& p : loop) {
+          const Vec3 a = p + origin;
+          out << "v " << a.x() << ' ' << a.y() << ' ' << a.z() << '\n';
+        }
+        out << 'l';
+        for (std::size_t k = 0; k < loop.size(); ++k) out << ' ' << next + k;
+        out << ' ' << next << '\n';  // closed
+        next += loop.size();
+      }
+    }
+  });
+}
+
+void writeOutlinesPly(const std::vector<PlaneComponent>& components, const Vec3& origin,
+                      const std::string& path) {
+  std::size_t vertices = 0;
+  for (const auto& c : components)
+    for (const auto& loop : c.outlines)
+      if (loop.size() >= 2) vertices += loop.size();
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "ply\nformat ascii 1.0\ncomment scalespace plane outlines\n";
+    out << "element vertex " << vertices << "\nproperty double x\nproperty double y\n"
+        << "property double z\nelement edge " << vertices
+        << "\nproperty int vertex1\nproperty int vertex2\nproperty int component\nend_header\n";
+    out << std::setprecision(17);
+    for (const auto& c : components)
+      for (const auto& loop : c.outlines)
+        if (loop.size() >= 2)
+          for (const Vec3& p : loop) {
+            const Vec3 a = p + origin;
+            out << a.x() << ' ' << a.y() << ' ' << a.z() << '\n';
+          }
+    std::size_t base = 0;
+    for (const auto& c : components)
+      for (const auto& loop : c.outlines) {
+        if (loop.size() < 2) continue;
+        for (std::size_t k = 0; k < loop.size(); ++k)
+          out << base + k << ' ' << base + (k + 1) % loop.size() << ' ' << c.id << '\n';
+        base += loop.size();
+      }
+  });
+}
+
+void writePersistenceDiagramSvg(const PlaneModel& model, const std::string& path) {
+  if (model.scales.empty()) throw OptionError("persistence diagram: the model has no scales");
+  const double size = 480, margin = 60, plot = size - 2 * margin;
+  // Log axes over [t_0, t_M-1], padded by half a decade step.
+  const double lo = std::log10(model.scales.front()), hiRaw = std::log10(model.scales.back());
+  const double pad = std::max(0.05, 0.05 * (hiRaw - lo));
+  const double a = lo - pad, b = hiRaw + pad;
+  auto X = [&](double t) { return margin + (std::log10(t) - a) / (b - a) * plot; };
+  auto Y = [&](double t) { return size - margin - (std::log10(t) - a) / (b - a) * plot; };
+  int maxPers = 1;
+  for (const auto& c : model.components) maxPers = std::max(maxPers, c.persistence);
+  std::ostringstream svg;
+  svg << std::setprecision(6);
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << size << "\" height=\"" << size
+      << "\" viewBox=\"0 0 " << size << ' ' << size
+      << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg << "<rect x=\"" << margin << "\" y=\"" << margin << "\" width=\"" << plot << "\" height=\""
+      << plot << "\" fill=\"none\" stroke=\"black\"/>\n";
+  // Decade ticks and labels (10^k) on both axes.
+  for (int k = int(std::ceil(a)); k <= int(std::floor(b)); ++k) {
+    const double t = std::pow(10.0, k);
+    svg << "<line x1=\"" << X(t) << "\" y1=\"" << size - margin << "\" x2=\"" << X(t) << "\" y2=\""
+        << size - margin + 5 << "\" stroke=\"black\"/>\n";
+    svg << "<text x=\"" << X(t) << "\" y=\"" << size - margin + 18 << "\" text-anchor=\"middle\">1e"
+        << k << "</text>\n";
+    svg << "<line x1=\"" << margin - 5 << "\" y1=\"" << Y(t) << "\" x2=\"" << margin << "\" y2=\""
+        << Y(t) << "\" stroke=\"black\"/>\n";
+    svg << "<text x=\"" << margin - 8 << "\" y=\"" << Y(t) + 4 << "\" text-anchor=\"end\">1e" << k
+        << "</text>\n";
+  }
+  svg << "<line x1=\"" << X(std::pow(10, a)) << "\" y1=\"" << Y(std::pow(10, a)) << "\" x2=\""
+      << X(std::pow(10, b)) << "\" y2=\"" << Y(std::pow(10, b))
+      << "\" stroke=\"grey\" stroke-dasharray=\"4 3\"/>\n";
+  svg << "<text x=\"" << size / 2 << "\" y=\"" << size - 15
+      << "\" text-anchor=\"middle\">birth scale</text>\n";
+  svg << "<text x=\"18\" y=\"" << size / 2 << "\" text-anchor=\"middle\" transform=\"rotate(-90 18 "
+      << size / 2 << ")\">death scale</text>\n";
+  svg << "<text x=\"" << size / 2 << "\" y=\"30\" text-anchor=\"middle\">persistence diagram ("
+      << model.components.size() << " components, " << model.scales.size() << " scales)</text>\n";
+  for (const auto& c : model.components) {
+    const Rgb col = viridis(double(c.persistence) / maxPers);
+    svg << "<circle cx=\"" << X(c.birthScale) << "\" cy=\"" << Y(c.deathScale)
+        << "\" r=\"3.5\" fill=\"rgb(" << int(col.r) << ',' << int(col.g) << ',' << int(col.b)
+        << ")\" fill-opacity=\"0.8\"><title>component " << c.id << ": persistence " << c.persistence
+        << "</title></circle>\n";
+  }
+  svg << "</svg>\n";
+  const std::string text = svg.str();
+  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
+void writeMembership(const PointMembership& m, const std::string& path) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    const std::uint64_t n = m.pointCount;
+    const std::uint32_t levels = std::uint32_t(m.levelCount);
+    out.write("SSPM", 4);
+    out.write(reinterpret_cast<const char*>(&n), sizeof n);
+    out.write(reinterpret_cast<const char*>(&levels), sizeof levels);
+    static_assert(sizeof(int) == 4, "membership ids are written as 32-bit integers");
+    out.write(reinterpret_cast<const char*>(m.ids.data()), std::streamsize(m.ids.size() * 4));
+  });
+}
+
+PointMembership readMembership(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, "", "cannot open", "run `scalespace planes` first");
+  char magic[4] = {};
+  std::uint64_t n = 0;
+  std::uint32_t levels = 0;
+  in.read(magic, 4);
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  in.read(reinterpret_cast<char*>(&levels), sizeof levels);
+  if (!in || std::memcmp(magic, "SSPM", 4) != 0)
+    throw FileError(path, "byte 0", "not a scalespace membership file");
+  PointMembership m;
+  m.pointCount = std::size_t(n);
+  m.levelCount = int(levels);
+  const auto expected = std::uintmax_t(n) * levels * 4 + 16;
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) != expected)
+    throw FileError(path, "", "truncated or corrupt (size does not match its header)",
+                    "run `scalespace planes` again");
+  m.ids.resize(std::size_t(n) * levels);
+  in.read(reinterpret_cast<char*>(m.ids.data()), std::streamsize(m.ids.size() * 4));
+  if (!in) throw FileError(path, "", "truncated");
+  return m;
+}
+
+PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
+  const std::string jsonPath = (std::filesystem::path(directory) / "components.json").string();
+  std::ifstream in(jsonPath);
+  if (!in) throw FileError(jsonPath, "", "cannot open", "run `scalespace planes IN -o DIR` first");
+  nlohmann::json root;
+  try {
+    in >> root;
+  } catch (const std::exception& e) {
+    throw FileError(jsonPath, "", std::string("invalid JSON: ") + e.what());
+  }
+  PlaneModel model;
+  try {
+    model.scales = root.at("scales").get<std::vector<double>>();
+    if (input) *input = root.at("input").get<std::string>();
+    for (const auto& j : root.at("components")) {
+      PlaneComponent c;
+      c.id = j.at("id").get<int>();
+      c.birthLevel = j.at("birth_level").get<int>();
+      c.birthScale = j.at("birth_scale").get<double>();
+      c.deathLevel = j.at("death_level").get<int>();
+      c.deathScale = j.at("death_scale").get<double>();
+      c.persistence = j.at("persistence").get<int>();
+      c.representativeLevel = j.at("representative_level").get<int>();
+      c.pointCount = j.at("point_count").get<std::size_t>();
+      const auto n = j.at("normal").get<std::vector<double>>();
+      if (n.size() != 3) throw std::runtime_error("normal must have 3 values");
+      c.plane.normal = Vec3(n[0], n[1], n[2]);
+      c.plane.offset = j.at("offset").get<double>();  // absolute coordinates
+      c.plane.rms = j.at("rms").get<double>();
+      c.plane.valid = j.value("plane_valid", true);
+      c.area = j.at("area").get<double>();
+      if (c.id != int(model.components.size())) throw std::runtime_error("ids must be 0, 1, ...");
+      model.components.push_back(std::move(c));
+    }
+  } catch (const std::exception& e) {
+    throw FileError(jsonPath, "", std::string("unexpected content: ") + e.what(),
+                    "run `scalespace planes` again");
+  }
+  model.membership = readMembership((std::filesystem::path(directory) / "membership.bin").string());
+  if (model.membership.levelCount != model.scaleCount())
+    throw FileError(directory, "", "components.json and membership.bin disagree on the scales");
+  for (int id : model.membership.ids)
+    if (id < -1 || id >= int(model.components.size()))
+      throw FileError(directory + "/membership.bin", "", "component id out of range");
+  return model;
+}
+
+void writePlaneModel(const PlaneModel& model, const Vec3& origin, const std::string& input,
+                     const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) throw FileError(directory, "", "cannot create the directory: " + ec.message());
+  const fs::path dir(directory);
+  writeMembership(model.membership, (dir / "membership.bin").string());
+  writeComponentsCsv(model, origin, (dir / "components.csv").string());
+  writeOutlinesObj(model.components, origin, (dir / "outlines.obj").string());
+  writePersistenceDiagramSvg(model, (dir / "persistence.svg").string());
+  writeComponentsJson(model, origin, input, (dir / "components.json").string());
+}
+
+}  // namespace scalespace

@@ -1,0 +1,45 @@
+#pragma once
+// Outputs of the plane pipeline: components.json / components.csv, outlines as OBJ polylines or
+// PLY edges, the persistence diagram as SVG, and the saved PlaneModel (components.json +
+// membership.bin) that `scalespace segment` reloads. Every file is written atomically.
+// Plane offsets and outlines are written in absolute coordinates (positions + origin).
+#include <string>
+
+#include "scalespace/planes/PlaneQueries.hpp"
+
+namespace scalespace {
+
+/// One JSON object: {"scales": [...], "input": ..., "point_count": n, "components": [{"id",
+/// "birth_level", "birth_scale", "death_level", "death_scale", "persistence",
+/// "representative_level", "point_count", "normal": [x,y,z], "offset", "rms", "area"}]}.
+void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std::string& input,
+                         const std::string& path);
+/// Header: id,birth_level,birth_scale,death_level,death_scale,persistence,nx,ny,nz,offset,rms,
+/// area,point_count.
+void writeComponentsCsv(const PlaneModel& model, const Vec3& origin, const std::string& path);
+
+/// Outline loops as OBJ polylines ("l" elements, closed), one group "g component_<id>" each.
+void writeOutlinesObj(const std::vector<PlaneComponent>& components, const Vec3& origin,
+                      const std::string& path);
+/// Outline loops as an ASCII PLY with vertices and edges (edge property "component").
+void writeOutlinesPly(const std::vector<PlaneComponent>& components, const Vec3& origin,
+                      const std::string& path);
+
+/// Persistence diagram (Sec. 2.3.3): one dot per component at (birth scale, death scale), log
+/// axes with decade labels, the diagonal y = x; dot colour = persistence (viridis).
+void writePersistenceDiagramSvg(const PlaneModel& model, const std::string& path);
+
+/// Saves membership.bin (magic "SSPM", uint64 points, uint32 levels, int32 ids level-major).
+void writeMembership(const PointMembership& membership, const std::string& path);
+PointMembership readMembership(const std::string& path);
+
+/// Reads DIR/components.json and DIR/membership.bin (outlines are not reloaded). `input`
+/// receives the path of the cloud the model was computed on. Throws FileError naming the file.
+PlaneModel readPlaneModel(const std::string& directory, std::string* input = nullptr);
+
+/// Writes components.json, components.csv, outlines.obj, persistence.svg and membership.bin
+/// into `directory` (created if needed).
+void writePlaneModel(const PlaneModel& model, const Vec3& origin, const std::string& input,
+                     const std::string& directory);
+
+}  // namespace scalespace

@@ -1,0 +1,185 @@
+#include "scalespace/planes/PlaneQueries.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+PlaneModel makePlaneModel(const PlaneDetection& detection) {
+  PlaneModel model;
+  const RegionGraph& g = detection.graph;
+  for (const auto& level : g.levels) model.scales.push_back(level.t);
+  model.components = detection.components;
+  model.membership.pointCount = g.pointCount;
+  model.membership.levelCount = int(g.levels.size());
+  model.membership.ids.reserve(g.pointCount * g.levels.size());
+  for (int j = 0; j < int(g.levels.size()); ++j) {
+    const std::vector<int> labels = g.componentLabels(j);
+    model.membership.ids.insert(model.membership.ids.end(), labels.begin(), labels.end());
+  }
+  return model;
+}
+
+namespace {
+// "a is preferred to b": higher persistence, then lower id.
+bool morePersistent(const PlaneModel& m, int a, int b) {
+  if (b < 0) return a >= 0;
+  if (a < 0) return false;
+  const int pa = m.components[std::size_t(a)].persistence;
+  const int pb = m.components[std::size_t(b)].persistence;
+  return pa != pb ? pa > pb : a < b;
+}
+
+void checkIndices(const PlaneModel& model, const std::vector<Index>& indices, const char* what) {
+  for (Index i : indices)
+    if (i >= model.membership.pointCount)
+      throw OptionError(std::string(what) + ": point index " + std::to_string(i) +
+                        " is out of range (the cloud has " +
+                        std::to_string(model.membership.pointCount) + " points)");
+}
+
+std::set<int> componentsHolding(const PlaneModel& model, const std::vector<Index>& points) {
+  std::set<int> out;
+  for (Index i : points)
+    for (int j = 0; j < model.membership.levelCount; ++j) {
+      const int c = model.membership.at(j, i);
+      if (c >= 0) out.insert(c);
+    }
+  return out;
+}
+}  // namespace
+
+std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence) {
+  const std::size_t n = model.membership.pointCount;
+  std::vector<int> labels(n, -1);
+  for (int j = 0; j < model.membership.levelCount; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      const int c = model.membership.at(j, i);
+      if (c >= 0 && model.components[std::size_t(c)].persistence >= minPersistence &&
+          morePersistent(model, c, labels[i]))
+        labels[i] = c;
+    }
+  return labels;
+}
+
+int nearestLevel(const PlaneModel& model, double t) {
+  if (model.scales.empty()) throw OptionError("the plane model has no scales");
+  if (!(t > 0)) throw OptionError("--scale must be > 0");
+  int best = 0;
+  for (int j = 1; j < model.scaleCount(); ++j)
+    if (std::abs(std::log(model.scales[std::size_t(j)] / t)) <
+        std::abs(std::log(model.scales[std::size_t(best)] / t)))
+      best = j;
+  return best;
+}
+
+std::vector<int> labelsAtScale(const PlaneModel& model, double t, int minPersistence) {
+  const int level = nearestLevel(model, t);
+  std::vector<int> labels(model.membership.pointCount, -1);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const int c = model.membership.at(level, i);
+    if (c >= 0 && model.components[std::size_t(c)].persistence >= minPersistence) labels[i] = c;
+  }
+  return labels;
+}
+
+std::vector<BrushMatch> rankByBrush(const PlaneModel& model, const std::vector<Index>& query) {
+  checkIndices(model, query, "brush");
+  const std::vector<Index> unique = [&] {
+    std::vector<Index> q = query;
+    std::sort(q.begin(), q.end());
+    q.erase(std::unique(q.begin(), q.end()), q.end());
+    return q;
+  }();
+  if (unique.empty()) return {};
+  std::map<int, std::size_t> hits;  // |P_Q n P_C|, P_C = points of C over all its levels
+  for (Index i : unique) {
+    std::set<int> here;
+    for (int j = 0; j < model.membership.levelCount; ++j)
+      if (model.membership.at(j, i) >= 0) here.insert(model.membership.at(j, i));
+    for (int c : here) ++hits[c];
+  }
+  std::vector<BrushMatch> out;
+  const double m = double(model.scaleCount());
+  for (const auto& [c, k] : hits) {
+    BrushMatch match;
+    match.component = c;
+    match.overlap = double(k) / double(unique.size());
+    match.score = match.overlap * model.components[std::size_t(c)].persistence / m;  // Eq. 2.2
+    out.push_back(match);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const BrushMatch& a, const BrushMatch& b) { return a.score > b.score; });
+  return out;
+}
+
+std::vector<int> findSimilar(const PlaneModel& model, int query, const std::vector<Index>& domain,
+                             const SimilarityOptions& options) {
+  if (query < 0 || query >= int(model.components.size()))
+    throw OptionError("--similar " + std::to_string(query) + ": no such component (0.." +
+                      std::to_string(int(model.components.size()) - 1) + ")");
+  checkIndices(model, domain, "similarity domain");
+  const PlaneComponent& q = model.components[std::size_t(query)];
+  const double cosAngle = std::cos(options.maxAngleDegrees * M_PI / 180.0);
+  std::vector<int> out;
+  for (int c : componentsHolding(model, domain)) {
+    const PlaneComponent& k = model.components[std::size_t(c)];
+    if (std::abs(k.birthLevel - q.birthLevel) > options.birthTolerance) continue;
+    if (std::abs(k.deathLevel - q.deathLevel) > options.deathTolerance) continue;
+    if (std::abs(k.plane.normal.dot(q.plane.normal)) < cosAngle - 1e-12) continue;
+    if (std::abs(k.area - q.area) > options.maxAreaDifference * q.area) continue;
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<int> extendCoverage(const PlaneModel& model, const std::vector<int>& labels,
+                                const std::vector<Vec3>& positions,
+                                const std::vector<Vec3>& normals, const KnnGraph& knn,
+                                const CoverageOptions& options) {
+  const std::size_t n = positions.size();
+  if (labels.size() != n || normals.size() != n || knn.size() != n)
+    throw OptionError("coverage: labels, positions, normals and graph differ in size");
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (const Vec3& p : positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double maxDistance = n ? options.maxDistanceFraction * (hi - lo).norm() : 0.0;
+  const double cosAngle = std::cos(options.maxAngleDegrees * M_PI / 180.0);
+  std::vector<int> out = labels;
+  std::vector<Index> frontier;
+  for (std::size_t i = 0; i < n; ++i)
+    if (out[i] >= 0) frontier.push_back(Index(i));
+  // Breadth-first rounds: every point reached in a round is decided from the labels of the
+  // previous round only, so the result does not depend on the visiting order.
+  while (!frontier.empty()) {
+    std::map<Index, std::pair<double, int>> claims;  // point -> (distance, component)
+    for (Index p : frontier)
+      for (std::size_t e = knn.offsets[p]; e < knn.offsets[p + 1]; ++e) {
+        const Index q = knn.neighbors[e];
+        if (out[q] >= 0) continue;
+        const int c = out[p];
+        const PlaneFit& plane = model.components[std::size_t(c)].plane;
+        if (!plane.valid) continue;
+        const double d = std::abs(plane.normal.dot(positions[q]) - plane.offset);
+        if (d > maxDistance || std::abs(plane.normal.dot(normals[q].normalized())) < cosAngle)
+          continue;
+        const auto claim = std::make_pair(d, c);
+        auto it = claims.find(q);
+        if (it == claims.end() || claim < it->second) claims[q] = claim;
+      }
+    frontier.clear();
+    for (const auto& [q, claim] : claims) {
+      out[q] = claim.second;
+      frontier.push_back(q);
+    }
+  }
+  return out;
+}
+
+}  // namespace scalespace
