@@ -2,7 +2,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/AtomicFile.hpp"
@@ -26,7 +25,22 @@ std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw FileError(path, "", "cannot open the file", "check that it exists and is readable");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // One read of the whole file: the parsers work on memory, with every count checked against
+  // this size. (Streams that cannot seek, e.g. pipes, fall back to reading chunk by chunk.)
+  std::string data;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (size > 0) {
+    data.resize(std::size_t(size));
+    in.read(data.data(), size);
+    if (in.gcount() != size) throw FileError(path, "", "reading the file failed", "check the disk");
+  } else {
+    in.clear();
+    char buffer[65536];
+    while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0)
+      data.append(buffer, std::size_t(in.gcount()));
+  }
   if (in.bad()) throw FileError(path, "", "reading the file failed", "check the disk");
   return data;
 }
