@@ -2,13 +2,19 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/planes/PlaneExport.hpp"
+#include "scalespace/planes/PlaneQueries.hpp"
+#include "scalespace/render/ColorMap.hpp"
 #include "scalespace/render/PngWriter.hpp"
 #include "scalespace/render/PointRenderer.hpp"
 
@@ -107,6 +113,157 @@ void addGenerateCommand(CLI::App& app) {
   });
 }
 
+// Point indices from a text file: integers separated by spaces/newlines, '#' starts a comment.
+std::vector<Index> readIndexFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FileError(path, "", "cannot open", "check the path");
+  std::vector<Index> out;
+  std::string line;
+  for (std::size_t lineNo = 1; std::getline(in, line); ++lineNo) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    std::istringstream words(line);
+    std::string word;
+    while (words >> word) {
+      char* end = nullptr;
+      const long long v = std::strtoll(word.c_str(), &end, 10);
+      if (*end != '\0' || v < 0 || v > 0xffffffffLL)
+        throw FileError(path, "line " + std::to_string(lineNo),
+                        "'" + word + "' is not a point index", "one non-negative integer per word");
+      out.push_back(Index(v));
+    }
+  }
+  if (out.empty()) throw FileError(path, "", "no point index found");
+  return out;
+}
+
+// Points of component c at its representative level (where its plane and outline were computed).
+void labelComponent(const PlaneModel& model, int c, std::vector<int>& labels) {
+  const int level = model.components[std::size_t(c)].representativeLevel;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] < 0 && model.membership.at(level, i) == c) labels[i] = c;
+}
+
+void addSegmentCommand(CLI::App& app) {
+  struct Args {
+    std::string directory, output, input, brush, within;
+    int minPersistence = -1, similar = -1;
+    double scale = 0;
+    SimilarityOptions similarity;
+    bool coverage = false;
+    CoverageOptions coverageOptions;
+    bool quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "segment", "label points with plane components (Sec. 2.4): plane_id (-1 none) and colours");
+  cmd->add_option("directory", args->directory, "output directory of `scalespace planes`")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("-o,--output", args->output, "output cloud (.ply ...)")->required();
+  auto* pers = cmd->add_option("--min-persistence", args->minPersistence,
+                               "components with persistence >= P (most persistent per point)");
+  auto* scale =
+      cmd->add_option("--scale", args->scale, "segmentation at the computed scale nearest to T");
+  auto* brush = cmd->add_option(
+      "--brush", args->brush, "file of point indices: rank components by Eq. 2.2, label the best");
+  auto* similar =
+      cmd->add_option("--similar", args->similar, "component id to search for (with --within)");
+  auto* within = cmd->add_option("--within", args->within, "file of point indices: search domain");
+  similar->needs(within);
+  within->needs(similar);
+  pers->excludes(scale, brush, similar);
+  scale->excludes(brush, similar);
+  brush->excludes(similar);
+  cmd->add_option("--birth-tolerance", args->similarity.birthTolerance,
+                  "similarity: max birth level difference")
+      ->capture_default_str();
+  cmd->add_option("--death-tolerance", args->similarity.deathTolerance,
+                  "similarity: max death level difference")
+      ->capture_default_str();
+  cmd->add_option("--area-tolerance", args->similarity.maxAreaDifference,
+                  "similarity: max |area difference| / query area")
+      ->capture_default_str();
+  cmd->add_option("--angle", args->similarity.maxAngleDegrees,
+                  "similarity: max angle between planes (degrees)")
+      ->capture_default_str();
+  cmd->add_flag(
+      "--extend-coverage", args->coverage,
+      "extend the labels to nearby points close to the plane (Sec. 2.5.1; needs normals)");
+  cmd->add_option("--coverage-distance", args->coverageOptions.maxDistanceFraction,
+                  "coverage: max distance to the plane, fraction of the diagonal")
+      ->capture_default_str();
+  cmd->add_option("--coverage-angle", args->coverageOptions.maxAngleDegrees,
+                  "coverage: max normal deviation (degrees)")
+      ->capture_default_str();
+  cmd->add_option("--input", args->input,
+                  "the cloud the planes were computed on (default: the one recorded in DIR)");
+  cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
+  cmd->callback([args, pers, scale, brush, similar] {
+    const auto start = std::chrono::steady_clock::now();
+    if (!*pers && !*scale && !*brush && !*similar)
+      throw OptionError("segment needs one of --min-persistence, --scale, --brush, --similar");
+    std::string recorded;
+    PlaneModel model = readPlaneModel(args->directory, &recorded);
+    InputOptions input;
+    input.path = args->input.empty() ? recorded : args->input;
+    checkOutputPath(input.path, args->output);
+    PointCloud cloud = loadCloud(input, args->quiet);
+    if (cloud.size() != model.membership.pointCount)
+      throw FileError(input.path, "",
+                      "has " + std::to_string(cloud.size()) + " points but the planes in " +
+                          args->directory + " were computed on " +
+                          std::to_string(model.membership.pointCount),
+                      "pass the original cloud with --input");
+    // The saved offsets are absolute; the algorithms work on positions relative to the origin.
+    for (auto& c : model.components) c.plane.offset -= c.plane.normal.dot(cloud.origin());
+
+    std::vector<int> labels;
+    if (*pers) {
+      labels = labelsByPersistence(model, args->minPersistence);
+    } else if (*scale) {
+      labels = labelsAtScale(model, args->scale);
+    } else if (*brush) {
+      const auto matches = rankByBrush(model, readIndexFile(args->brush));
+      labels.assign(cloud.size(), -1);
+      if (!args->quiet) std::printf("component,score,overlap,persistence\n");
+      for (const BrushMatch& m : matches)
+        if (!args->quiet)
+          std::printf("%d,%.6g,%.6g,%d\n", m.component, m.score, m.overlap,
+                      model.components[std::size_t(m.component)].persistence);
+      if (!matches.empty()) labelComponent(model, matches.front().component, labels);
+    } else {
+      const auto found =
+          findSimilar(model, args->similar, readIndexFile(args->within), args->similarity);
+      labels.assign(cloud.size(), -1);
+      for (int c : found) labelComponent(model, c, labels);
+      if (!args->quiet) std::fprintf(stderr, "%zu similar components\n", found.size());
+    }
+    if (args->coverage) {
+      if (!cloud.hasNormals())
+        throw OptionError("--extend-coverage needs normals in the input cloud");
+      labels = extendCoverage(model, labels, cloud.positions(), cloud.normals(),
+                              buildKnnGraph(cloud.positions()), args->coverageOptions);
+    }
+    auto& id = cloud.addAttribute("plane_id", ScalarType::Int32);
+    auto& red = cloud.addAttribute("red", ScalarType::UInt8);
+    auto& green = cloud.addAttribute("green", ScalarType::UInt8);
+    auto& blue = cloud.addAttribute("blue", ScalarType::UInt8);
+    std::size_t labelled = 0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+      const Rgb c = labelColor(labels[i]);
+      id.values[i] = labels[i];
+      red.values[i] = c.r;
+      green.values[i] = c.g;
+      blue.values[i] = c.b;
+      labelled += labels[i] >= 0;
+    }
+    writeCloud(cloud, args->output);
+    if (!args->quiet) std::fprintf(stderr, "%zu of %zu points labelled\n", labelled, labels.size());
+    reportDone("segment", start, args->quiet);
+  });
+}
+
 bool hasSubcommand(CLI::App& app, const std::string& name) {
   return !app.get_subcommands([&](CLI::App* sub) { return sub->get_name() == name; }).empty();
 }
@@ -116,6 +273,7 @@ bool hasSubcommand(CLI::App& app, const std::string& name) {
 void addPlanesCommands(CLI::App& app) {
   addRenderCommand(app);
   if (!hasSubcommand(app, "generate")) addGenerateCommand(app);
+  addSegmentCommand(app);
 }
 
 }  // namespace scalespace::cli
