@@ -11,6 +11,14 @@
 // Every reader is strict: malformed input throws FileError naming the file, the line or byte, what
 // was expected and a fix. Declared counts are checked against the file size before allocating.
 // The per-format functions (PlyFormat.hpp, ...) parse from memory, for the fuzzers and for tests.
+//
+// Policies shared by every reader:
+//  - NaN/Inf coordinates (and magnitudes beyond 1e100): FileError, or skipped and counted with
+//    ReadOptions::dropNonFinite. Attributes may hold NaN.
+//  - Normals are kept as read: a cloud whose file has normals "has normals" even if some are zero
+//    or NaN; callers needing valid normals check them or re-estimate them.
+//  - Empty clouds are valid files and read as empty clouds.
+//  - Values of float32 columns read from text are rounded to float, as the binary encodings store.
 #include <string>
 
 #include "scalespace/core/PointCloud.hpp"
