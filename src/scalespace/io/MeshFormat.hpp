@@ -9,7 +9,8 @@
 //
 // OFF: "OFF" / "NOFF" (x y z nx ny nz per vertex) / "COFF" / "CNOFF" headers, counts on the header
 // line or the next one; one vertex or face per line, extra values (colours) ignored.
-// OBJ: v, vn and f lines (f a, a/b, a/b/c, a//c; negative indices count back); other statements
+// OBJ: v, vn and f lines (f a, a/b, a/b/c, a//c; negative indices count back; a face may only
+// reference vertices and normals defined before it, as the format requires); other statements
 // (vt, o, g, usemtl, l, ...) are ignored. `vn` normals are used only when they are unambiguous:
 // each vertex is given the same vn by every face that references it (and every vertex is
 // referenced), or, when faces reference no vn at all, there are exactly as many vn as v (matched by
