@@ -55,6 +55,23 @@ TEST(AlphaShape, RandomSquareAreaAndSeparateParts) {
   EXPECT_EQ(alphaShape2({Vec2(0, 0), Vec2(1, 0)}, 1.0).area, 0.0);
 }
 
+TEST(AlphaShape, AreaWithoutOutlinesMatchesTheFullAlphaShape) {
+  // The area-only path sums Delaunay triangles by circumradius; it must agree with CGAL's
+  // Alpha_shape_2 classification (the path with outlines) for any alpha.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<Vec2> pts;
+  for (int i = 0; i < 3000; ++i) pts.emplace_back(g(rng), 0.3 * g(rng));
+  for (double radius : {0.02, 0.05, 0.1, 0.3, 1.0, 10.0}) {
+    const double a = alphaShape2(pts, radius * radius, false).area;
+    const double b = alphaShape2(pts, radius * radius, true).area;
+    EXPECT_NEAR(a, b, 1e-12 * std::max(1.0, b)) << radius;
+    if (radius > 0.02) {
+      EXPECT_GT(a, 0.0);
+    }
+  }
+}
+
 TEST(AlphaShape, AnnulusHasTwoLoops) {
   std::vector<Vec2> pts;
   for (int i = 0; i <= 60; ++i)
