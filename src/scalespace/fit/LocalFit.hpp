@@ -24,6 +24,8 @@ enum class EstimatorKind {
 /// "w3", "w2", "w1", "plane", "mean", "quadric", "jet"; parse throws OptionError on anything else.
 const char* estimatorName(EstimatorKind kind);
 EstimatorKind parseEstimator(const std::string& name);
+/// W3, W2, W1 and Mean read the input normals; Plane, Quadric and Jet only use them for signs.
+bool estimatorNeedsNormals(EstimatorKind kind);
 
 struct FitOptions {
   EstimatorKind estimator = EstimatorKind::W3;
@@ -43,11 +45,11 @@ struct FitOptions {
 /// numeric fields are zero (never NaN) and only `neighbors` is meaningful.
 struct LocalFit {
   bool valid = false;
-  int neighbors = 0;              // samples with non-zero weight in the last fit
-  Vec3 projection = Vec3::Zero(); // where the point lands on the fitted surface (same frame as x)
-  Vec3 normal = Vec3::Zero();     // unit, oriented like the input normals
-  double meanCurvature = 0;       // H = (kMax + kMin)/2, > 0 on a sphere with outward normals
-  double kMax = 0, kMin = 0;      // principal curvatures, kMax >= kMin
+  int neighbors = 0;               // samples with non-zero weight in the last fit
+  Vec3 projection = Vec3::Zero();  // where the point lands on the fitted surface (same frame as x)
+  Vec3 normal = Vec3::Zero();      // unit, oriented like the input normals
+  double meanCurvature = 0;        // H = (kMax + kMin)/2, > 0 on a sphere with outward normals
+  double kMax = 0, kMin = 0;       // principal curvatures, kMax >= kMin
   Vec3 dirMax = Vec3::Zero(), dirMin = Vec3::Zero();  // unit, orthogonal, tangent
   // GLS parameters (Mellado 2012): u_c, u_l, u_q divided by sqrt(Delta) (Sec. 1.3.2).
   double tau = 0, kappa = 0;

@@ -1,0 +1,173 @@
+#include "scalespace/fit/OrientedSphereFit.hpp"
+
+#include <cmath>
+
+#include "scalespace/fit/Jet.hpp"
+
+namespace scalespace {
+namespace {
+
+template <class S>
+struct SphereTerms {
+  S uc, uq;
+  S ul[3];
+  bool ok = false;
+};
+
+template <class S>
+double valueOf(const S& s) {
+  return s.v;
+}
+template <>
+double valueOf<double>(const double& s) {
+  return s;
+}
+
+/// Eq. 1.7-1.9 on sums of any differentiable scalar type. `item` holds the sums of 1, q (3),
+/// n (3), q.n, |q|^2. `degenerate` is the threshold below which the position variance is zero.
+template <class S>
+SphereTerms<S> solveSphere(const S* item, double degenerate) {
+  SphereTerms<S> r;
+  const S& s0 = item[0];
+  const S* sp = item + 1;
+  const S* sn = item + 4;
+  const S& spn = item[7];
+  const S& spp = item[8];
+  const S num = s0 * spn - (sp[0] * sn[0] + sp[1] * sn[1] + sp[2] * sn[2]);  // Eq. 1.7 numerator
+  const S den = s0 * spp - (sp[0] * sp[0] + sp[1] * sp[1] + sp[2] * sp[2]);
+  if (!(valueOf(den) > degenerate)) return r;  // all samples (numerically) at one position
+  r.uq = 0.5 * (num / den);                    // Eq. 1.7
+  for (int k = 0; k < 3; ++k) r.ul[k] = (sn[k] - 2.0 * (r.uq * sp[k])) / s0;  // Eq. 1.8
+  const S dot = r.ul[0] * sp[0] + r.ul[1] * sp[1] + r.ul[2] * sp[2];
+  r.uc = -1.0 * ((dot + r.uq * spp) / s0);  // Eq. 1.9
+  r.ok = true;
+  return r;
+}
+
+}  // namespace
+
+void OrientedSphereFit::begin(const Vec3& x, double t, FitDerivatives order, bool scale) {
+  x_ = x;
+  kernel_ = WeightKernel(t);
+  order_ = order;
+  scale_ = scale;
+  count_ = 0;
+  s_.setZero();
+  if (order_ >= FitDerivatives::First) g_.setZero();
+  if (order_ >= FitDerivatives::Second) {
+    a_.setZero();
+    b_.setZero();
+  }
+  if (scale_) dt_.setZero();
+}
+
+void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
+  const Vec3 q = p - x_;
+  const double d2 = q.squaredNorm();
+  const double r = kernel_.ratio(d2);
+  if (r >= 1) return;
+  const double rm1 = r - 1;
+  const double w = rm1 * rm1 * extraWeight;
+  if (!(w > 0)) return;
+  ++count_;
+  Item item;
+  item << 1.0, q.x(), q.y(), q.z(), n.x(), n.y(), n.z(), q.dot(n), d2;
+  s_.noalias() += w * item;
+  if (order_ >= FitDerivatives::First) {
+    // grad_x w = -grad_q w = -4 (r - 1) q / t^2 (dq/dx = -I).
+    const Vec3 gx = (-4 * rm1 * kernel_.invT2 * extraWeight) * q;
+    g_.noalias() += item * gx.transpose();
+  }
+  if (order_ >= FitDerivatives::Second) {
+    // hess_x w = hess_q w = 4 (r - 1) I / t^2 + 8 q q^T / t^4 (two sign flips cancel).
+    const double a = 4 * rm1 * kernel_.invT2 * extraWeight;
+    const double b = 8 * kernel_.invT2 * kernel_.invT2 * extraWeight;
+    a_.noalias() += a * item;
+    Eigen::Matrix<double, 1, 6> qq;
+    qq << q.x() * q.x(), q.y() * q.y(), q.z() * q.z(), q.x() * q.y(), q.x() * q.z(), q.y() * q.z();
+    b_.noalias() += (b * item) * qq;
+  }
+  if (scale_) dt_.noalias() += (kernel_.scaleDerivative(r) * extraWeight) * item;
+}
+
+OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
+  OrientedSphereFitResult res;
+  res.neighbors = count_;
+  res.weightSum = s_[0];
+  if (count_ < minNeighbors || count_ < 1 || !(s_[0] > 0)) return res;
+  const double t2 = kernel_.t * kernel_.t;
+  const double degenerate = 1e-14 * s_[0] * s_[0] * t2;
+  AlgebraicSphere sphere;
+  if (order_ == FitDerivatives::None) {
+    double items[9];
+    for (int k = 0; k < 9; ++k) items[k] = s_[k];
+    const auto u = solveSphere<double>(items, degenerate);
+    if (!u.ok) return res;
+    sphere.uc = u.uc;
+    sphere.uq = u.uq;
+    sphere.ul = Vec3(u.ul[0], u.ul[1], u.ul[2]);
+    res.gradient = sphere.ul;
+  } else if (order_ == FitDerivatives::First) {
+    Jet1 items[9];
+    for (int k = 0; k < 9; ++k) items[k] = {s_[k], g_.row(k).transpose()};
+    const auto u = solveSphere<Jet1>(items, degenerate);
+    if (!u.ok) return res;
+    sphere.uc = u.uc.v;
+    sphere.uq = u.uq.v;
+    for (int k = 0; k < 3; ++k) {
+      sphere.ul[k] = u.ul[k].v;
+      res.jacobianUl.row(k) = u.ul[k].g.transpose();
+    }
+    res.gradUc = u.uc.g;
+    res.gradUq = u.uq.g;
+  } else {
+    Jet2 items[9];
+    for (int k = 0; k < 9; ++k) {
+      Mat3 h = a_[k] * Mat3::Identity();
+      h(0, 0) += b_(k, 0);
+      h(1, 1) += b_(k, 1);
+      h(2, 2) += b_(k, 2);
+      h(0, 1) += b_(k, 3);
+      h(1, 0) += b_(k, 3);
+      h(0, 2) += b_(k, 4);
+      h(2, 0) += b_(k, 4);
+      h(1, 2) += b_(k, 5);
+      h(2, 1) += b_(k, 5);
+      items[k] = {s_[k], g_.row(k).transpose(), h};
+    }
+    const auto u = solveSphere<Jet2>(items, degenerate);
+    if (!u.ok) return res;
+    sphere.uc = u.uc.v;
+    sphere.uq = u.uq.v;
+    for (int k = 0; k < 3; ++k) {
+      sphere.ul[k] = u.ul[k].v;
+      res.jacobianUl.row(k) = u.ul[k].g.transpose();
+    }
+    res.gradUc = u.uc.g;
+    res.gradUq = u.uq.g;
+    // Eq. 1.36 at x = 0: the terms in x vanish, leaving hess u_c + J + J^T + 2 u_q I.
+    res.hessianW3 =
+        u.uc.h + res.jacobianUl + res.jacobianUl.transpose() + 2 * sphere.uq * Mat3::Identity();
+  }
+  if (order_ >= FitDerivatives::First) {
+    // Eq. 1.33 at x = 0: grad u_c + u_l; Eq. 1.34 at x = 0: J + 2 u_q I.
+    res.gradient = res.gradUc + sphere.ul;
+    res.hessianW2 = res.jacobianUl + 2 * sphere.uq * Mat3::Identity();
+  }
+  if (scale_) {
+    Dual items[9];
+    for (int k = 0; k < 9; ++k) items[k] = {s_[k], dt_[k]};
+    const auto u = solveSphere<Dual>(items, degenerate);
+    if (u.ok) {
+      res.dUcDt = u.uc.d;
+      res.dUqDt = u.uq.d;
+      res.dUlDt = Vec3(u.ul[0].d, u.ul[1].d, u.ul[2].d);
+    }
+  }
+  res.sphere = sphere;
+  res.valid = sphere.isValid() && res.gradient.allFinite() && res.hessianW2.allFinite() &&
+              res.hessianW3.allFinite() && res.gradient.squaredNorm() > 0;
+  return res;
+}
+
+}  // namespace scalespace

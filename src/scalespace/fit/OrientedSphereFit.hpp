@@ -1,0 +1,64 @@
+#pragma once
+// Closed-form fit of an algebraic sphere to oriented samples (Eq. 1.7-1.9, Guennebaud 2008),
+// evaluated in a frame centred at the evaluation point x (q = p - x, NOTES.md). One pass over the
+// neighbours accumulates the weighted sums of 1, q, n, q.n, |q|^2 and, on request, their first and
+// second derivatives with respect to x (through the weights only: the frame stays fixed at x) and
+// with respect to t. The quotient/product rules (Jet.hpp) then give the derivatives of u_c, u_l,
+// u_q, hence the complete gradient (Eq. 1.33) and Hessians of Eq. 1.34 (W2) and 1.36 (W3) of the
+// scalar field f(y) = u_c(y) + u_l(y).(y - x) + u_q(y) |y - x|^2 at y = x.
+#include <Eigen/Core>
+
+#include "scalespace/core/Types.hpp"
+#include "scalespace/fit/AlgebraicSphere.hpp"
+#include "scalespace/fit/WeightKernel.hpp"
+
+namespace scalespace {
+
+/// Which spatial derivatives of the fit to compute (W1: None, W2: First, W3: Second).
+enum class FitDerivatives { None = 0, First = 1, Second = 2 };
+
+struct OrientedSphereFitResult {
+  bool valid = false;
+  int neighbors = 0;       // samples with non-zero weight
+  double weightSum = 0;    // sum of the weights
+  AlgebraicSphere sphere;  // frame centred at x
+  /// Complete gradient of f at x (Eq. 1.33 with x := 0); equals u_l when derivatives are None.
+  Vec3 gradient = Vec3::Zero();
+  Mat3 hessianW2 = Mat3::Zero();   // Eq. 1.34 at x (needs First)
+  Mat3 hessianW3 = Mat3::Zero();   // Eq. 1.36 at x (needs Second)
+  Mat3 jacobianUl = Mat3::Zero();  // d u_l_i / d x_j (needs First)
+  Vec3 gradUc = Vec3::Zero(), gradUq = Vec3::Zero();
+  /// Scale derivatives d/dt of u_c, u_l, u_q at fixed x (only when requested).
+  double dUcDt = 0, dUqDt = 0;
+  Vec3 dUlDt = Vec3::Zero();
+};
+
+class OrientedSphereFit {
+ public:
+  /// Starts a fit at x with support t. `scaleDerivatives` adds the d/dt sums.
+  void begin(const Vec3& x, double t, FitDerivatives order, bool scaleDerivatives = false);
+  /// Adds sample p with unit normal n; `extraWeight` multiplies the kernel weight (robust
+  /// re-weighting; treated as a constant when differentiating).
+  void add(const Vec3& p, const Vec3& n, double extraWeight = 1.0);
+  /// Solves Eq. 1.7-1.9 (and the derivatives). Invalid when fewer than minNeighbors samples
+  /// have weight, when the positions are degenerate (all equal) or Delta <= 0.
+  OrientedSphereFitResult finish(int minNeighbors) const;
+
+  const Vec3& center() const { return x_; }
+  double support() const { return kernel_.t; }
+
+ private:
+  using Item = Eigen::Matrix<double, 9, 1>;  // 1, q, n, q.n, |q|^2
+  Vec3 x_ = Vec3::Zero();
+  WeightKernel kernel_{1.0};
+  FitDerivatives order_ = FitDerivatives::None;
+  bool scale_ = false;
+  int count_ = 0;
+  Item s_;                         // sum w item
+  Eigen::Matrix<double, 9, 3> g_;  // sum grad_x w item^T
+  Item a_;                         // sum a item   (hess w = a I + b q q^T)
+  Eigen::Matrix<double, 9, 6> b_;  // sum b item (q q^T as xx, yy, zz, xy, xz, yz)
+  Item dt_;                        // sum dw/dt item
+};
+
+}  // namespace scalespace
