@@ -12,29 +12,29 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 }
 }  // namespace
 
-PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& knn,
-                            const std::vector<ScaleFeatures>& scales,
-                            const PlaneDetectionOptions& options,
-                            const ProgressCallback& progress) {
-  if (knn.size() != positions.size())
-    throw OptionError("plane detection: the neighbour graph was built on another cloud");
-  checkScaleFeatures(scales, positions.size());
+RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                         const ScaleFeatures& scale, const PlaneDetectionOptions& options,
+                         PlaneDetectionTimings& timings) {
+  auto start = std::chrono::steady_clock::now();
+  const Segmentation seg = growRegions(knn, scale, options.growing);
+  timings.segmentation += secondsSince(start);
+  start = std::chrono::steady_clock::now();
+  RegionFilterOptions filter;
+  filter.alphaFactor = options.alphaFactor;
+  RegionLevel level;
+  level.t = scale.t;
+  level.regions = filterRegions(positions, seg, scale.t, filter);
+  timings.filtering += secondsSince(start);
+  return level;
+}
+
+PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
+                                   std::vector<RegionLevel> levels,
+                                   const PlaneDetectionOptions& options,
+                                   PlaneDetectionTimings timings,
+                                   const ProgressCallback& progress) {
   PlaneDetection result;
-  std::vector<RegionLevel> levels(scales.size());
-  // Progress of the per-scale loop: one tick per scale, the filter's own progress is not nested.
-  for (std::size_t j = 0; j < scales.size(); ++j) {
-    if (progress && !progress(double(j) / double(scales.size()), "planar segmentations"))
-      throw Cancelled();
-    auto start = std::chrono::steady_clock::now();
-    const Segmentation seg = growRegions(knn, scales[j], options.growing);
-    result.timings.segmentation += secondsSince(start);
-    start = std::chrono::steady_clock::now();
-    RegionFilterOptions filter;
-    filter.alphaFactor = options.alphaFactor;
-    levels[j].t = scales[j].t;
-    levels[j].regions = filterRegions(positions, seg, scales[j].t, filter);
-    result.timings.filtering += secondsSince(start);
-  }
+  result.timings = timings;
   auto start = std::chrono::steady_clock::now();
   result.graph = buildRegionGraph(std::move(levels), positions.size(), options.minJaccard);
   result.timings.graph = secondsSince(start);
@@ -45,6 +45,23 @@ PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& 
   result.components = extractComponents(result.graph, positions, componentOptions, progress);
   result.timings.components = secondsSince(start);
   return result;
+}
+
+PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                            const std::vector<ScaleFeatures>& scales,
+                            const PlaneDetectionOptions& options,
+                            const ProgressCallback& progress) {
+  if (knn.size() != positions.size())
+    throw OptionError("plane detection: the neighbour graph was built on another cloud");
+  checkScaleFeatures(scales, positions.size());
+  PlaneDetectionTimings timings;
+  std::vector<RegionLevel> levels;
+  for (std::size_t j = 0; j < scales.size(); ++j) {
+    if (progress && !progress(double(j) / double(scales.size()), "planar segmentations"))
+      throw Cancelled();
+    levels.push_back(segmentScale(positions, knn, scales[j], options, timings));
+  }
+  return buildPlaneDetection(positions, std::move(levels), options, timings, progress);
 }
 
 }  // namespace scalespace

@@ -27,6 +27,19 @@ struct PlaneDetection {
   int scaleCount() const { return int(graph.levels.size()); }
 };
 
+/// Sec. 2.3.1 for one scale: region growing then the alpha-shape filter; adds the time spent to
+/// `timings` (segmentation, filtering).
+RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                         const ScaleFeatures& scale, const PlaneDetectionOptions& options,
+                         PlaneDetectionTimings& timings);
+
+/// Sec. 2.3.2-2.3.3 on the filtered levels: graph, components, planes and outlines.
+PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
+                                   std::vector<RegionLevel> levels,
+                                   const PlaneDetectionOptions& options,
+                                   PlaneDetectionTimings timings,
+                                   const ProgressCallback& progress = {});
+
 /// Runs Sec. 2.3 on precomputed scale features (increasing t) and the k-NN graph of `positions`.
 PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& knn,
                             const std::vector<ScaleFeatures>& scales,
