@@ -1,0 +1,221 @@
+#include "scalespace/scales/PoissonDiskSampler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/Parallel.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+
+namespace scalespace {
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+constexpr int kCellBits = 21;  // per axis, packed into a 63-bit key
+constexpr std::int64_t kCellMax = (std::int64_t(1) << kCellBits) - 4;
+
+struct Candidate {
+  std::uint64_t cell;   // packed cell coordinates
+  std::uint64_t order;  // seeded random key inside the cell
+  Index point;
+};
+
+std::uint64_t packCell(std::int64_t x, std::int64_t y, std::int64_t z) {
+  return (std::uint64_t(x) << (2 * kCellBits)) | (std::uint64_t(y) << kCellBits) | std::uint64_t(z);
+}
+
+// r(i, k) of the rejection rule: the larger radius (homogeneous: the radius).
+template <class RadiusOf>
+std::vector<Index> gridSample(const std::vector<Vec3>& positions,
+                              const std::vector<Index>& candidates, double maxRadius,
+                              const RadiusOf& radiusOf, std::uint64_t seed) {
+  if (candidates.empty()) return {};
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (Index i : candidates) {
+    lo = lo.cwiseMin(positions[i]);
+    hi = hi.cwiseMax(positions[i]);
+  }
+  // A cell of size >= r keeps every conflict within the 27 neighbouring cells; grow it when the
+  // grid would overflow the 21-bit cell coordinates (still correct, just more points per cell).
+  const double extent = (hi - lo).maxCoeff();
+  const double cell = std::max(maxRadius, extent / double(kCellMax));
+  std::vector<Candidate> c(candidates.size());
+  parallelFor(candidates.size(), [&](std::size_t k) {
+    const Index i = candidates[k];
+    const Vec3 g = (positions[i] - lo) / cell;
+    c[k] = {packCell(std::int64_t(g.x()) + 1, std::int64_t(g.y()) + 1, std::int64_t(g.z()) + 1),
+            sampleOrderKey(seed, i), i};
+  });
+  std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
+    return a.cell != b.cell     ? a.cell < b.cell
+           : a.order != b.order ? a.order < b.order
+                                : a.point < b.point;
+  });
+  // Cells as runs of the sorted array, grouped by colour (parity of the three coordinates).
+  std::vector<std::size_t> cellBegin;
+  for (std::size_t k = 0; k < c.size(); ++k)
+    if (k == 0 || c[k].cell != c[k - 1].cell) cellBegin.push_back(k);
+  const std::size_t cellCount = cellBegin.size();
+  cellBegin.push_back(c.size());
+  std::vector<std::vector<std::size_t>> byColour(8);
+  const std::uint64_t mask = (std::uint64_t(1) << kCellBits) - 1;
+  for (std::size_t q = 0; q < cellCount; ++q) {
+    const std::uint64_t key = c[cellBegin[q]].cell;
+    const int colour =
+        int(((key >> (2 * kCellBits)) & 1) | (((key >> kCellBits) & 1) << 1) | ((key & 1) << 2));
+    byColour[std::size_t(colour)].push_back(q);
+  }
+  auto findCell = [&](std::uint64_t key) -> std::ptrdiff_t {
+    auto it = std::lower_bound(cellBegin.begin(), cellBegin.end() - 1, key,
+                               [&](std::size_t b, std::uint64_t v) { return c[b].cell < v; });
+    if (it == cellBegin.end() - 1 || c[*it].cell != key) return -1;
+    return it - cellBegin.begin();
+  };
+  std::vector<std::uint8_t> accepted(c.size(), 0);
+  for (const auto& cells : byColour) {
+    parallelFor(
+        cells.size(),
+        [&](std::size_t ci) {
+          const std::size_t q = cells[ci];
+          const std::uint64_t key = c[cellBegin[q]].cell;
+          const std::int64_t x = std::int64_t((key >> (2 * kCellBits)) & mask),
+                             y = std::int64_t((key >> kCellBits) & mask),
+                             z = std::int64_t(key & mask);
+          std::ptrdiff_t near[27];
+          int nearCount = 0;
+          for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dz = -1; dz <= 1; ++dz) {
+                const std::ptrdiff_t f = findCell(packCell(x + dx, y + dy, z + dz));
+                if (f >= 0) near[nearCount++] = f;
+              }
+          for (std::size_t k = cellBegin[q]; k < cellBegin[q + 1]; ++k) {
+            const Vec3& p = positions[c[k].point];
+            bool free = true;
+            for (int n = 0; n < nearCount && free; ++n)
+              for (std::size_t m = cellBegin[std::size_t(near[n])];
+                   m < cellBegin[std::size_t(near[n]) + 1]; ++m) {
+                if (!accepted[m]) continue;
+                const double r = radiusOf(c[k].point, c[m].point);
+                if ((positions[c[m].point] - p).squaredNorm() < r * r) {
+                  free = false;
+                  break;
+                }
+              }
+            accepted[k] = free;
+          }
+        },
+        16);
+  }
+  std::vector<Index> out;
+  for (std::size_t k = 0; k < c.size(); ++k)
+    if (accepted[k]) out.push_back(c[k].point);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+std::uint64_t sampleOrderKey(std::uint64_t seed, Index i) {
+  return splitmix64(splitmix64(seed) ^ std::uint64_t(i));
+}
+
+std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
+                                     const std::vector<Index>& candidates, double radius,
+                                     std::uint64_t seed) {
+  if (!std::isfinite(radius)) throw OptionError("Poisson-disk radius must be finite");
+  if (radius <= 0) {
+    std::vector<Index> all = candidates;
+    std::sort(all.begin(), all.end());
+    return all;
+  }
+  return gridSample(
+      positions, candidates, radius, [radius](Index, Index) { return radius; }, seed);
+}
+
+std::vector<Index> poissonDiskSampleAdaptive(const std::vector<Vec3>& positions,
+                                             const std::vector<Index>& candidates,
+                                             const std::vector<double>& radii, std::uint64_t seed) {
+  if (radii.size() != positions.size())
+    throw OptionError("adaptive Poisson-disk sampling: " + std::to_string(radii.size()) +
+                      " radii for " + std::to_string(positions.size()) + " points");
+  double maxRadius = 0;
+  for (Index i : candidates) {
+    if (!std::isfinite(radii[i]) || radii[i] < 0)
+      throw OptionError("adaptive Poisson-disk radius of point " + std::to_string(i) +
+                        " must be finite and >= 0");
+    maxRadius = std::max(maxRadius, radii[i]);
+  }
+  if (maxRadius <= 0) {
+    std::vector<Index> all = candidates;
+    std::sort(all.begin(), all.end());
+    return all;
+  }
+  return gridSample(
+      positions, candidates, maxRadius,
+      [&radii](Index a, Index b) { return std::max(radii[a], radii[b]); }, seed);
+}
+
+std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
+                                           const std::vector<Index>& candidates, double radius,
+                                           std::uint64_t seed) {
+  if (radius <= 0) {
+    std::vector<Index> all = candidates;
+    std::sort(all.begin(), all.end());
+    return all;
+  }
+  std::vector<Vec3> pts;
+  pts.reserve(candidates.size());
+  for (Index i : candidates) pts.push_back(positions[i]);
+  auto index = makeSpatialIndex(pts);
+  std::vector<std::size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const auto ka = sampleOrderKey(seed, candidates[a]), kb = sampleOrderKey(seed, candidates[b]);
+    return ka != kb ? ka < kb : candidates[a] < candidates[b];
+  });
+  std::vector<std::uint8_t> removed(candidates.size(), 0);
+  std::vector<Neighbor> nb;
+  std::vector<Index> out;
+  for (std::size_t k : order) {
+    if (removed[k]) continue;
+    out.push_back(candidates[k]);
+    index->radiusSearch(pts[k], radius, nb);
+    for (const Neighbor& n : nb) removed[n.index] = 1;
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
+                                 const std::vector<double>& scales, double alpha,
+                                 std::uint64_t seed, const ProgressCallback& progress) {
+  if (!(alpha >= 0) || !std::isfinite(alpha))
+    throw OptionError("--alpha must be >= 0 (Poisson-disk radius / scale), got " +
+                      std::to_string(alpha));
+  SamplePyramid pyramid;
+  std::vector<Index> previous(positions.size());
+  std::iota(previous.begin(), previous.end(), Index(0));
+  for (std::size_t j = 0; j < scales.size(); ++j) {
+    const double r = alpha * scales[j];
+    // Each level gets its own seed so that visiting orders are not correlated across levels.
+    std::vector<Index> level =
+        poissonDiskSample(positions, previous, r, seed + 0x632be59bd9b4e019ULL * (j + 1));
+    pyramid.radii.push_back(r);
+    pyramid.levels.push_back(level);
+    previous = std::move(level);
+    if (progress && !progress(double(j + 1) / double(scales.size()), "Poisson-disk pyramid"))
+      throw Cancelled();
+  }
+  return pyramid;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,60 @@
+#pragma once
+// Poisson-disk sub-sampling and the multi-resolution pyramid of Sec. 1.5.2: the sample of scale j
+// is drawn from the sample of scale j-1 with disk radius r_j = alpha t_j, so levels are nested
+// and coarse scales are fitted on few samples.
+//
+// Rule (what the tests check): a candidate is rejected iff an already accepted sample lies at a
+// distance < r (adaptive: < max(r_candidate, r_sample)). Hence
+//   - separation: no two samples of a level are closer than r (adaptive: the larger radius);
+//   - coverage: every candidate is a sample or lies within r (adaptive: the larger of its radius
+//     and that sample's) of a sample — the thesis asks for 2 r, this is stronger;
+//   - nesting: each level is a subset of the candidates (the previous level).
+//
+// Parallel algorithm (instead of the thesis' greedy sequential loop, ~10% of its time): candidates
+// are binned in a grid of cell size >= r, so conflicts only involve the 3x3x3 neighbouring cells.
+// Cells are coloured by the parity of their coordinates (8 colours); cells of one colour are >= 2
+// cells apart, hence never conflict and are processed in parallel; colours in sequence. Inside a
+// cell the candidates are visited in a seeded random order (a hash of seed and point index).
+// The result depends only on the seed, never on the thread count.
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+/// The Poisson-disk subset of `candidates` (indices into `positions`) with radius `radius`,
+/// sorted by increasing index. radius <= 0 keeps every candidate. Throws OptionError on a
+/// non-finite radius.
+std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
+                                     const std::vector<Index>& candidates, double radius,
+                                     std::uint64_t seed);
+
+/// Adaptive variant: radii[i] is the radius of point i (indexed like `positions`).
+std::vector<Index> poissonDiskSampleAdaptive(const std::vector<Vec3>& positions,
+                                             const std::vector<Index>& candidates,
+                                             const std::vector<double>& radii, std::uint64_t seed);
+
+/// Reference: the thesis' greedy sequential sampler (random order, kd-tree radius query around
+/// each accepted sample). Same rule, different visiting order; used by tests and the bench.
+std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
+                                           const std::vector<Index>& candidates, double radius,
+                                           std::uint64_t seed);
+
+struct SamplePyramid {
+  /// levels[j]: indices of the input points kept at scale j (sorted), levels[j] ⊂ levels[j-1].
+  std::vector<std::vector<Index>> levels;
+  std::vector<double> radii;  // r_j = alpha t_j
+};
+
+/// Level j drawn from level j-1 (level 0 from all points) with r_j = alpha scales[j]
+/// (Sec. 1.5.2). alpha = 0 keeps every point at every level. Throws OptionError if alpha < 0.
+SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
+                                 const std::vector<double>& scales, double alpha,
+                                 std::uint64_t seed, const ProgressCallback& progress = {});
+
+/// The seeded visiting key of a point (splitmix64 of seed and index): exposed for the tests.
+std::uint64_t sampleOrderKey(std::uint64_t seed, Index i);
+
+}  // namespace scalespace

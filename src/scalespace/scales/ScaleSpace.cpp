@@ -1,0 +1,187 @@
+#include "scalespace/scales/ScaleSpace.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/Parallel.hpp"
+#include "scalespace/core/SpatialOrder.hpp"
+#include "scalespace/scales/PoissonDiskSampler.hpp"
+
+namespace scalespace {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void put3(std::vector<float>& v, std::size_t i, const Vec3& x) {
+  v[3 * i] = float(x.x());
+  v[3 * i + 1] = float(x.y());
+  v[3 * i + 2] = float(x.z());
+}
+
+}  // namespace
+
+void ScaleLayer::resize(std::size_t n) {
+  for (auto* v : {&projection, &normal, &dirMax, &dirMin}) v->assign(3 * n, 0.0f);
+  for (auto* v :
+       {&meanCurvature, &kMax, &kMin, &tau, &kappa, &fitness, &anisotropy, &geometricVariation})
+    v->assign(n, 0.0f);
+  neighbors.assign(n, 0);
+  valid.assign(n, 0);
+}
+
+std::uint64_t cloudChecksum(const PointCloud& cloud) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a offset basis
+  auto mix = [&h](double d) {
+    unsigned char b[8];
+    std::memcpy(b, &d, 8);  // little-endian hosts only (x86-64, arm64)
+    for (unsigned char c : b) {
+      h ^= c;
+      h *= 0x100000001b3ULL;  // FNV prime
+    }
+  };
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3 p = cloud.absolutePosition(i);
+    mix(p.x()), mix(p.y()), mix(p.z());
+  }
+  for (const Vec3& n : cloud.normals()) mix(n.x()), mix(n.y()), mix(n.z());
+  return h;
+}
+
+ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                const ScaleSink& sink, const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (cloud.empty()) throw OptionError("the cloud has no points: nothing to analyse");
+  if (!cloud.hasNormals())
+    throw OptionError(
+        "the multi-scale projection needs oriented normals: estimate and orient them first "
+        "(core/NormalEstimation + NormalOrientation; the CLI does it when they are missing)");
+  if (options.mlsSteps < 1)
+    throw OptionError("--mls-steps must be >= 1, got " + std::to_string(options.mlsSteps));
+  if (!(options.mlsTolerance > 0)) throw OptionError("MLS tolerance must be > 0 (fraction of t)");
+  ThreadLimit limit(options.threads);
+
+  ScaleSpaceSummary summary;
+  summary.inputChecksum = cloudChecksum(cloud);
+  const std::size_t n = cloud.size();
+
+  // Process points along a Morton curve: consecutive points share neighbours (cache reuse).
+  const std::vector<Index> order = spatialOrder(cloud.positions());
+  const std::vector<Vec3> positions = applyPermutation(cloud.positions(), order);
+  const std::vector<Vec3> normals = applyPermutation(cloud.normals(), order);
+  {
+    auto index = makeSpatialIndex(positions);
+    summary.series = makeScaleSeries(positions, options.series, index.get());
+  }
+  const std::vector<double>& scales = summary.series.scales;
+  const std::size_t m = scales.size();
+  if (!(options.alpha >= 0) || !std::isfinite(options.alpha))
+    throw OptionError("--alpha must be >= 0, got " + std::to_string(options.alpha));
+
+  FitOptions fit;
+  fit.estimator = options.estimator;
+  fit.mls = true;
+  fit.mlsMaxSteps = options.mlsSteps;
+  fit.mlsTolerance = options.mlsTolerance;
+  fit.robust = options.robust;
+  fit.robustIterations = options.robustIterations;
+  fit.minNeighbors = options.minNeighbors;
+
+  std::vector<Vec3> current = positions;  // projection at the previous scale (Fig. 1.9)
+  std::vector<Index> level(n);
+  for (std::size_t k = 0; k < n; ++k) level[k] = Index(k);
+  ScaleLayer layer;
+  layer.resize(n);
+  tbb::enumerable_thread_specific<FitWorkspace> workspaces;
+  std::vector<std::uint32_t> neighborCount(n);
+  std::vector<Vec3> samplePositions, sampleNormals;
+
+  for (std::size_t j = 0; j < m; ++j) {
+    ScaleStats stats;
+    stats.t = scales[j];
+    auto t0 = std::chrono::steady_clock::now();
+    // Sec. 1.5.2: level j drawn from level j-1 with r_j = alpha t_j (nested pyramid).
+    level = poissonDiskSample(positions, level, options.alpha * scales[j],
+                              options.seed + 0x632be59bd9b4e019ULL * (j + 1));
+    stats.samplingSeconds = secondsSince(t0);
+    stats.samples = level.size();
+
+    t0 = std::chrono::steady_clock::now();
+    samplePositions.resize(level.size());
+    sampleNormals.resize(level.size());
+    for (std::size_t s = 0; s < level.size(); ++s) {
+      samplePositions[s] = positions[level[s]];
+      sampleNormals[s] = normals[level[s]];
+    }
+    auto index = makeSpatialIndex(samplePositions);
+    stats.indexSeconds = secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    const SurfaceSamples samples{samplePositions, sampleNormals, *index};
+    const double t = scales[j];
+    ProgressTracker tracker(progress ? ProgressCallback([&](double f, std::string_view) {
+                              return progress(
+                                  (double(j) + f) / double(m),
+                                  "scale " + std::to_string(j + 1) + "/" + std::to_string(m));
+                            })
+                                     : ProgressCallback(),
+                            "projection", n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        FitWorkspace& ws = workspaces.local();
+                        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                          const LocalFit f = fitAt(current[k], t, samples, fit, ws);
+                          const std::size_t i = order[k];  // input index
+                          neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
+                          layer.neighbors[i] = std::uint16_t(std::min(f.neighbors, 65535));
+                          layer.valid[i] = f.valid ? 1 : 0;
+                          if (f.valid) current[k] = f.projection;  // else keep the last one
+                          put3(layer.projection, i, current[k]);
+                          put3(layer.normal, i, f.normal);
+                          put3(layer.dirMax, i, f.dirMax);
+                          put3(layer.dirMin, i, f.dirMin);
+                          layer.meanCurvature[i] = float(f.meanCurvature);
+                          layer.kMax[i] = float(f.kMax);
+                          layer.kMin[i] = float(f.kMin);
+                          layer.tau[i] = float(f.tau);
+                          layer.kappa[i] = float(f.kappa);
+                          layer.fitness[i] = float(f.fitness);
+                          layer.anisotropy[i] = float(f.anisotropy);
+                          layer.geometricVariation[i] = float(f.geometricVariation);
+                        }
+                        tracker.advance(r.size());
+                      });
+    tracker.finish();
+    stats.projectionSeconds = secondsSince(t0);
+    double sum = 0;
+    for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k];
+    stats.meanNeighbors = sum / double(n);
+    for (std::uint8_t v : layer.valid) stats.validPoints += v;
+    summary.stats.push_back(stats);
+    if (sink) sink(j, layer, stats);
+  }
+  summary.totalSeconds = secondsSince(start);
+  return summary;
+}
+
+ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                             const ProgressCallback& progress) {
+  ScaleStack stack;
+  stack.summary = runScaleSpace(
+      cloud, options,
+      [&](std::size_t, const ScaleLayer& layer, const ScaleStats&) {
+        stack.layers.push_back(layer);
+      },
+      progress);
+  return stack;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,85 @@
+#pragma once
+// The multi-scale, multi-resolution representation of Sec. 1.5 (Fig. 1.9): for each scale t_j
+// (increasing), every input point is projected with the robust APSS fit of scale t_j onto the
+// surface defined by that scale's Poisson-disk sample (original positions and normals of the
+// sampled points), starting from its projection at scale j-1 (the input position at j = 1).
+// Per point and scale we record the projection, normal, curvatures, directions, GLS parameters,
+// anisotropy, neighbour count and validity.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/fit/LocalFit.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
+
+namespace scalespace {
+
+struct ScaleSpaceOptions {
+  ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
+  double alpha = 0.1;         // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2)
+  bool robust = true;         // robust APSS (Sec. 2.3, NOTES.md)
+  int robustIterations = 5;   // re-weightings per fit (NOTES.md: 5)
+  /// MLS projection steps per scale; each scale starts from the previous scale's projection,
+  /// so few steps are needed (NOTES.md: the authors allow up to 10, stop below 0.01 t).
+  int mlsSteps = 10;
+  double mlsTolerance = 0.01;  // step < mlsTolerance * t_j stops the projection
+  int minNeighbors = 6;        // fits with fewer samples are invalid (NOTES.md)
+  EstimatorKind estimator = EstimatorKind::W3;
+  std::uint64_t seed = 1;  // Poisson-disk visiting order
+  int threads = 0;         // 0: all cores
+};
+
+/// Statistics of one scale (what Fig. 1.11 plots).
+struct ScaleStats {
+  double t = 0;
+  std::size_t samples = 0;   // size of the Poisson-disk sample of this scale
+  double meanNeighbors = 0;  // mean neighbours per projection (last fit of each point)
+  std::size_t validPoints = 0;
+  double samplingSeconds = 0;    // this level's Poisson-disk sampling
+  double indexSeconds = 0;       // building the kd-tree on the sample
+  double projectionSeconds = 0;  // projecting every input point
+};
+
+/// Everything computed at one scale, one entry per input point, in input order. Positions are
+/// relative to the cloud's origin() (PointCloud.hpp); vectors are packed x,y,z.
+struct ScaleLayer {
+  std::vector<float> projection, normal, dirMax, dirMin;                   // 3 N each
+  std::vector<float> meanCurvature, kMax, kMin;                            // N each
+  std::vector<float> tau, kappa, fitness, anisotropy, geometricVariation;  // N each
+  std::vector<std::uint16_t> neighbors;                                    // N, saturated at 65535
+  std::vector<std::uint8_t> valid;                                         // N, 1 = valid fit
+  void resize(std::size_t n);
+  std::size_t size() const { return valid.size(); }
+};
+
+/// Receives each scale as soon as it is computed (j = 0..M-1), e.g. to stream it to disk.
+using ScaleSink = std::function<void(std::size_t j, const ScaleLayer& layer, const ScaleStats&)>;
+
+struct ScaleSpaceSummary {
+  ScaleSeriesResult series;
+  std::vector<ScaleStats> stats;
+  std::uint64_t inputChecksum = 0;
+  double totalSeconds = 0;
+};
+
+/// Runs the multi-scale projection. The cloud must have normals (OptionError otherwise: estimate
+/// and orient them first, core/NormalEstimation + NormalOrientation). Deterministic for any
+/// thread count. Progress per scale; the callback may cancel (throws Cancelled).
+ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                const ScaleSink& sink, const ProgressCallback& progress = {});
+
+/// The whole stack in memory (small clouds, tests): layers[j] for scale j.
+struct ScaleStack {
+  ScaleSpaceSummary summary;
+  std::vector<ScaleLayer> layers;
+};
+ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                             const ProgressCallback& progress = {});
+
+/// FNV-1a 64-bit over the absolute positions and the normals (as little-endian doubles): identifies
+/// the input a stack was computed from.
+std::uint64_t cloudChecksum(const PointCloud& cloud);
+
+}  // namespace scalespace

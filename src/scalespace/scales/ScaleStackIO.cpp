@@ -1,0 +1,642 @@
+#include "scalespace/scales/ScaleStackIO.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "scalespace/core/Error.hpp"
+
+#ifndef SCALESPACE_VERSION
+#define SCALESPACE_VERSION "unknown"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace scalespace {
+namespace {
+
+// One .npy file per quantity. dtype strings are NumPy's ('<f4' little-endian float32, ...).
+struct Quantity {
+  const char* name;
+  const char* dtype;
+  std::size_t itemSize;
+  int components;  // 1: shape (M, N); 3: shape (M, N, 3)
+  const char* description;
+  std::vector<float> ScaleLayer::*floats;  // nullptr for the integer quantities
+};
+
+const Quantity kQuantities[] = {
+    {"projection", "<f4", 4, 3, "projected position relative to manifest origin",
+     &ScaleLayer::projection},
+    {"normal", "<f4", 4, 3, "unit normal", &ScaleLayer::normal},
+    {"dir_max", "<f4", 4, 3, "principal direction of k_max", &ScaleLayer::dirMax},
+    {"dir_min", "<f4", 4, 3, "principal direction of k_min", &ScaleLayer::dirMin},
+    {"curv_mean", "<f4", 4, 1, "mean curvature H", &ScaleLayer::meanCurvature},
+    {"curv_max", "<f4", 4, 1, "principal curvature k_max", &ScaleLayer::kMax},
+    {"curv_min", "<f4", 4, 1, "principal curvature k_min", &ScaleLayer::kMin},
+    {"gls_tau", "<f4", 4, 1, "GLS tau", &ScaleLayer::tau},
+    {"gls_kappa", "<f4", 4, 1, "GLS kappa", &ScaleLayer::kappa},
+    {"gls_fitness", "<f4", 4, 1, "GLS fitness (Pratt norm)", &ScaleLayer::fitness},
+    {"anisotropy", "<f4", 4, 1, "1 - |u_l| (Eq. 1.20)", &ScaleLayer::anisotropy},
+    {"geometric_variation", "<f4", 4, 1, "GLS geometric variation nu",
+     &ScaleLayer::geometricVariation},
+    {"neighbors", "<u2", 2, 1, "samples in the last fit (saturated at 65535)", nullptr},
+    {"fit_valid", "|u1", 1, 1, "1 if the fit is valid", nullptr},
+};
+constexpr const char* kManifest = "manifest.json";
+
+const unsigned char* layerBytes(const Quantity& q, const ScaleLayer& layer) {
+  if (q.floats) return reinterpret_cast<const unsigned char*>((layer.*q.floats).data());
+  if (std::strcmp(q.name, "neighbors") == 0)
+    return reinterpret_cast<const unsigned char*>(layer.neighbors.data());
+  return layer.valid.data();
+}
+unsigned char* layerBytes(const Quantity& q, ScaleLayer& layer) {
+  return const_cast<unsigned char*>(layerBytes(q, static_cast<const ScaleLayer&>(layer)));
+}
+
+// 64-bit FNV-1a-style hash over 8-byte little-endian words of the whole data stream (a final
+// partial word is zero-padded): one multiply per 8 bytes, fast enough to run while writing
+// gigabytes. Streaming: add() may be called with any split of the data.
+struct Checksum {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  unsigned char carry[8] = {};
+  std::size_t carried = 0;
+  void word(const unsigned char* p) {
+    std::uint64_t w;
+    std::memcpy(&w, p, 8);
+    h = (h ^ w) * 0x100000001b3ULL;
+  }
+  void add(const unsigned char* p, std::size_t n) {
+    while (carried > 0 && carried < 8 && n > 0) {
+      carry[carried++] = *p++;
+      --n;
+    }
+    if (carried == 8) {
+      word(carry);
+      carried = 0;
+    }
+    for (; n >= 8; n -= 8, p += 8) word(p);
+    for (; n > 0; --n) carry[carried++] = *p++;
+  }
+  std::uint64_t value() const {
+    if (carried == 0) return h;
+    unsigned char last[8] = {};
+    std::memcpy(last, carry, carried);
+    std::uint64_t w;
+    std::memcpy(&w, last, 8);
+    return (h ^ w) * 0x100000001b3ULL;
+  }
+};
+
+std::string hex64(std::uint64_t v) {
+  char b[17];
+  std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(v));
+  return b;
+}
+
+std::string shapeText(const std::vector<std::size_t>& shape) {
+  std::string s = "(";
+  for (std::size_t k = 0; k < shape.size(); ++k)
+    s += std::to_string(shape[k]) + (shape.size() == 1 ? "," : k + 1 < shape.size() ? ", " : "");
+  return s + ")";
+}
+
+// NumPy format 1.0: magic, version, uint16 header length, dict padded with spaces and '\n' so
+// that the data starts at a multiple of 64 bytes.
+std::string npyHeader(const std::string& dtype, const std::vector<std::size_t>& shape) {
+  std::string dict =
+      "{'descr': '" + dtype + "', 'fortran_order': False, 'shape': " + shapeText(shape) + ", }";
+  std::size_t total = 10 + dict.size() + 1;
+  const std::size_t padded = (total + 63) / 64 * 64;
+  dict.append(padded - total, ' ');
+  dict.push_back('\n');
+  std::string h = "\x93NUMPY";
+  h.push_back(char(1));
+  h.push_back(char(0));
+  h.push_back(char(dict.size() & 0xff));
+  h.push_back(char(dict.size() >> 8));
+  return h + dict;
+}
+
+std::vector<std::size_t> quantityShape(const Quantity& q, std::size_t m, std::size_t n) {
+  if (q.components == 1) return {m, n};
+  return {m, n, std::size_t(q.components)};
+}
+
+void writeAll(int fd, const void* data, std::size_t size, const std::string& file) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t w = ::write(fd, p, size);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      throw FileError(file, "", std::string("cannot write: ") + std::strerror(errno),
+                      "check free disk space and permissions");
+    }
+    p += w;
+    size -= std::size_t(w);
+  }
+}
+
+void syncPath(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
+}
+
+void preadAll(int fd, void* data, std::size_t size, std::uint64_t offset, const std::string& file) {
+  char* p = static_cast<char*>(data);
+  while (size > 0) {
+    const ssize_t r = ::pread(fd, p, size, off_t(offset));
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0)
+      throw FileError(file, "byte " + std::to_string(offset),
+                      "unexpected end of file or read error",
+                      "the stack is damaged: recompute it with 'scalespace scales'");
+    p += r;
+    size -= std::size_t(r);
+    offset += std::uint64_t(r);
+  }
+}
+
+nlohmann::json statsJson(const ScaleStats& s) {
+  return {{"t", s.t},
+          {"samples", s.samples},
+          {"mean_neighbors", s.meanNeighbors},
+          {"valid_points", s.validPoints},
+          {"sampling_seconds", s.samplingSeconds},
+          {"index_seconds", s.indexSeconds},
+          {"projection_seconds", s.projectionSeconds}};
+}
+
+nlohmann::json optionsJson(const ScaleSpaceOptions& o) {
+  return {{"scales", o.series.count},
+          {"spacing", scaleSpacingName(o.series.spacing)},
+          {"tmin_option", o.series.tMin},
+          {"tmax_option", o.series.tMax},
+          {"K", o.series.K},
+          {"alpha", o.alpha},
+          {"robust", o.robust},
+          {"robust_iterations", o.robustIterations},
+          {"mls_steps", o.mlsSteps},
+          {"mls_tolerance", o.mlsTolerance},
+          {"min_neighbors", o.minNeighbors},
+          {"estimator", estimatorName(o.estimator)},
+          {"seed", o.seed}};
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------- writer
+
+struct ScaleStackWriter::Impl {
+  fs::path finalPath, tmpPath;
+  std::size_t n = 0, m = 0, written = 0;
+  std::vector<int> fds;
+  std::vector<Checksum> sums;
+  std::uint64_t positionsSum = 0;
+  Vec3 origin;
+  nlohmann::json parameters;
+  bool finished = false;
+
+  void closeAll() {
+    for (int& fd : fds)
+      if (fd >= 0) {
+        ::close(fd);
+        fd = -1;
+      }
+  }
+};
+
+ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cloud,
+                                   const ScaleSpaceOptions& options, std::size_t scaleCount)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  std::string clean = path;
+  while (clean.size() > 1 && clean.back() == '/') clean.pop_back();
+  d.finalPath = clean;
+  d.tmpPath = clean + ".tmp-" + std::to_string(::getpid());
+  d.n = cloud.size();
+  d.m = scaleCount;
+  d.origin = cloud.origin();
+  d.parameters = optionsJson(options);
+  std::error_code ec;
+  fs::remove_all(d.tmpPath, ec);
+  if (!fs::create_directories(d.tmpPath, ec) || ec)
+    throw FileError(d.tmpPath.string(), "",
+                    "cannot create the temporary stack directory: " + ec.message(),
+                    "check that the parent directory exists and is writable");
+  try {
+    for (const Quantity& q : kQuantities) {
+      const std::string file = (d.tmpPath / (std::string(q.name) + ".npy")).string();
+      const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (fd < 0)
+        throw FileError(file, "", std::string("cannot create: ") + std::strerror(errno),
+                        "check permissions and free space");
+      d.fds.push_back(fd);
+      d.sums.emplace_back();
+      const std::string h = npyHeader(q.dtype, quantityShape(q, d.m, d.n));
+      writeAll(fd, h.data(), h.size(), file);
+    }
+    // Input positions (absolute, float64): exports put them beside the per-scale values.
+    const std::string file = (d.tmpPath / "input_positions.npy").string();
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) throw FileError(file, "", std::string("cannot create: ") + std::strerror(errno));
+    const std::string h = npyHeader("<f8", {d.n, 3});
+    writeAll(fd, h.data(), h.size(), file);
+    std::vector<double> xyz(3 * d.n);
+    for (std::size_t i = 0; i < d.n; ++i) {
+      const Vec3 p = cloud.absolutePosition(i);
+      xyz[3 * i] = p.x(), xyz[3 * i + 1] = p.y(), xyz[3 * i + 2] = p.z();
+    }
+    writeAll(fd, xyz.data(), xyz.size() * 8, file);
+    Checksum c;
+    c.add(reinterpret_cast<const unsigned char*>(xyz.data()), xyz.size() * 8);
+    d.positionsSum = c.value();
+    ::fsync(fd);
+    ::close(fd);
+  } catch (...) {
+    d.closeAll();
+    fs::remove_all(d.tmpPath, ec);
+    throw;
+  }
+}
+
+ScaleStackWriter::~ScaleStackWriter() {
+  if (!impl_) return;
+  impl_->closeAll();
+  if (!impl_->finished) {
+    std::error_code ec;
+    fs::remove_all(impl_->tmpPath, ec);
+  }
+}
+
+void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer) {
+  Impl& d = *impl_;
+  if (j != d.written || j >= d.m)
+    throw Error("ScaleStackWriter: scale " + std::to_string(j) +
+                " written out of order (expected " + std::to_string(d.written) + " of " +
+                std::to_string(d.m) + ")");
+  if (layer.size() != d.n)
+    throw Error("ScaleStackWriter: layer has " + std::to_string(layer.size()) +
+                " points, expected " + std::to_string(d.n));
+  std::size_t k = 0;
+  for (const Quantity& q : kQuantities) {
+    const std::size_t bytes = d.n * std::size_t(q.components) * q.itemSize;
+    const unsigned char* p = layerBytes(q, layer);
+    writeAll(d.fds[k], p, bytes, (d.tmpPath / q.name).string() + ".npy");
+    d.sums[k].add(p, bytes);
+    ++k;
+  }
+  ++d.written;
+}
+
+void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
+  Impl& d = *impl_;
+  if (d.written != d.m)
+    throw Error("ScaleStackWriter: " + std::to_string(d.written) + " of " + std::to_string(d.m) +
+                " scales written before finish()");
+  for (int fd : d.fds) ::fsync(fd);
+  d.closeAll();
+  nlohmann::json manifest;
+  manifest["format"] = "scalespace-stack";
+  manifest["format_version"] = kStackFormatVersion;
+  manifest["program"] = "scalespace";
+  manifest["program_version"] = SCALESPACE_VERSION;
+  manifest["point_count"] = d.n;
+  manifest["scale_count"] = d.m;
+  manifest["scales"] = summary.series.scales;
+  manifest["t_min"] = summary.series.tMin;
+  manifest["t_max"] = summary.series.tMax;
+  manifest["origin"] = {d.origin.x(), d.origin.y(), d.origin.z()};
+  manifest["input_checksum"] = hex64(summary.inputChecksum);
+  manifest["checksum_algorithm"] = "fnv1a64-words";
+  manifest["quantisation"] = "none";
+  manifest["parameters"] = d.parameters;
+  nlohmann::json stats = nlohmann::json::array();
+  for (const ScaleStats& s : summary.stats) stats.push_back(statsJson(s));
+  manifest["stats"] = stats;
+  manifest["total_seconds"] = summary.totalSeconds;
+  nlohmann::json quantities = nlohmann::json::object();
+  std::size_t k = 0;
+  for (const Quantity& q : kQuantities) {
+    quantities[q.name] = {
+        {"file", std::string(q.name) + ".npy"}, {"dtype", q.dtype},
+        {"shape", quantityShape(q, d.m, d.n)},  {"scale_factor", 1.0},
+        {"description", q.description},         {"checksum", hex64(d.sums[k++].value())}};
+  }
+  manifest["quantities"] = quantities;
+  manifest["input_positions"] = {{"file", "input_positions.npy"},
+                                 {"dtype", "<f8"},
+                                 {"shape", {d.n, 3}},
+                                 {"checksum", hex64(d.positionsSum)}};
+  // The manifest is written last: a directory without it is never a valid stack.
+  const std::string manifestPath = (d.tmpPath / kManifest).string();
+  {
+    const std::string text = manifest.dump(1) + "\n";
+    const int fd = ::open(manifestPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0)
+      throw FileError(manifestPath, "", std::string("cannot create: ") + std::strerror(errno));
+    writeAll(fd, text.data(), text.size(), manifestPath);
+    ::fsync(fd);
+    ::close(fd);
+  }
+  syncPath(d.tmpPath.string());
+  // Replace an older stack only now that the new one is complete.
+  std::error_code ec;
+  fs::path old;
+  if (fs::exists(d.finalPath, ec)) {
+    old = d.finalPath.string() + ".old-" + std::to_string(::getpid());
+    fs::remove_all(old, ec);
+    fs::rename(d.finalPath, old, ec);
+    if (ec)
+      throw FileError(d.finalPath.string(), "",
+                      "cannot replace the existing stack: " + ec.message(),
+                      "remove it or choose another -o");
+  }
+  fs::rename(d.tmpPath, d.finalPath, ec);
+  if (ec)
+    throw FileError(d.finalPath.string(), "",
+                    "cannot move the finished stack into place: " + ec.message(),
+                    "check permissions of the parent directory");
+  d.finished = true;
+  if (!old.empty()) fs::remove_all(old, ec);
+  const fs::path parent = d.finalPath.parent_path();
+  syncPath(parent.empty() ? "." : parent.string());
+}
+
+ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                    const std::string& path, const ProgressCallback& progress) {
+  std::unique_ptr<ScaleStackWriter> writer;
+  ScaleSpaceSummary summary = runScaleSpace(
+      cloud, options,
+      [&](std::size_t j, const ScaleLayer& layer, const ScaleStats&) {
+        // The series is known only once runScaleSpace resolved t_min; M is the option count.
+        if (!writer)
+          writer = std::make_unique<ScaleStackWriter>(path, cloud, options,
+                                                      std::size_t(options.series.count));
+        writer->writeScale(j, layer);
+      },
+      progress);
+  if (!writer) throw Error("computeScaleStack: no scale was computed");
+  writer->finish(summary);
+  return summary;
+}
+
+void writeScaleStack(const std::string& path, const PointCloud& cloud,
+                     const ScaleSpaceOptions& options, const ScaleStack& stack) {
+  ScaleStackWriter writer(path, cloud, options, stack.layers.size());
+  for (std::size_t j = 0; j < stack.layers.size(); ++j) writer.writeScale(j, stack.layers[j]);
+  writer.finish(stack.summary);
+}
+
+// ---------------------------------------------------------------------------------------- reader
+
+struct ScaleStackReader::Impl {
+  fs::path dir;
+  StackInfo info;
+  std::vector<int> fds;  // one per kQuantities entry
+  std::vector<std::uint64_t> dataOffset;
+  std::vector<std::string> files;
+  std::vector<std::string> sums;
+  int positionsFd = -1;
+  std::uint64_t positionsOffset = 0;
+  std::string positionsFile, positionsSum;
+
+  ~Impl() {
+    for (int fd : fds)
+      if (fd >= 0) ::close(fd);
+    if (positionsFd >= 0) ::close(positionsFd);
+  }
+
+  // Opens an .npy file and checks magic, dtype, order, shape and size; returns the data offset.
+  std::uint64_t openNpy(const std::string& file, const std::string& dtype,
+                        const std::vector<std::size_t>& shape, std::size_t itemSize, int& fdOut) {
+    const std::string fix =
+        "the stack is damaged or was modified: recompute it with 'scalespace scales'";
+    const int fd = ::open(file.c_str(), O_RDONLY);
+    if (fd < 0) throw FileError(file, "", std::string("cannot open: ") + std::strerror(errno), fix);
+    fdOut = fd;
+    unsigned char pre[10];
+    struct stat st {};
+    ::fstat(fd, &st);
+    if (st.st_size < 10) throw FileError(file, "byte 0", "not a NumPy .npy file (too short)", fix);
+    preadAll(fd, pre, 10, 0, file);
+    if (std::memcmp(pre, "\x93NUMPY", 6) != 0 || pre[6] != 1)
+      throw FileError(file, "byte 0", "not a NumPy format 1.0 .npy file", fix);
+    const std::size_t headerLen = std::size_t(pre[8]) | (std::size_t(pre[9]) << 8);
+    if (std::uint64_t(st.st_size) < 10 + headerLen)
+      throw FileError(file, "byte 10", "truncated .npy header", fix);
+    std::string header(headerLen, '\0');
+    preadAll(fd, header.data(), headerLen, 10, file);
+    std::vector<std::size_t> wantShape = shape;
+    const std::string want = npyHeader(dtype, wantShape).substr(10);
+    if (header != want)
+      throw FileError(file, "byte 10",
+                      "header '" + header.substr(0, header.find('}') + 1) +
+                          "' differs from the manifest (expected dtype " + dtype + ", shape " +
+                          shapeText(shape) + ")",
+                      fix);
+    std::uint64_t count = itemSize;
+    for (std::size_t s : shape) count *= s;
+    const std::uint64_t expected = 10 + headerLen + count;
+    if (std::uint64_t(st.st_size) != expected)
+      throw FileError(file, "",
+                      "size is " + std::to_string(st.st_size) + " bytes, expected " +
+                          std::to_string(expected) + " from the manifest's shape",
+                      fix);
+    return 10 + headerLen;
+  }
+};
+
+ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  d.dir = path;
+  const std::string manifestPath = (d.dir / kManifest).string();
+  std::error_code ec;
+  if (!fs::is_directory(d.dir, ec))
+    throw FileError(path, "", "not a scale stack directory",
+                    "give the NAME.stack directory written by 'scalespace scales'");
+  if (!fs::exists(manifestPath, ec))
+    throw FileError(path, "", "no manifest.json: an incomplete stack (its writer was interrupted)",
+                    "recompute it with 'scalespace scales'");
+  nlohmann::json manifest;
+  try {
+    std::ifstream in(manifestPath);
+    manifest = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw FileError(manifestPath, "", std::string("invalid JSON: ") + e.what(),
+                    "recompute the stack with 'scalespace scales'");
+  }
+  const std::string fix = "recompute the stack with 'scalespace scales'";
+  try {
+    if (manifest.at("format").get<std::string>() != "scalespace-stack")
+      throw FileError(manifestPath, "", "not a scalespace stack manifest", fix);
+    StackInfo& info = d.info;
+    info.formatVersion = manifest.at("format_version").get<int>();
+    if (info.formatVersion != kStackFormatVersion)
+      throw FileError(manifestPath, "",
+                      "format version " + std::to_string(info.formatVersion) +
+                          " is not supported (this program reads version " +
+                          std::to_string(kStackFormatVersion) + ")",
+                      "recompute the stack with this version of scalespace");
+    info.programVersion = manifest.at("program_version").get<std::string>();
+    info.pointCount = manifest.at("point_count").get<std::size_t>();
+    info.scales = manifest.at("scales").get<std::vector<double>>();
+    if (manifest.at("scale_count").get<std::size_t>() != info.scales.size())
+      throw FileError(manifestPath, "", "scale_count differs from the number of scale values", fix);
+    const auto origin = manifest.at("origin").get<std::vector<double>>();
+    if (origin.size() != 3)
+      throw FileError(manifestPath, "", "origin must have 3 coordinates", fix);
+    info.origin = Vec3(origin[0], origin[1], origin[2]);
+    info.inputChecksum = std::stoull(manifest.at("input_checksum").get<std::string>(), nullptr, 16);
+    for (const auto& s : manifest.at("stats")) {
+      ScaleStats st;
+      st.t = s.at("t").get<double>();
+      st.samples = s.at("samples").get<std::size_t>();
+      st.meanNeighbors = s.at("mean_neighbors").get<double>();
+      st.validPoints = s.at("valid_points").get<std::size_t>();
+      st.samplingSeconds = s.at("sampling_seconds").get<double>();
+      st.indexSeconds = s.at("index_seconds").get<double>();
+      st.projectionSeconds = s.at("projection_seconds").get<double>();
+      info.stats.push_back(st);
+    }
+    if (manifest.at("quantisation").get<std::string>() != "none")
+      throw FileError(
+          manifestPath, "",
+          "unknown quantisation '" + manifest.at("quantisation").get<std::string>() + "'", fix);
+    info.parametersJson = manifest.at("parameters").dump();
+    info.manifestJson = manifest.dump(1);
+    const std::size_t m = info.scales.size(), n = info.pointCount;
+    for (const Quantity& q : kQuantities) {
+      const auto& entry = manifest.at("quantities").at(q.name);
+      if (entry.at("dtype").get<std::string>() != q.dtype ||
+          entry.at("shape").get<std::vector<std::size_t>>() != quantityShape(q, m, n))
+        throw FileError(manifestPath, "",
+                        std::string("quantity '") + q.name + "' has an unexpected dtype or shape",
+                        fix);
+      const std::string file = (d.dir / entry.at("file").get<std::string>()).string();
+      d.fds.push_back(-1);
+      d.dataOffset.push_back(
+          d.openNpy(file, q.dtype, quantityShape(q, m, n), q.itemSize, d.fds.back()));
+      d.files.push_back(file);
+      d.sums.push_back(entry.at("checksum").get<std::string>());
+    }
+    const auto& pos = manifest.at("input_positions");
+    d.positionsFile = (d.dir / pos.at("file").get<std::string>()).string();
+    d.positionsSum = pos.at("checksum").get<std::string>();
+    d.positionsOffset = d.openNpy(d.positionsFile, "<f8", {n, 3}, 8, d.positionsFd);
+  } catch (const nlohmann::json::exception& e) {
+    throw FileError(manifestPath, "", std::string("missing or malformed entry: ") + e.what(), fix);
+  } catch (const std::invalid_argument&) {
+    throw FileError(manifestPath, "", "input_checksum is not hexadecimal", fix);
+  } catch (const std::out_of_range&) {
+    throw FileError(manifestPath, "", "input_checksum is out of range", fix);
+  }
+}
+
+ScaleStackReader::~ScaleStackReader() = default;
+
+const StackInfo& ScaleStackReader::info() const { return impl_->info; }
+
+ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
+  const Impl& d = *impl_;
+  if (j >= scaleCount())
+    throw OptionError("--scale " + std::to_string(j) + " is out of range: the stack has " +
+                      std::to_string(scaleCount()) + " scales (0.." +
+                      std::to_string(scaleCount() - 1) + ")");
+  const std::size_t n = pointCount();
+  ScaleLayer layer;
+  layer.resize(n);
+  std::size_t k = 0;
+  for (const Quantity& q : kQuantities) {
+    const std::size_t bytes = n * std::size_t(q.components) * q.itemSize;
+    preadAll(d.fds[k], layerBytes(q, layer), bytes, d.dataOffset[k] + std::uint64_t(j) * bytes,
+             d.files[k]);
+    ++k;
+  }
+  return layer;
+}
+
+ScaleLayer ScaleStackReader::readPointSeries(std::size_t i) const {
+  const Impl& d = *impl_;
+  if (i >= pointCount())
+    throw OptionError("--point " + std::to_string(i) + " is out of range: the stack has " +
+                      std::to_string(pointCount()) + " points");
+  const std::size_t m = scaleCount(), n = pointCount();
+  ScaleLayer series;
+  series.resize(m);
+  std::size_t k = 0;
+  for (const Quantity& q : kQuantities) {
+    const std::size_t item = std::size_t(q.components) * q.itemSize;
+    unsigned char* out = layerBytes(q, series);
+    for (std::size_t j = 0; j < m; ++j)
+      preadAll(d.fds[k], out + j * item, item, d.dataOffset[k] + (std::uint64_t(j) * n + i) * item,
+               d.files[k]);
+    ++k;
+  }
+  return series;
+}
+
+std::vector<Vec3> ScaleStackReader::inputPositions() const {
+  const Impl& d = *impl_;
+  std::vector<double> xyz(3 * pointCount());
+  preadAll(d.positionsFd, xyz.data(), xyz.size() * 8, d.positionsOffset, d.positionsFile);
+  std::vector<Vec3> out(pointCount());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  return out;
+}
+
+void ScaleStackReader::verifyChecksums() const {
+  const Impl& d = *impl_;
+  auto check = [&](int fd, std::uint64_t offset, std::uint64_t bytes, const std::string& file,
+                   const std::string& expected) {
+    Checksum c;
+    std::vector<unsigned char> buf(std::size_t(1) << 22);
+    for (std::uint64_t done = 0; done < bytes;) {
+      const std::size_t chunk = std::size_t(std::min<std::uint64_t>(buf.size(), bytes - done));
+      preadAll(fd, buf.data(), chunk, offset + done, file);
+      c.add(buf.data(), chunk);
+      done += chunk;
+    }
+    if (hex64(c.value()) != expected)
+      throw FileError(
+          file, "", "checksum " + hex64(c.value()) + " differs from the manifest's " + expected,
+          "the file was modified or damaged: recompute the stack with 'scalespace scales'");
+  };
+  const std::uint64_t m = scaleCount(), n = pointCount();
+  std::size_t k = 0;
+  for (const Quantity& q : kQuantities) {
+    check(d.fds[k], d.dataOffset[k], m * n * std::uint64_t(q.components) * q.itemSize, d.files[k],
+          d.sums[k]);
+    ++k;
+  }
+  check(d.positionsFd, d.positionsOffset, n * 24, d.positionsFile, d.positionsSum);
+}
+
+void ScaleStackReader::checkInput(const PointCloud& cloud, const std::string& cloudName) const {
+  const std::uint64_t sum = cloudChecksum(cloud);
+  if (sum != info().inputChecksum)
+    throw FileError(impl_->dir.string(), "",
+                    "was computed from another cloud than " + cloudName + " (input checksum " +
+                        hex64(info().inputChecksum) + ", this cloud " + hex64(sum) + ")",
+                    "recompute the stack from this cloud");
+}
+
+bool isScaleStack(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec) && fs::exists(fs::path(path) / kManifest, ec);
+}
+
+}  // namespace scalespace

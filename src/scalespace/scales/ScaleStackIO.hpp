@@ -1,0 +1,99 @@
+#pragma once
+// The scale stack on disk (docs/STACK_FORMAT.md): a directory NAME.stack/ holding manifest.json
+// and one NumPy .npy file per quantity, shaped (M, N) or (M, N, 3), so that
+// numpy.load(f, mmap_mode='r')[j] is scale j and [:, i] is point i without our code.
+//
+// Writing is atomic: everything goes to NAME.stack.tmp-<pid>/, each file is fsync'ed, the
+// manifest is written last, and only then is the directory renamed to NAME.stack (an older stack
+// of that name is replaced only once the new one is complete). A directory without a manifest is
+// never accepted by the reader.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/scales/ScaleSpace.hpp"
+
+namespace scalespace {
+
+constexpr int kStackFormatVersion = 1;
+
+/// Streams a stack to disk scale by scale (peak memory: one ScaleLayer).
+class ScaleStackWriter {
+ public:
+  /// Creates NAME.stack.tmp-<pid>/ beside `path`; throws FileError if it cannot.
+  ScaleStackWriter(const std::string& path, const PointCloud& cloud,
+                   const ScaleSpaceOptions& options, std::size_t scaleCount);
+  /// Removes the temporary directory unless finish() succeeded.
+  ~ScaleStackWriter();
+  ScaleStackWriter(const ScaleStackWriter&) = delete;
+  ScaleStackWriter& operator=(const ScaleStackWriter&) = delete;
+
+  /// Appends scale j; scales must come in order 0, 1, ..., scaleCount-1.
+  void writeScale(std::size_t j, const ScaleLayer& layer);
+  /// Writes the manifest (scales, stats, checksums), syncs and renames into place.
+  void finish(const ScaleSpaceSummary& summary);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Computes the scale space of `cloud` and streams it into the stack `path`.
+ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                    const std::string& path, const ProgressCallback& progress = {});
+
+/// Writes an in-memory stack.
+void writeScaleStack(const std::string& path, const PointCloud& cloud,
+                     const ScaleSpaceOptions& options, const ScaleStack& stack);
+
+/// What the manifest says, besides the arrays.
+struct StackInfo {
+  int formatVersion = 0;
+  std::string programVersion;
+  std::size_t pointCount = 0;
+  std::vector<double> scales;
+  std::vector<ScaleStats> stats;
+  std::uint64_t inputChecksum = 0;
+  Vec3 origin = Vec3::Zero();  // projections are stored relative to it
+  std::string parametersJson;  // the options, as JSON text
+  std::string manifestJson;    // the whole manifest, as JSON text
+};
+
+/// Random access to a stack without loading it: reads with pread at computed offsets.
+class ScaleStackReader {
+ public:
+  /// Validates the manifest, every file's header, dtype, shape and size (FileError naming the
+  /// file and the fix on any mismatch; a directory without manifest.json is an incomplete stack).
+  explicit ScaleStackReader(const std::string& path);
+  ~ScaleStackReader();
+  ScaleStackReader(const ScaleStackReader&) = delete;
+  ScaleStackReader& operator=(const ScaleStackReader&) = delete;
+
+  const StackInfo& info() const;
+  std::size_t pointCount() const { return info().pointCount; }
+  std::size_t scaleCount() const { return info().scales.size(); }
+
+  /// Scale j for every point (input order).
+  ScaleLayer readScale(std::size_t j) const;
+  /// Point i at every scale: entry j of each array is scale j.
+  ScaleLayer readPointSeries(std::size_t i) const;
+  /// The input positions (absolute coordinates), in input order.
+  std::vector<Vec3> inputPositions() const;
+
+  /// Re-reads every file and compares its checksum with the manifest (FileError on mismatch).
+  void verifyChecksums() const;
+  /// FileError when `cloud` is not the input the stack was computed from.
+  void checkInput(const PointCloud& cloud, const std::string& cloudName) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// True if `path` is a directory with a manifest.json of a scale stack.
+bool isScaleStack(const std::string& path);
+
+}  // namespace scalespace
