@@ -57,7 +57,7 @@ class ProgressTracker {
     if (!callback_(f, stage_)) cancelled_.store(true);
   }
 
-  const ProgressCallback& callback_;
+  ProgressCallback callback_;  // a copy: callers may pass a temporary (a wrapping lambda)
   std::string stage_;
   std::size_t total_;
   std::chrono::milliseconds interval_;
