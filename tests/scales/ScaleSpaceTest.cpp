@@ -1,0 +1,111 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scales/ScalesTestClouds.hpp"
+#include "scalespace/core/Parallel.hpp"
+#include "scalespace/scales/ScaleSpace.hpp"
+
+namespace scalespace {
+namespace {
+
+ScaleSpaceOptions smallOptions(int scales) {
+  ScaleSpaceOptions o;
+  o.series.count = scales;
+  return o;
+}
+
+TEST(ScaleSpace, SphereProjectionsStayOnTheSphere) {
+  const double r = 1.0;
+  const PointCloud cloud = test::sphereCloud(2000, r);
+  ScaleSpaceOptions o = smallOptions(6);
+  o.series.tMax = 1.0;  // up to the radius: larger supports see the whole sphere (still exact)
+  const ScaleStack stack = computeScaleSpace(cloud, o);
+  ASSERT_EQ(stack.layers.size(), 6u);
+  for (std::size_t j = 0; j < stack.layers.size(); ++j) {
+    const ScaleLayer& L = stack.layers[j];
+    const double t = stack.summary.series.scales[j];
+    std::size_t valid = 0;
+    double worst = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      if (!L.valid[i]) continue;
+      ++valid;
+      const Vec3 p = Vec3(L.projection[3 * i], L.projection[3 * i + 1], L.projection[3 * i + 2]) +
+                     cloud.origin();
+      worst = std::max(worst, std::abs(p.norm() - r) / t);
+      const Vec3 n(L.normal[3 * i], L.normal[3 * i + 1], L.normal[3 * i + 2]);
+      EXPECT_GT(n.dot(p.normalized()), 0.99);
+      EXPECT_NEAR(L.meanCurvature[i], 1.0 / r, 0.05);
+    }
+    EXPECT_EQ(valid, cloud.size()) << "scale " << j;
+    EXPECT_LT(worst, 0.01) << "scale " << j;
+  }
+}
+
+TEST(ScaleSpace, NoisyPlaneGetsFlatterWithScale) {
+  const PointCloud cloud = test::noisyPlane(50, 1.0, 0.01, 3);
+  ScaleSpaceOptions o = smallOptions(5);
+  o.series.tMax = 0.25;  // supports around the interior stay inside the square
+  const ScaleStack stack = computeScaleSpace(cloud, o);
+  double previous = 1e9;
+  for (std::size_t j = 0; j < stack.layers.size(); ++j) {
+    const ScaleLayer& L = stack.layers[j];
+    // RMS height of the projections of the interior points (away from the border effects).
+    double sum = 0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Vec3 p = cloud.absolutePosition(i);
+      if (p.x() < 0.35 || p.x() > 0.65 || p.y() < 0.35 || p.y() > 0.65 || !L.valid[i]) continue;
+      const double z = L.projection[3 * i + 2] + cloud.origin().z();
+      sum += z * z;
+      ++count;
+    }
+    const double rms = std::sqrt(sum / double(count));
+    EXPECT_LT(rms, previous) << "scale " << j;
+    previous = rms;
+    if (j == 0) {
+      EXPECT_LT(rms, 0.01);  // already smoother than the noise
+    }
+  }
+  EXPECT_LT(previous, 0.002);
+}
+
+TEST(ScaleSpace, IdenticalForOneAndTwoThreads) {
+  const PointCloud cloud = test::noisyPlane(40, 1.0, 0.02, 8);
+  ScaleSpaceOptions o = smallOptions(4);
+  o.threads = 1;
+  const ScaleStack a = computeScaleSpace(cloud, o);
+  o.threads = 2;
+  const ScaleStack b = computeScaleSpace(cloud, o);
+  ASSERT_EQ(a.layers.size(), b.layers.size());
+  for (std::size_t j = 0; j < a.layers.size(); ++j) {
+    EXPECT_EQ(a.layers[j].projection, b.layers[j].projection);
+    EXPECT_EQ(a.layers[j].kMax, b.layers[j].kMax);
+    EXPECT_EQ(a.layers[j].neighbors, b.layers[j].neighbors);
+    EXPECT_EQ(a.summary.stats[j].samples, b.summary.stats[j].samples);
+  }
+}
+
+TEST(ScaleSpace, SamplesShrinkAndStatsAreFilled) {
+  const PointCloud cloud = test::sphereCloud(3000, 1.0);
+  const ScaleStack s = computeScaleSpace(cloud, smallOptions(5));
+  ASSERT_EQ(s.summary.stats.size(), 5u);
+  EXPECT_EQ(s.summary.stats[0].t, s.summary.series.scales[0]);
+  for (std::size_t j = 1; j < 5; ++j)
+    EXPECT_LE(s.summary.stats[j].samples, s.summary.stats[j - 1].samples);
+  EXPECT_LT(s.summary.stats.back().samples, cloud.size() / 10);
+  for (const auto& st : s.summary.stats) EXPECT_GE(st.meanNeighbors, 6.0);
+  EXPECT_NE(s.summary.inputChecksum, 0u);
+}
+
+TEST(ScaleSpace, NeedsNormalsAndCanBeCancelled) {
+  PointCloud cloud = test::sphereCloud(500, 1.0);
+  EXPECT_THROW(
+      computeScaleSpace(cloud, smallOptions(3), [](double, std::string_view) { return false; }),
+      Cancelled);
+  cloud.setNormals({});
+  EXPECT_THROW(computeScaleSpace(cloud, smallOptions(3)), OptionError);
+}
+
+}  // namespace
+}  // namespace scalespace
