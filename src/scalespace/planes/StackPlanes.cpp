@@ -1,0 +1,48 @@
+#include "scalespace/planes/StackPlanes.hpp"
+
+#include <chrono>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+ScaleFeatures scaleFeaturesFromLayer(const ScaleLayer& layer, double t) {
+  const std::size_t n = layer.size();
+  if (layer.normal.size() != 3 * n || layer.kMax.size() != n || layer.kMin.size() != n)
+    throw Error("scale layer arrays have inconsistent sizes");
+  ScaleFeatures f;
+  f.t = t;
+  f.normals.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    f.normals[i] = Vec3(layer.normal[3 * i], layer.normal[3 * i + 1], layer.normal[3 * i + 2]);
+  f.kMax = layer.kMax;
+  f.kMin = layer.kMin;
+  f.valid = layer.valid;
+  return f;
+}
+
+StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
+                                        const ScaleSpaceOptions& stackOptions,
+                                        const PlaneDetectionOptions& options,
+                                        const ProgressCallback& progress) {
+  StackPlaneDetection out;
+  const auto& positions = cloud.positions();
+  auto start = std::chrono::steady_clock::now();
+  const KnnGraph knn = buildKnnGraph(positions, 10);  // k = 10 (Sec. 2.3.1)
+  out.knnSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PlaneDetectionTimings timings;
+  std::vector<RegionLevel> levels;
+  const ScaleSink sink = [&](std::size_t, const ScaleLayer& layer, const ScaleStats& stats) {
+    levels.push_back(
+        segmentScale(positions, knn, scaleFeaturesFromLayer(layer, stats.t), options, timings));
+  };
+  start = std::chrono::steady_clock::now();
+  out.stack = runScaleSpace(cloud, stackOptions, sink, progress);
+  out.stackSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
+      timings.segmentation - timings.filtering;
+  out.detection = buildPlaneDetection(positions, std::move(levels), options, timings, progress);
+  return out;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,28 @@
+#pragma once
+// The full pipeline of Fig. 2.4 on a point cloud: the multi-scale stack (scales layer, robust
+// APSS) is computed scale by scale and each scale is segmented as soon as it is available, so
+// the stack never has to be held in memory; then the graph and the components.
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/planes/PlaneDetection.hpp"
+#include "scalespace/scales/ScaleSpace.hpp"
+
+namespace scalespace {
+
+/// The plane pipeline's view of one scale of the stack: normals, principal curvatures, validity.
+ScaleFeatures scaleFeaturesFromLayer(const ScaleLayer& layer, double t);
+
+struct StackPlaneDetection {
+  PlaneDetection detection;
+  ScaleSpaceSummary stack;  // scales, per-scale statistics and time
+  double stackSeconds = 0;  // Table 2.1 "Surf. Recon." (includes the per-scale segmentation
+                            // hand-off, which is timed separately in detection.timings)
+  double knnSeconds = 0;
+};
+
+/// Computes the stack with `stackOptions` (the cloud needs normals) and detects the planes.
+StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
+                                        const ScaleSpaceOptions& stackOptions,
+                                        const PlaneDetectionOptions& options = {},
+                                        const ProgressCallback& progress = {});
+
+}  // namespace scalespace

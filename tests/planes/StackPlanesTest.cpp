@@ -1,0 +1,51 @@
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "scalespace/core/SceneGenerator.hpp"
+#include "scalespace/planes/PlaneQueries.hpp"
+#include "scalespace/planes/StackPlanes.hpp"
+
+using namespace scalespace;
+
+// End to end (Fig. 2.4): the robust APSS stack of a clean box, segmented per scale. Every face
+// must be found as one component (IoU >= 0.8 with the face's points at some level), and the
+// most persistent face components must be the larger faces.
+TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
+  SceneOptions scene;
+  scene.pointCount = 2500;
+  scene.boxSize = Vec3(4, 2, 1);
+  const PointCloud cloud = generateScene(SceneKind::Box, scene);
+  std::vector<int> gt;
+  for (double v : cloud.findAttribute("gt_face")->values) gt.push_back(int(v));
+  ScaleSpaceOptions stack;
+  stack.series.count = 8;
+  const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
+  const PlaneModel model = makePlaneModel(result.detection);
+  ASSERT_EQ(model.scaleCount(), 8);
+
+  std::map<int, std::size_t> faceSize;
+  for (int f : gt) ++faceSize[f];
+  std::map<int, int> bestPersistence;  // per face, the persistence of its matching component
+  for (int level = 0; level < model.scaleCount(); ++level) {
+    std::map<std::pair<int, int>, std::size_t> common;  // (component, face) -> points
+    std::map<int, std::size_t> componentSize;
+    for (std::size_t i = 0; i < gt.size(); ++i) {
+      const int c = model.membership.at(level, i);
+      if (c < 0) continue;
+      ++common[{c, gt[i]}];
+      ++componentSize[c];
+    }
+    for (const auto& [key, k] : common) {
+      const double iou = double(k) / double(componentSize[key.first] + faceSize[key.second] - k);
+      if (iou >= 0.8)
+        bestPersistence[key.second] = std::max(
+            bestPersistence[key.second], model.components[std::size_t(key.first)].persistence);
+    }
+  }
+  EXPECT_EQ(bestPersistence.size(), 6u);
+  // Faces 4, 5 (4 x 2) outlive faces 0, 1 (2 x 1).
+  EXPECT_GE(bestPersistence[4], bestPersistence[0]);
+  EXPECT_GE(bestPersistence[5], bestPersistence[1]);
+  EXPECT_GT(bestPersistence[4] + bestPersistence[5], bestPersistence[0] + bestPersistence[1]);
+}
