@@ -268,7 +268,7 @@ void addSegmentCommand(CLI::App& app) {
 void addPlanesCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
-    std::string output;
+    std::string output, stack;
     int scales = 50;
     double alpha = 0.1, angle = 5.0;
     int threads = 0;
@@ -283,6 +283,9 @@ void addPlanesCommand(CLI::App& app) {
                   "membership.bin)")
       ->required();
   cmd->add_option("--scales", args->scales, "number of log-spaced scales M")->capture_default_str();
+  cmd->add_option("--stack", args->stack,
+                  "use this stack (`scalespace scales IN -o STACK`) instead of computing one")
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--alpha", args->alpha, "Poisson-disk sub-sampling factor of the stack")
       ->capture_default_str();
   cmd->add_option("--angle", args->angle, "region growing angle theta (degrees)")
@@ -295,7 +298,7 @@ void addPlanesCommand(CLI::App& app) {
     ThreadScope threads(args->threads);
     if (args->scales < 2) throw OptionError("--scales must be >= 2 (persistence needs levels)");
     const PointCloud cloud = loadCloud(args->input, args->quiet);
-    if (!cloud.hasNormals())
+    if (args->stack.empty() && !cloud.hasNormals())
       throw OptionError(args->input.path +
                         " has no normals: the stack needs oriented normals (run `scalespace "
                         "normals` first)");
@@ -305,8 +308,14 @@ void addPlanesCommand(CLI::App& app) {
     stack.threads = args->threads;
     PlaneDetectionOptions options;
     options.growing.maxAngleDegrees = args->angle;
-    const StackPlaneDetection result =
-        detectPlanesInCloud(cloud, stack, options, makeProgressBar(args->quiet));
+    StackPlaneDetection result;
+    if (args->stack.empty()) {
+      result = detectPlanesInCloud(cloud, stack, options, makeProgressBar(args->quiet));
+    } else {
+      const ScaleStackReader reader(args->stack);
+      result.detection =
+          detectPlanesFromStack(cloud, reader, options, makeProgressBar(args->quiet));
+    }
     const PlaneModel model = makePlaneModel(result.detection);
     writePlaneModel(model, cloud.origin(), args->input.path, args->output);
     if (!args->quiet) {

@@ -45,4 +45,22 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   return out;
 }
 
+PlaneDetection detectPlanesFromStack(const PointCloud& cloud, const ScaleStackReader& stack,
+                                     const PlaneDetectionOptions& options,
+                                     const ProgressCallback& progress) {
+  stack.checkInput(cloud, "the input cloud");
+  const auto& positions = cloud.positions();
+  const KnnGraph knn = buildKnnGraph(positions, 10);
+  PlaneDetectionTimings timings;
+  std::vector<RegionLevel> levels;
+  const std::size_t m = stack.scaleCount();
+  for (std::size_t j = 0; j < m; ++j) {
+    if (progress && !progress(double(j) / double(m), "planar segmentations")) throw Cancelled();
+    levels.push_back(segmentScale(
+        positions, knn, scaleFeaturesFromLayer(stack.readScale(j), stack.info().scales[j]), options,
+        timings));
+  }
+  return buildPlaneDetection(positions, std::move(levels), options, timings, progress);
+}
+
 }  // namespace scalespace

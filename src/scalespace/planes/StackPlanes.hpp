@@ -5,6 +5,7 @@
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/planes/PlaneDetection.hpp"
 #include "scalespace/scales/ScaleSpace.hpp"
+#include "scalespace/scales/ScaleStackIO.hpp"
 
 namespace scalespace {
 
@@ -24,5 +25,11 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
                                         const ScaleSpaceOptions& stackOptions,
                                         const PlaneDetectionOptions& options = {},
                                         const ProgressCallback& progress = {});
+
+/// Same pipeline on a stack already on disk (`scalespace scales`), read one scale at a time.
+/// Throws FileError when the stack was not computed from `cloud` (checksum).
+PlaneDetection detectPlanesFromStack(const PointCloud& cloud, const ScaleStackReader& stack,
+                                     const PlaneDetectionOptions& options = {},
+                                     const ProgressCallback& progress = {});
 
 }  // namespace scalespace
