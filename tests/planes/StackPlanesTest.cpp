@@ -42,7 +42,7 @@ std::map<int, int> facePersistence(const PlaneModel& model, const std::vector<in
 // most persistent face components must be the larger faces.
 TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
   SceneOptions scene;
-  scene.pointCount = 2500;
+  scene.pointCount = 1500;
   scene.boxSize = Vec3(4, 2, 1);
   const PointCloud cloud = generateScene(SceneKind::Box, scene);
   std::vector<int> gt;
