@@ -35,6 +35,9 @@ struct FitOptions {
   int mlsMaxSteps = 20;
   double mlsTolerance = 1e-3;
   /// Robust re-weighting (RIMLS, Oztireli 2009): per fit, `robustIterations` re-weightings.
+  /// Applies to the APSS estimators (W1, W2, W3) only; the baselines ignore it. Weights are
+  /// w_t(q_i) exp(-(r_i / 0.2 t)^2) exp(-(|n_i - grad f/|grad f|| / 0.5)^2), r_i = f(p_i)/|grad f|
+  /// (fit/LocalFit.cpp); the re-weighting factors are constants when differentiating (W2, W3).
   bool robust = false;
   int robustIterations = 5;
   /// Fits with fewer neighbours are invalid (NOTES.md: < 6).
@@ -43,6 +46,13 @@ struct FitOptions {
 
 /// Everything one fit tells about the surface near the evaluation point. When valid is false the
 /// numeric fields are zero (never NaN) and only `neighbors` is meaningful.
+/// Where the quantities are evaluated: W2 and W3 at the (final) evaluation point with the complete
+/// gradient (Eq. 1.33) as normal; W1 at the projection with the plain gradient (Eq. 1.29) as
+/// normal and H = 2 u_q / sqrt(Delta) (Eq. 1.32). W1, Plane and Mean have no principal
+/// curvatures: they report kMax = kMin = H and an arbitrary orthonormal tangent pair as directions.
+/// With MLS the evaluation point is the last projected point (Eq. 1.12).
+/// The GLS fields (tau, kappa, fitness, anisotropy, geometricVariation) are filled by the APSS
+/// estimators only (zero for the baselines).
 struct LocalFit {
   bool valid = false;
   int neighbors = 0;               // samples with non-zero weight in the last fit
@@ -53,9 +63,13 @@ struct LocalFit {
   Vec3 dirMax = Vec3::Zero(), dirMin = Vec3::Zero();  // unit, orthogonal, tangent
   // GLS parameters (Mellado 2012): u_c, u_l, u_q divided by sqrt(Delta) (Sec. 1.3.2).
   double tau = 0, kappa = 0;
-  double fitness = 0;             // Delta of Eq. 1.11 (Pratt norm)
-  double anisotropy = 0;          // 1 - |u_l| (Theorem 1, Eq. 1.20)
-  double geometricVariation = 0;  // nu from scale derivatives of the GLS parameters
+  double fitness = 0;  // Delta of Eq. 1.11 (Pratt norm)
+  /// 1 - |u_l| (Theorem 1, Eq. 1.20). With the kernel of Eq. 1.6 (not constant weights) it
+  /// behaves like (H^2 - K) t^2 / 8 (measured and tested; Theorem 1 has / 4 for constant weights).
+  double anisotropy = 0;
+  /// nu = (dtau/dt)^2 + t^2 |deta/dt|^2 + t^4 (dkappa/dt)^2: Mellado 2012's geometric variation
+  /// made dimensionless; zero where the fitted sphere does not change with t (spheres, planes).
+  double geometricVariation = 0;
   int mlsSteps = 0;
 };
 
