@@ -1,5 +1,7 @@
 #include "scalespace/scales/PoissonDiskSampler.hpp"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -54,7 +56,8 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
     c[k] = {packCell(std::int64_t(g.x()) + 1, std::int64_t(g.y()) + 1, std::int64_t(g.z()) + 1),
             sampleOrderKey(seed, i), i};
   });
-  std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
+  // (cell, order, point) is a total order, so the parallel sort is deterministic.
+  tbb::parallel_sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
     return a.cell != b.cell     ? a.cell < b.cell
            : a.order != b.order ? a.order < b.order
                                 : a.point < b.point;
@@ -79,7 +82,12 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
     if (it == cellBegin.end() - 1 || c[*it].cell != key) return -1;
     return it - cellBegin.begin();
   };
-  std::vector<std::uint8_t> accepted(c.size(), 0);
+  // Accepted samples of cell q are kept compactly in accepted[cellBegin[q] .. + acceptedCount[q]):
+  // a cell of size >= r holds a bounded number of samples, so checking a candidate costs O(1)
+  // however many candidates the neighbouring cells hold. A cell is written only by its own task,
+  // and cells of the same colour are never neighbours, so there is no race.
+  std::vector<Index> accepted(c.size());
+  std::vector<std::uint32_t> acceptedCount(cellCount, 0);
   for (const auto& cells : byColour) {
     parallelFor(
         cells.size(),
@@ -89,35 +97,37 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
           const std::int64_t x = std::int64_t((key >> (2 * kCellBits)) & mask),
                              y = std::int64_t((key >> kCellBits) & mask),
                              z = std::int64_t(key & mask);
-          std::ptrdiff_t near[27];
+          std::size_t near[27];
           int nearCount = 0;
           for (int dx = -1; dx <= 1; ++dx)
             for (int dy = -1; dy <= 1; ++dy)
               for (int dz = -1; dz <= 1; ++dz) {
                 const std::ptrdiff_t f = findCell(packCell(x + dx, y + dy, z + dz));
-                if (f >= 0) near[nearCount++] = f;
+                if (f >= 0) near[nearCount++] = std::size_t(f);
               }
           for (std::size_t k = cellBegin[q]; k < cellBegin[q + 1]; ++k) {
-            const Vec3& p = positions[c[k].point];
+            const Index candidate = c[k].point;
+            const Vec3& p = positions[candidate];
             bool free = true;
-            for (int n = 0; n < nearCount && free; ++n)
-              for (std::size_t m = cellBegin[std::size_t(near[n])];
-                   m < cellBegin[std::size_t(near[n]) + 1]; ++m) {
-                if (!accepted[m]) continue;
-                const double r = radiusOf(c[k].point, c[m].point);
-                if ((positions[c[m].point] - p).squaredNorm() < r * r) {
+            for (int nb = 0; nb < nearCount && free; ++nb) {
+              const std::size_t f = near[nb];
+              for (std::size_t a = cellBegin[f]; a < cellBegin[f] + acceptedCount[f]; ++a) {
+                const double r = radiusOf(candidate, accepted[a]);
+                if ((positions[accepted[a]] - p).squaredNorm() < r * r) {
                   free = false;
                   break;
                 }
               }
-            accepted[k] = free;
+            }
+            if (free) accepted[cellBegin[q] + acceptedCount[q]++] = candidate;
           }
         },
         16);
   }
   std::vector<Index> out;
-  for (std::size_t k = 0; k < c.size(); ++k)
-    if (accepted[k]) out.push_back(c[k].point);
+  for (std::size_t q = 0; q < cellCount; ++q)
+    out.insert(out.end(), accepted.begin() + std::ptrdiff_t(cellBegin[q]),
+               accepted.begin() + std::ptrdiff_t(cellBegin[q] + acceptedCount[q]));
   std::sort(out.begin(), out.end());
   return out;
 }
