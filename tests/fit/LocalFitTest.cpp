@@ -299,3 +299,17 @@ TEST(LocalFit, GlsParametersOnASphere) {
   EXPECT_GT(g.geometricVariation, 1e-6);  // anisotropic: the fitted sphere changes with t
   EXPECT_GT(g.anisotropy, 1e-4);
 }
+
+TEST(LocalFit, PlaneAndMeanMlsMeasureHFromTheTotalDisplacement) {
+  // The converged point lies on its own plane; H comes from the displacement of x instead, so it
+  // stays positive on a sphere with outward normals (and negative with inward ones).
+  auto c = sampleCloud(SurfaceShape::Sphere, Vec3::Zero(), 0.5, 4000, 4);
+  for (EstimatorKind k : {EstimatorKind::Plane, EstimatorKind::Mean}) {
+    const LocalFit single = fitWith(*c, Vec3::Zero(), 0.3, k, false);
+    const LocalFit mls = fitWith(*c, Vec3::Zero(), 0.3, k, true);
+    ASSERT_TRUE(single.valid && mls.valid);
+    EXPECT_NEAR(single.meanCurvature, 1, 0.1) << estimatorName(k);
+    EXPECT_GT(mls.meanCurvature, single.meanCurvature) << estimatorName(k);
+    EXPECT_LT(mls.meanCurvature, 3) << estimatorName(k);
+  }
+}

@@ -198,6 +198,14 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
     if (move < options.mlsTolerance * t) break;
     y = fit.projection;
   }
+  if (options.mls && fit.mlsSteps > 1 &&
+      (options.estimator == EstimatorKind::Plane || options.estimator == EstimatorKind::Mean)) {
+    // At the converged point x lies on its own plane (d = 0), so H = 8 d / t^2 would vanish.
+    // With MLS, d is the signed displacement from the original x to the converged point along
+    // the final normal (our reading of "Plane (MLS)" / "Mean (MLS)" in Table 1.1).
+    const double d = (x - fit.projection).dot(fit.normal);
+    fit.meanCurvature = fit.kMax = fit.kMin = 8 * d / (t * t);
+  }
   return fit;
 }
 
