@@ -183,7 +183,7 @@ void timingBench(const PointCloud& cloud, const ScaleSpaceOptions& options, cons
 
   // One single-scale W3 pass over the same cloud (all points as samples, robust, same MLS steps)
   // at a middle scale, to express the stack's cost in "passes".
-  const double t = s.series.scales[s.series.scales.size() / 2 > 0 ? 1 : 0];
+  const double t = s.series.scales[s.series.scales.size() / 2];
   auto idx = makeSpatialIndex(cloud.positions());
   const SurfaceSamples samplesRef{cloud.positions(), cloud.normals(), *idx};
   FitOptions fit;

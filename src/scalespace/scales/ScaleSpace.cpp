@@ -127,13 +127,14 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     t0 = std::chrono::steady_clock::now();
     const SurfaceSamples samples{samplePositions, sampleNormals, *index};
     const double t = scales[j];
-    ProgressTracker tracker(progress ? ProgressCallback([&](double f, std::string_view) {
-                              return progress(
-                                  (double(j) + f) / double(m),
-                                  "scale " + std::to_string(j + 1) + "/" + std::to_string(m));
-                            })
-                                     : ProgressCallback(),
-                            "projection", n);
+    // ProgressTracker keeps a reference to its callback: it must outlive the tracker.
+    const ProgressCallback scaleProgress =
+        progress ? ProgressCallback([&](double f, std::string_view) {
+          return progress((double(j) + f) / double(m),
+                          "scale " + std::to_string(j + 1) + "/" + std::to_string(m));
+        })
+                 : ProgressCallback();
+    ProgressTracker tracker(scaleProgress, "projection", n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         FitWorkspace& ws = workspaces.local();

@@ -493,6 +493,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     info.programVersion = manifest.at("program_version").get<std::string>();
     info.pointCount = manifest.at("point_count").get<std::size_t>();
     info.scales = manifest.at("scales").get<std::vector<double>>();
+    if (info.scales.empty()) throw FileError(manifestPath, "", "the stack has no scales", fix);
     if (manifest.at("scale_count").get<std::size_t>() != info.scales.size())
       throw FileError(manifestPath, "", "scale_count differs from the number of scale values", fix);
     const auto origin = manifest.at("origin").get<std::vector<double>>();
@@ -511,6 +512,11 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
       st.projectionSeconds = s.at("projection_seconds").get<double>();
       info.stats.push_back(st);
     }
+    if (info.stats.size() != info.scales.size())
+      throw FileError(manifestPath, "",
+                      "stats has " + std::to_string(info.stats.size()) + " entries for " +
+                          std::to_string(info.scales.size()) + " scales",
+                      fix);
     if (manifest.at("quantisation").get<std::string>() != "none")
       throw FileError(
           manifestPath, "",
