@@ -25,9 +25,9 @@ case "$mode" in
   demo)
     configure_and_build build -DCMAKE_BUILD_TYPE=Release -DSCALESPACE_TESTS=OFF -DSCALESPACE_BENCH=OFF
     mkdir -p out
-    ./build/scalespace generate torus -n 200000 --noise 0.002 --seed 1 -o out/sample_torus.ply
+    ./build/scalespace generate torus -n 200000 --noise 0.0001 --seed 1 -o out/sample_torus.ply
     ./build/scalespace info out/sample_torus.ply
-    ./build/scalespace curvature out/sample_torus.ply -o out/sample_torus_curvature.ply --scale-k 40
+    ./build/scalespace curvature out/sample_torus.ply -o out/sample_torus_curvature.ply --scale-k 80
     echo "demo: result written to $(pwd)/out/sample_torus_curvature.ply (summary: out/sample_torus_curvature.json)"
     ;;
   test)

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "IoTestSupport.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/CloudIO.hpp"
@@ -121,11 +123,19 @@ TEST(Xyz, NormalNamesAsAttributes) {
   std::ostringstream out;
   writeXyz(cloud, out);
   EXPECT_EQ(readXyz(out.str(), "p.xyz").findAttribute("nx")->values[0], 0.5);
-  // ... but three normal-named attributes would come back as normals: refused.
-  cloud.addAttribute("NY", ScalarType::Float32);
-  cloud.addAttribute("normal_z", ScalarType::Float32);
+  // ... and three normal-named columns of a cloud without normals are written as they are and
+  // read back as its normals (how the curvature output places the fitted normal last).
+  cloud.addAttribute("ny", ScalarType::Float32).values[0] = 0.0;
+  cloud.addAttribute("nz", ScalarType::Float32).values[0] = std::sqrt(0.75);
   std::ostringstream out2;
-  EXPECT_THROW(writeXyz(cloud, out2), Error);
+  writeXyz(cloud, out2);
+  const PointCloud back = readXyz(out2.str(), "p.xyz");
+  ASSERT_TRUE(back.hasNormals());
+  EXPECT_NEAR(back.normals()[0].x(), 0.5, 1e-12);
+  // A cloud that has normals cannot also carry normal-named columns.
+  cloud.setNormals({Vec3::UnitZ()});
+  std::ostringstream out3;
+  EXPECT_THROW(writeXyz(cloud, out3), Error);
 }
 
 }  // namespace

@@ -86,34 +86,6 @@ void addRenderCommand(CLI::App& app) {
   });
 }
 
-void addGenerateCommand(CLI::App& app) {
-  struct Args {
-    std::string scene, output;
-    GenerateOptions options;
-    bool quiet = false;
-  };
-  auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "generate", "sample a synthetic piecewise-planar scene (Table 2.1) with face labels gt_face");
-  cmd->add_option("scene", args->scene, "tri | stairs | cubes | box")->required();
-  cmd->add_option("-n,--points", args->options.pointCount, "number of points")
-      ->capture_default_str();
-  cmd->add_option("--noise", args->options.noise,
-                  "Gaussian noise sigma as a fraction of the bounding-box diagonal (e.g. 1e-4)")
-      ->capture_default_str();
-  cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
-  cmd->add_option("-o,--output", args->output, "output cloud (.ply .xyz .las .pcd)")->required();
-  cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
-  cmd->callback([args] {
-    const auto start = std::chrono::steady_clock::now();
-    PointCloud cloud;
-    if (!generateScene(args->scene, args->options, cloud))
-      throw OptionError("unknown scene '" + args->scene + "' (use tri, stairs, cubes or box)");
-    writeCloud(cloud, args->output);
-    reportDone("generate", start, args->quiet);
-  });
-}
-
 // Point indices from a text file: integers separated by spaces/newlines, '#' starts a comment.
 std::vector<Index> readIndexFile(const std::string& path) {
   std::ifstream in(path);
@@ -330,15 +302,10 @@ void addPlanesCommand(CLI::App& app) {
   });
 }
 
-bool hasSubcommand(CLI::App& app, const std::string& name) {
-  return !app.get_subcommands([&](CLI::App* sub) { return sub->get_name() == name; }).empty();
-}
-
 }  // namespace
 
 void addPlanesCommands(CLI::App& app) {
   addRenderCommand(app);
-  if (!hasSubcommand(app, "generate")) addGenerateCommand(app);
   addPlanesCommand(app);
   addSegmentCommand(app);
 }

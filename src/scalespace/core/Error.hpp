@@ -1,6 +1,7 @@
 #pragma once
 // Error policy of the library (docs/ERRORS.md):
-//  - The library never prints and never returns NaN silently. Failures throw one of the types below.
+//  - The library never prints and never returns NaN silently. Failures throw one of the types
+//  below.
 //  - FileError names the file, the place in it (line or byte offset) and what was expected, and
 //    a fix when one is known; the CLI prints what() on one line and exits non-zero.
 //  - OptionError is thrown for invalid parameters (names the option and the accepted range).

@@ -9,14 +9,22 @@ namespace scalespace {
 
 const char* scalarTypeName(ScalarType type) {
   switch (type) {
-    case ScalarType::Int8: return "int8";
-    case ScalarType::UInt8: return "uint8";
-    case ScalarType::Int16: return "int16";
-    case ScalarType::UInt16: return "uint16";
-    case ScalarType::Int32: return "int32";
-    case ScalarType::UInt32: return "uint32";
-    case ScalarType::Float32: return "float32";
-    case ScalarType::Float64: return "float64";
+    case ScalarType::Int8:
+      return "int8";
+    case ScalarType::UInt8:
+      return "uint8";
+    case ScalarType::Int16:
+      return "int16";
+    case ScalarType::UInt16:
+      return "uint16";
+    case ScalarType::Int32:
+      return "int32";
+    case ScalarType::UInt32:
+      return "uint32";
+    case ScalarType::Float32:
+      return "float32";
+    case ScalarType::Float64:
+      return "float64";
   }
   return "unknown";
 }
@@ -24,13 +32,17 @@ const char* scalarTypeName(ScalarType type) {
 std::size_t scalarTypeSize(ScalarType type) {
   switch (type) {
     case ScalarType::Int8:
-    case ScalarType::UInt8: return 1;
+    case ScalarType::UInt8:
+      return 1;
     case ScalarType::Int16:
-    case ScalarType::UInt16: return 2;
+    case ScalarType::UInt16:
+      return 2;
     case ScalarType::Int32:
     case ScalarType::UInt32:
-    case ScalarType::Float32: return 4;
-    case ScalarType::Float64: return 8;
+    case ScalarType::Float32:
+      return 4;
+    case ScalarType::Float64:
+      return 8;
   }
   return 0;
 }

@@ -32,7 +32,8 @@ class ProgressTracker {
     if (!callback_) return;
     const auto now = std::chrono::steady_clock::now().time_since_epoch().count();
     auto last = lastReport_.load(std::memory_order_relaxed);
-    if (now - last < std::chrono::duration_cast<std::chrono::steady_clock::duration>(interval_).count())
+    if (now - last <
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(interval_).count())
       return;
     std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
     if (!lock.owns_lock()) return;

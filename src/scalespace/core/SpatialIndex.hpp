@@ -9,8 +9,8 @@
 namespace scalespace {
 
 struct Neighbor {
-  Index index;     // index into the positions the index was built on
-  double distSq;   // squared Euclidean distance to the query
+  Index index;    // index into the positions the index was built on
+  double distSq;  // squared Euclidean distance to the query
 };
 
 class SpatialIndex {

@@ -23,7 +23,6 @@ void checkAttributeNames(const PointCloud& cloud, const char* format,
   auto same = [&](const std::string& name, const char* r) {
     return caseInsensitive ? toLower(name) == r : name == r;
   };
-  std::size_t normalColumns = 0;
   for (const auto& column : cloud.attributes()) {
     bool bad = column.name.empty();
     for (char c : column.name)
@@ -31,10 +30,7 @@ void checkAttributeNames(const PointCloud& cloud, const char* format,
     for (const char* r : reserved)
       if (same(column.name, r)) bad = true;
     for (const char* r : normalNames)
-      if (same(column.name, r)) {
-        bad = bad || cloud.hasNormals();
-        ++normalColumns;
-      }
+      if (same(column.name, r)) bad = bad || cloud.hasNormals();
     if (bad)
       throw Error(std::string("cannot write attribute '") + column.name + "' to " + format +
                   ": names must be non-empty, without spaces or commas, and not a position or "
@@ -43,9 +39,9 @@ void checkAttributeNames(const PointCloud& cloud, const char* format,
       throw Error("attribute '" + column.name + "' has " + std::to_string(column.values.size()) +
                   " values for " + std::to_string(cloud.size()) + " points");
   }
-  if (normalColumns >= 3)
-    throw Error(std::string("cannot write attributes named like the normals to ") + format +
-                ": they would be read back as normals (rename them or set them as normals)");
+  // A cloud without normals may carry nx ny nz as ordinary columns after other attributes (the
+  // curvature output does: the fitted normal follows the input's attributes). Readers recognise
+  // them by name, so they are read back as the cloud's normals.
 }
 
 }  // namespace scalespace::io_detail

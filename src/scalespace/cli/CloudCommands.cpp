@@ -1,0 +1,303 @@
+#include "scalespace/cli/CloudCommands.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/PlanesCommands.hpp"
+#include "scalespace/cli/ProgressBar.hpp"
+#include "scalespace/cli/ScalesCommands.hpp"
+#include "scalespace/core/AnalyticSurface.hpp"
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/fit/CurvatureEstimation.hpp"
+#include "scalespace/io/CloudIO.hpp"
+
+namespace scalespace::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// ---------------------------------------------------------------------------------------- info
+void addInfoCommand(CLI::App& app) {
+  auto path = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand("info", "describe a point cloud file or a scale stack");
+  cmd->add_option("file", *path, "point cloud or scale stack (NAME.stack)")->required();
+  cmd->callback([path] {
+    if (printStackInfo(*path, std::cout)) return;
+    ReadReport report;
+    const PointCloud cloud = readCloud(*path, {}, &report);
+    std::printf("file        %s\nformat      %s\npoints      %zu\n", path->c_str(),
+                report.format.c_str(), cloud.size());
+    if (!cloud.empty()) {
+      Vec3 lo, hi;
+      cloud.bounds(lo, hi);
+      lo += cloud.origin();
+      hi += cloud.origin();
+      std::printf("bounds      [%.17g, %.17g] x [%.17g, %.17g] x [%.17g, %.17g]\n", lo.x(), hi.x(),
+                  lo.y(), hi.y(), lo.z(), hi.z());
+      std::printf("diagonal    %.6g\n", (hi - lo).norm());
+    }
+    std::printf("normals     %s\n", cloud.hasNormals() ? "yes (nx ny nz)" : "no");
+    std::printf("attributes  %zu\n", cloud.attributes().size());
+    for (const AttributeColumn& a : cloud.attributes()) {
+      double mn = 0, mx = 0;
+      if (!a.values.empty()) {
+        const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
+        mn = *lo;
+        mx = *hi;
+      }
+      std::printf("  %-20s %-8s min %.6g max %.6g\n", a.name.c_str(), scalarTypeName(a.type), mn,
+                  mx);
+    }
+  });
+}
+
+// ------------------------------------------------------------------------------------ generate
+void addGenerateCommand(CLI::App& app) {
+  struct Args {
+    std::string shape, output;
+    GenerateOptions options;
+    double normalNoise = 0;
+    bool absoluteNoise = false;
+    bool quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "generate",
+      "sample an analytic surface (exact normals and curvatures as columns) or a "
+      "piecewise-planar scene of Table 2.1 (face labels as gt_face)");
+  cmd->add_option("shape", args->shape,
+                  "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box")
+      ->required();
+  cmd->add_option("-n,--points", args->options.pointCount, "number of points")
+      ->capture_default_str();
+  cmd->add_option("--noise", args->options.noise,
+                  "Gaussian position noise, as a fraction of the bounding-box diagonal")
+      ->capture_default_str();
+  cmd->add_option("--normal-noise", args->normalNoise,
+                  "analytic shapes: normal rotation noise sigma in degrees (Sec. 1.4.3)");
+  cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "output cloud (.ply .xyz .pcd .las)")->required();
+  cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    if (args->options.pointCount == 0) throw OptionError("--points must be >= 1");
+    if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
+    PointCloud cloud;
+    if (!generateScene(args->shape, args->options, cloud)) {
+      SurfaceSampleOptions o;
+      o.shape = parseSurfaceShape(args->shape);  // OptionError names the accepted shapes
+      o.count = args->options.pointCount;
+      o.seed = args->options.seed;
+      o.normalNoiseDegrees = args->normalNoise;
+      const PointCloud clean = sampleSurface(o);
+      o.positionNoise = args->options.noise * clean.boundingBoxDiagonal();
+      cloud = o.positionNoise > 0 ? sampleSurface(o) : clean;
+    }
+    writeCloud(cloud, args->output);
+    if (!args->quiet)
+      std::fprintf(stderr, "generate: %zu points written to %s\n", cloud.size(),
+                   args->output.c_str());
+    reportDone("generate", start, args->quiet);
+  });
+}
+
+// ------------------------------------------------------------------------------------- normals
+struct NormalArgs {
+  std::size_t k = 10;
+  std::vector<std::string> orient{"mst"};
+};
+
+void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
+  cmd.add_option("--k", a.k, "neighbours for PCA normals and the orientation graph")
+      ->capture_default_str();
+  cmd.add_option("--orient", a.orient,
+                 "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z) or "
+                 "'viewpoint X Y Z' (towards a scanner position, in file coordinates)")
+      ->expected(1, 4);
+}
+
+NormalOrientationOptions orientationFrom(const NormalArgs& a, const PointCloud& cloud) {
+  NormalOrientationOptions o;
+  o.k = a.k;
+  if (a.orient.size() == 1 && a.orient[0] == "mst") {
+    o.method = OrientationMethod::MinimumSpanningTree;
+  } else if (a.orient.size() == 4 && a.orient[0] == "viewpoint") {
+    o.method = OrientationMethod::Viewpoint;
+    Vec3 v;
+    for (int c = 0; c < 3; ++c) {
+      try {
+        v[c] = std::stod(a.orient[1 + c]);
+      } catch (const std::exception&) {
+        throw OptionError("--orient viewpoint expects three numbers, got '" + a.orient[1 + c] +
+                          "'");
+      }
+    }
+    o.viewpoint = v - cloud.origin();  // the cloud works in recentred coordinates
+  } else {
+    throw OptionError("--orient takes 'mst' or 'viewpoint X Y Z'");
+  }
+  return o;
+}
+
+/// Estimates (PCA) and orients normals in place; adds a `normal_reliable` column (0/1).
+void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCallback& progress,
+                       bool quiet) {
+  if (a.k < 3) throw OptionError("--k must be >= 3");
+  const NormalOrientationOptions orientation = orientationFrom(a, cloud);
+  const auto index = makeSpatialIndex(cloud.positions());
+  NormalEstimationOptions eo;
+  eo.k = a.k;
+  NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
+  NormalOrientationResult ori =
+      orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid, progress);
+  cloud.setNormals(std::move(est.normals));
+  AttributeColumn& flag = cloud.addAttribute("normal_reliable", ScalarType::UInt8);
+  for (std::size_t i = 0; i < cloud.size(); ++i) flag.values[i] = ori.reliable[i];
+  if (!quiet)
+    std::fprintf(stderr,
+                 "normals: %zu estimated (k = %zu), %zu degenerate, %zu flipped, %zu without a "
+                 "reliable orientation (normal_reliable = 0)\n",
+                 cloud.size(), a.k, est.invalidCount, ori.flippedCount, ori.unreliableCount);
+}
+
+void addNormalsCommand(CLI::App& app) {
+  struct Args {
+    InputOptions input;
+    std::string output;
+    NormalArgs normals;
+    int threads = 0;
+    bool ascii = false, quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "normals", "estimate (PCA over k neighbours) and orient normals; replaces existing ones");
+  addInputOptions(*cmd, args->input);
+  cmd->add_option("-o,--output", args->output, "output cloud")->required();
+  addNormalOptions(*cmd, args->normals);
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    ThreadScope threads(args->threads);
+    checkOutputPath(args->input.path, args->output);
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    estimateAndOrient(cloud, args->normals, makeProgressBar(args->quiet), args->quiet);
+    writeCloud(cloud, args->output, WriteOptions{args->ascii});
+    if (!args->quiet) std::fprintf(stderr, "normals: written to %s\n", args->output.c_str());
+    reportDone("normals", start, args->quiet);
+  });
+}
+
+// ----------------------------------------------------------------------------------- curvature
+void addCurvatureCommand(CLI::App& app) {
+  struct Args {
+    InputOptions input;
+    std::string output, estimator = "w3";
+    double scale = 0;
+    int scaleK = 0;
+    bool mls = false, robust = false, ascii = false, quiet = false;
+    int threads = 0;
+    NormalArgs normals;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "curvature", "normals, mean and principal curvatures and directions at one scale (Ch. 1)");
+  addInputOptions(*cmd, args->input);
+  cmd->add_option("-o,--output", args->output, "output cloud, one row per input point")->required();
+  auto* scale = cmd->add_option("--scale", args->scale, "support radius t in the cloud's units");
+  auto* scaleK = cmd->add_option("--scale-k", args->scaleK,
+                                 "per-point t = distance to the K-th nearest neighbour");
+  scale->excludes(scaleK);
+  cmd->add_option("--estimator", args->estimator, "w3 | w2 | w1 | plane | mean | quadric | jet")
+      ->capture_default_str();
+  cmd->add_flag("--mls", args->mls, "iterate the MLS projection (Eq. 1.12; <= 20 steps, 0.001 t)");
+  cmd->add_flag("--robust", args->robust, "robust re-weighting (RIMLS, Oztireli 2009)");
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
+  addNormalOptions(*cmd, args->normals);
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    if ((args->scale > 0) == (args->scaleK > 0))
+      throw OptionError("give exactly one of --scale T (> 0) or --scale-k K (> 0)");
+    ThreadScope threads(args->threads);
+    checkOutputPath(args->input.path, args->output);
+    CurvatureOptions options;
+    options.fit.estimator = parseEstimator(args->estimator);
+    options.fit.mls = args->mls;
+    options.fit.robust = args->robust;
+    options.scale = args->scale;
+    options.scaleK = args->scaleK;
+
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    const auto progress = makeProgressBar(args->quiet);
+    const bool hadNormals = cloud.hasNormals();
+    if (!hadNormals) {
+      if (!args->quiet)
+        std::fprintf(stderr, "%s has no normals: estimating and orienting them first\n",
+                     args->input.path.c_str());
+      estimateAndOrient(cloud, args->normals, progress, args->quiet);
+    }
+    // The fitted normal is written as nx ny nz after the input's attributes; the normals the fit
+    // started from are kept as in_nx in_ny in_nz so nothing of the input is lost.
+    const std::vector<Vec3> inputNormals = cloud.normals();
+    const char* inNames[] = {"in_nx", "in_ny", "in_nz"};
+    for (int c = 0; c < 3; ++c) {
+      AttributeColumn& col = cloud.addAttribute(inNames[c], ScalarType::Float32);
+      for (std::size_t i = 0; i < cloud.size(); ++i) col.values[i] = inputNormals[i][c];
+    }
+    const CurvatureSummary summary = computeCurvatureColumns(cloud, options, progress);
+    cloud.setNormals({});
+    writeCloud(cloud, args->output, WriteOptions{args->ascii});
+
+    const double total = std::chrono::duration<double>(Clock::now() - start).count();
+    nlohmann::json json = {{"command", "curvature"},
+                           {"version", SCALESPACE_VERSION},
+                           {"input", args->input.path},
+                           {"output", args->output},
+                           {"points", summary.points},
+                           {"invalid_fits", summary.invalid},
+                           {"mean_neighbors", summary.meanNeighbors},
+                           {"parameters",
+                            {{"estimator", estimatorName(options.fit.estimator)},
+                             {"scale", options.scale},
+                             {"scale_k", options.scaleK},
+                             {"median_scale", summary.medianScale},
+                             {"mls", options.fit.mls},
+                             {"robust", options.fit.robust},
+                             {"normals_estimated", !hadNormals},
+                             {"threads", args->threads}}},
+                           {"seconds", {{"fits", summary.seconds}, {"total", total}}}};
+    const std::string summaryPath = summaryPathFor(args->output);
+    writeJson(summaryPath, json);
+    if (!args->quiet)
+      std::fprintf(stderr,
+                   "curvature: %zu points, t = %.6g%s, %.1f neighbours on average, %zu invalid "
+                   "fits -> %s (summary %s)\n",
+                   summary.points, summary.medianScale, options.scaleK ? " (median)" : "",
+                   summary.meanNeighbors, summary.invalid, args->output.c_str(),
+                   summaryPath.c_str());
+    reportDone("curvature", start, args->quiet);
+  });
+}
+
+}  // namespace
+
+void addCloudCommands(CLI::App& app) {
+  addInfoCommand(app);
+  addGenerateCommand(app);
+  addNormalsCommand(app);
+  addCurvatureCommand(app);
+  addScalesCommands(app);
+  addPlanesCommands(app);
+}
+
+}  // namespace scalespace::cli

@@ -1,0 +1,40 @@
+// scalespace: command-line front end. Each group of commands lives in its own file and registers
+// itself on the CLI11 app; this file only dispatches and turns exceptions into one-line errors.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "scalespace/cli/CloudCommands.hpp"
+#include "scalespace/core/Error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"scalespace " SCALESPACE_VERSION
+               ": multi-scale analysis of 3D point clouds (normals, curvatures, scale spaces)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", SCALESPACE_VERSION);
+  scalespace::cli::addCloudCommands(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, then a non-zero exit (CLI11's default prints two).
+    std::fprintf(stderr, "scalespace: error: %s (see --help)\n", e.what());
+    return 2;
+  } catch (const scalespace::Cancelled& e) {
+    std::fprintf(stderr, "scalespace: %s\n", e.what());
+    return 130;
+  } catch (const scalespace::OptionError& e) {
+    std::fprintf(stderr, "scalespace: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "scalespace: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,164 @@
+#include "scalespace/fit/CurvatureEstimation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/core/SpatialOrder.hpp"
+
+namespace scalespace {
+namespace {
+
+bool needsNormals(EstimatorKind kind) {
+  return kind == EstimatorKind::W1 || kind == EstimatorKind::W2 || kind == EstimatorKind::W3;
+}
+
+void validate(const PointCloud& cloud, const CurvatureOptions& options) {
+  if ((options.scale > 0) == (options.scaleK > 0))
+    throw OptionError(
+        "give exactly one of a scale t > 0 (--scale) or a neighbour count (--scale-k)");
+  if (!(std::isfinite(options.scale) && options.scale >= 0))
+    throw OptionError("--scale must be a finite positive distance");
+  if (options.scaleK < 0) throw OptionError("--scale-k must be positive");
+  if (options.fit.minNeighbors < 1) throw OptionError("minimum neighbour count must be >= 1");
+  if (needsNormals(options.fit.estimator) && !cloud.hasNormals())
+    throw Error(std::string("the ") + estimatorName(options.fit.estimator) +
+                " estimator needs oriented normals: estimate them first (scalespace normals)");
+}
+
+/// Calls `visit(i, fit)` for every point, i in input order, in parallel. The cloud is traversed in
+/// spatial order (core/SpatialOrder) so that consecutive fits touch the same memory: this is
+/// where most of the time goes (neighbour queries and accumulation over ~40 samples).
+void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
+                const ProgressCallback& progress, CurvatureSummary& summary,
+                const std::function<void(std::size_t, const LocalFit&)>& visit) {
+  validate(cloud, options);
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = cloud.size();
+  summary = CurvatureSummary{};
+  summary.points = n;
+  if (n == 0) return;
+
+  const std::vector<Index> order = spatialOrder(cloud.positions());
+  std::vector<Vec3> positions(n), normals;
+  for (std::size_t k = 0; k < n; ++k) positions[k] = cloud.positions()[order[k]];
+  if (cloud.hasNormals()) {
+    normals.resize(n);
+    for (std::size_t k = 0; k < n; ++k) normals[k] = cloud.normals()[order[k]];
+  }
+  const std::unique_ptr<SpatialIndex> index = makeSpatialIndex(positions);
+  const SurfaceSamples samples{positions, normals, *index};
+
+  std::vector<double> scales(n, options.scale);
+  struct Counters {
+    std::size_t invalid = 0;
+    double neighbors = 0;
+    FitWorkspace workspace;
+  };
+  tbb::enumerable_thread_specific<Counters> counters;
+  ProgressTracker tracker(progress, "fitting", n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& range) {
+    Counters& c = counters.local();
+    for (std::size_t k = range.begin(); k < range.end(); ++k) {
+      double t = options.scale;
+      if (options.scaleK > 0) {
+        // K + 1 because the point itself is its own nearest neighbour.
+        index->knnSearch(positions[k], std::size_t(options.scaleK) + 1, c.workspace.neighbors);
+        t = c.workspace.neighbors.empty() ? 0.0 : std::sqrt(c.workspace.neighbors.back().distSq);
+        // The support is open (|q| < t): widen by a hair so the K-th neighbour is inside it.
+        t *= 1.0 + 1e-9;
+        scales[k] = t;
+      }
+      LocalFit fit;
+      if (t > 0) fit = fitAt(positions[k], t, samples, options.fit, c.workspace);
+      if (fit.valid)
+        c.neighbors += fit.neighbors;
+      else
+        ++c.invalid;
+      visit(order[k], fit);
+    }
+    tracker.advance(range.size());
+  });
+  tracker.finish();
+
+  for (const Counters& c : counters) {
+    summary.invalid += c.invalid;
+    summary.meanNeighbors += c.neighbors;
+  }
+  const std::size_t valid = n - summary.invalid;
+  summary.meanNeighbors = valid ? summary.meanNeighbors / double(valid) : 0.0;
+  std::nth_element(scales.begin(), scales.begin() + n / 2, scales.end());
+  summary.medianScale = scales[n / 2];
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+const std::vector<std::string>& curvatureColumnNames() {
+  static const std::vector<std::string> names = {
+      "nx",        "ny",        "nz",          "curv_mean",  "curv_max",  "curv_min",
+      "dir_max_x", "dir_max_y", "dir_max_z",   "dir_min_x",  "dir_min_y", "dir_min_z",
+      "gls_tau",   "gls_kappa", "gls_fitness", "anisotropy", "neighbors", "fit_valid"};
+  return names;
+}
+
+CurvatureSummary computeCurvatureColumns(PointCloud& cloud, const CurvatureOptions& options,
+                                         const ProgressCallback& progress) {
+  validate(cloud, options);
+  const auto& names = curvatureColumnNames();
+  // Columns are created up front (in the documented order) and filled in place: no per-point
+  // result array, which keeps peak memory at the columns themselves.
+  std::vector<double*> col(names.size());
+  // Re-running on our own output moves the columns to the end instead of duplicating them.
+  for (const std::string& name : names) cloud.removeAttribute(name);
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    const ScalarType type = names[c] == "neighbors"   ? ScalarType::Int32
+                            : names[c] == "fit_valid" ? ScalarType::UInt8
+                                                      : ScalarType::Float32;
+    cloud.addAttribute(names[c], type);
+  }
+  for (std::size_t c = 0; c < names.size(); ++c)
+    col[c] = cloud.findAttribute(names[c])->values.data();
+
+  CurvatureSummary summary;
+  forEachFit(cloud, options, progress, summary, [&](std::size_t i, const LocalFit& f) {
+    const double v[] = {f.normal.x(),
+                        f.normal.y(),
+                        f.normal.z(),
+                        f.meanCurvature,
+                        f.kMax,
+                        f.kMin,
+                        f.dirMax.x(),
+                        f.dirMax.y(),
+                        f.dirMax.z(),
+                        f.dirMin.x(),
+                        f.dirMin.y(),
+                        f.dirMin.z(),
+                        f.tau,
+                        f.kappa,
+                        f.fitness,
+                        f.anisotropy,
+                        double(f.neighbors),
+                        f.valid ? 1.0 : 0.0};
+    for (std::size_t c = 0; c < names.size(); ++c) col[c][i] = v[c];
+  });
+  return summary;
+}
+
+std::vector<LocalFit> fitAllPoints(const PointCloud& cloud, const CurvatureOptions& options,
+                                   const ProgressCallback& progress, CurvatureSummary* summary) {
+  std::vector<LocalFit> fits(cloud.size());
+  CurvatureSummary s;
+  forEachFit(cloud, options, progress, s, [&](std::size_t i, const LocalFit& f) { fits[i] = f; });
+  if (summary) *summary = s;
+  return fits;
+}
+
+}  // namespace scalespace

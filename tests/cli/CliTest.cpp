@@ -1,0 +1,159 @@
+// End-to-end checks of the `scalespace` program: exit codes, one-line errors, the curvature
+// output's layout (one row per input point, in order, named columns) and its values on a sphere.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "scalespace/fit/CurvatureEstimation.hpp"
+#include "scalespace/io/CloudIO.hpp"
+
+namespace fs = std::filesystem;
+using namespace scalespace;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string err;
+};
+
+// Runs the CLI with `args`, capturing stderr.
+Result run(const std::string& args) {
+  static int counter = 0;
+  const fs::path errFile =
+      fs::temp_directory_path() /
+      ("scalespace_cli_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  const std::string cmd =
+      std::string(SCALESPACE_CLI_PATH) + " " + args + " >/dev/null 2>" + errFile.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(errFile);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  fs::remove(errFile);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("scalespace_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(Cli, HelpAndVersionSucceed) {
+  EXPECT_EQ(run("--help").code, 0);
+  EXPECT_EQ(run("curvature --help").code, 0);
+  EXPECT_EQ(run("--version").code, 0);
+}
+
+TEST_F(Cli, WrongOptionsGiveOneLineAndNonZeroExit) {
+  for (const std::string args :
+       {"curvature", "curvature nope.ply -o x.ply --scale 1", "frobnicate", "curvature --bogus"}) {
+    const Result r = run(args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  }
+}
+
+TEST_F(Cli, CurvatureOfASphereKeepsRowsAndNamesColumns) {
+  ASSERT_EQ(run("generate sphere -n 20000 --seed 3 -q -o " + path("s.ply")).code, 0);
+  const PointCloud input = readCloud(path("s.ply"));
+  const Result r = run("curvature " + path("s.ply") + " -o " + path("c.ply") + " --scale 0.2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("done in"), std::string::npos);  // final line with the time taken
+  ASSERT_TRUE(fs::exists(path("c.json")));
+
+  const PointCloud out = readCloud(path("c.ply"));
+  ASSERT_EQ(out.size(), input.size());
+  for (std::size_t i = 0; i < input.size(); i += 997)
+    EXPECT_EQ(out.absolutePosition(i), input.absolutePosition(i));  // input order kept
+  // The input's columns come first, then in_n*, then the documented curvature columns.
+  const auto& attrs = out.attributes();
+  ASSERT_GE(attrs.size(), input.attributes().size() + 3);
+  for (std::size_t c = 0; c < input.attributes().size(); ++c)
+    EXPECT_EQ(attrs[c].name, input.attributes()[c].name);
+  std::vector<std::string> tail;
+  for (std::size_t c = input.attributes().size() + 3; c < attrs.size(); ++c)
+    tail.push_back(attrs[c].name);
+  std::vector<std::string> expected;
+  for (const std::string& n : curvatureColumnNames())
+    if (n != "nx" && n != "ny" && n != "nz") expected.push_back(n);  // read back as normals
+  EXPECT_EQ(tail, expected);
+  ASSERT_TRUE(out.hasNormals());
+
+  // Unit sphere with outward normals: H = k1 = k2 = +1 (NOTES.md sign convention).
+  const auto* h = out.findAttribute("curv_mean");
+  const auto* valid = out.findAttribute("fit_valid");
+  for (std::size_t i = 0; i < out.size(); i += 101) {
+    ASSERT_EQ(valid->values[i], 1.0);
+    EXPECT_NEAR(h->values[i], 1.0, 0.05);
+    EXPECT_GT(out.normals()[i].dot(input.normals()[i]), 0.999);
+  }
+}
+
+TEST_F(Cli, CurvatureEstimatesNormalsWhenMissingAndNeverOverwritesItsInput) {
+  {
+    std::ofstream xyz(path("plane.xyz"));
+    for (int i = 0; i < 60; ++i)
+      for (int j = 0; j < 60; ++j) xyz << i * 0.1 << ' ' << j * 0.1 << ' ' << 0.0 << '\n';
+  }
+  const auto before = fs::file_size(path("plane.xyz"));
+  Result r = run("curvature " + path("plane.xyz") + " -o " + path("plane.xyz") + " --scale 0.5");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(fs::file_size(path("plane.xyz")), before);
+
+  r = run("curvature " + path("plane.xyz") + " -o " + path("plane.ply") + " --scale-k 20");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("no normals"), std::string::npos);
+  const PointCloud out = readCloud(path("plane.ply"));
+  const auto* kmax = out.findAttribute("curv_max");
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_NEAR(std::abs(out.normals()[i].z()), 1.0, 1e-6);
+    EXPECT_NEAR(kmax->values[i], 0.0, 1e-6);
+  }
+}
+
+TEST_F(Cli, BadFilesGiveAClearErrorNamingTheFile) {
+  {
+    std::ofstream bad(path("bad.ply"));
+    bad << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n";
+  }
+  const Result r = run("curvature " + path("bad.ply") + " -o " + path("o.ply") + " --scale 1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("bad.ply"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("o.ply")));
+}
+
+TEST_F(Cli, ThreadCountDoesNotChangeTheResult) {
+  ASSERT_EQ(run("generate saddle -n 5000 -q -o " + path("s.ply")).code, 0);
+  ASSERT_EQ(
+      run("curvature -q " + path("s.ply") + " -o " + path("a.ply") + " --scale 0.3 --threads 1")
+          .code,
+      0);
+  ASSERT_EQ(
+      run("curvature -q " + path("s.ply") + " -o " + path("b.ply") + " --scale 0.3 --threads 2")
+          .code,
+      0);
+  std::ifstream a(path("a.ply"), std::ios::binary), b(path("b.ply"), std::ios::binary);
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_EQ(sa.str(), sb.str());
+}
+
+}  // namespace
