@@ -3,6 +3,7 @@
 #include <CGAL/Monge_via_jet_fitting.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -37,6 +38,20 @@ LocalFit fitJet(const Vec3& x, double t, const std::vector<Neighbor>& nbrs,
   }
   fit.neighbors = static_cast<int>(pts.size());
   if (fit.neighbors < std::max(minNeighbors, 6)) return fit;  // 6 coefficients (degree 2)
+  // CGAL's PCA and SVD read uninitialised values (and may crash) when the points do not span a
+  // surface: refuse neighbourhoods whose covariance has a second eigenvalue ~0 (all points
+  // identical or colinear); they are invalid fits, like any other degenerate neighbourhood.
+  Vec3 mean = Vec3::Zero();
+  for (const CgalPoint& p : pts) mean += toVec(p);
+  mean /= double(pts.size());
+  Mat3 cov = Mat3::Zero();
+  for (const CgalPoint& p : pts) {
+    const Vec3 d = toVec(p) - mean;
+    cov.noalias() += d * d.transpose();
+  }
+  cov /= double(pts.size());
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(cov, Eigen::EigenvaluesOnly);
+  if (!(eig.eigenvalues()[1] > 1e-12 * t2)) return fit;
   std::swap(pts[0], pts[nearest]);
   try {
     Fitting fitter;
