@@ -83,11 +83,7 @@ LocalFit fitJet(const Vec3& x, double t, const std::vector<Neighbor>& nbrs,
   } catch (...) {
     fit.valid = false;  // CGAL precondition failures (degenerate neighbourhoods) are per-point
   }
-  if (!fit.valid) {
-    const int n = fit.neighbors;
-    fit = LocalFit{};
-    fit.neighbors = n;
-  }
+  if (!fit.valid) markInvalid(fit);
   return fit;
 }
 

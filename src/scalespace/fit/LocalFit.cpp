@@ -58,12 +58,6 @@ namespace {
 constexpr double kRobustSigmaR = 0.2;  // times t
 constexpr double kRobustSigmaN = 0.5;
 
-void clearNumbers(LocalFit& fit) {
-  const int n = fit.neighbors;
-  fit = LocalFit{};
-  fit.neighbors = n;
-}
-
 /// One APSS fit at y (with optional robust re-weighting) and its shape operator.
 LocalFit fitSphere(const Vec3& y, double t, const SurfaceSamples& samples,
                    const FitOptions& options, FitWorkspace& ws) {
@@ -188,7 +182,7 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
     fit = fitOnce(y, t, samples, options, workspace);
     fit.mlsSteps = step;
     if (!fit.valid) {
-      clearNumbers(fit);
+      markInvalid(fit);
       return fit;
     }
     // Eq. 1.12: iterate x <- phi(x) until the step is below tolerance * t; the last fit is the

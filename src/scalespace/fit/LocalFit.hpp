@@ -73,6 +73,13 @@ struct LocalFit {
   int mlsSteps = 0;
 };
 
+/// Turns `fit` into an invalid result: zeros everywhere (never NaN) but the neighbour count.
+inline void markInvalid(LocalFit& fit) {
+  const int neighbors = fit.neighbors;
+  fit = LocalFit{};
+  fit.neighbors = neighbors;
+}
+
 /// The samples a fit reads: positions and normals (same frame as x) and an index over positions.
 struct SurfaceSamples {
   const std::vector<Vec3>& positions;

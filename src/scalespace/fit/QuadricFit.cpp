@@ -77,11 +77,7 @@ LocalFit fitQuadric(const Vec3& x, double t, const std::vector<Neighbor>& nbrs,
   fit.projection = x + cov.mean + t * (u * frame.e1 + v * frame.e2 + h * frame.normal);
   fit.valid = std::isfinite(fit.kMax) && std::isfinite(fit.kMin) && fit.normal.allFinite() &&
               fit.projection.allFinite();
-  if (!fit.valid) {
-    const int n = fit.neighbors;
-    fit = LocalFit{};
-    fit.neighbors = n;
-  }
+  if (!fit.valid) markInvalid(fit);
   return fit;
 }
 
