@@ -31,3 +31,16 @@ TEST(PointCloud, AttributesFollowSubsetAndResize) {
   EXPECT_EQ(sub.positions()[1], Vec3(0, 0, 0));
   EXPECT_THROW(cloud.setNormals({Vec3::UnitZ()}), std::exception);
 }
+
+TEST(PointCloud, RecentringNearTheLargestDoubleStaysFinite) {
+  // lo + hi overflows here; the origin must not (readers cap coordinates, the core must not rely
+  // on it).
+  const std::vector<Vec3> abs = {{1.5e308, -1.5e308, 0.0}, {1.6e308, -1.6e308, 1.0}};
+  PointCloud cloud;
+  cloud.setAbsolutePositions(abs);
+  ASSERT_TRUE(cloud.origin().allFinite());
+  for (std::size_t i = 0; i < abs.size(); ++i) {
+    ASSERT_TRUE(cloud.positions()[i].allFinite());
+    EXPECT_EQ(cloud.absolutePosition(i), abs[i]);
+  }
+}

@@ -66,7 +66,7 @@ void PointCloud::setAbsolutePositions(const std::vector<Vec3>& absolute) {
   }
   // An integer origin keeps p - origin exact (both are multiples of ulp(p) and |p - o| <= |p|
   // whenever the cloud does not straddle far from its centre); small clouds keep origin 0.
-  const Vec3 centre = 0.5 * (lo + hi);
+  const Vec3 centre = 0.5 * lo + 0.5 * hi;  // lo + hi would overflow near DBL_MAX
   origin_ = centre.cwiseAbs().maxCoeff() < 1e3 ? Vec3::Zero() : Vec3(centre.array().round());
   positions_.resize(absolute.size());
   for (std::size_t i = 0; i < absolute.size(); ++i) positions_[i] = absolute[i] - origin_;
