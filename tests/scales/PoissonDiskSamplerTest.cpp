@@ -94,7 +94,8 @@ TEST(PoissonDisk, PyramidIsNestedAndEachLevelIsADiskSampleOfThePrevious) {
   std::vector<Index> previous = all(p.size());
   for (std::size_t j = 0; j < scales.size(); ++j) {
     EXPECT_DOUBLE_EQ(pyr.radii[j], 0.25 * scales[j]);
-    const double r = pyr.radii[j];
+    // Disks of radius r_j do not overlap: separation and coverage 2 r_j (Sec. 1.5.2).
+    const double r = 2 * pyr.radii[j];
     expectPoissonDisk(p, previous, pyr.levels[j], [r](Index, Index) { return r; });
     EXPECT_LE(pyr.levels[j].size(), previous.size());
     previous = pyr.levels[j];

@@ -58,40 +58,98 @@ namespace {
 constexpr double kRobustSigmaR = 0.2;  // times t
 constexpr double kRobustSigmaN = 0.5;
 
-/// One APSS fit at y (with optional robust re-weighting) and its shape operator.
-LocalFit fitSphere(const Vec3& y, double t, const SurfaceSamples& samples,
-                   const FitOptions& options, FitWorkspace& ws) {
-  const FitDerivatives order = options.estimator == EstimatorKind::W3   ? FitDerivatives::Second
-                               : options.estimator == EstimatorKind::W2 ? FitDerivatives::First
-                                                                        : FitDerivatives::None;
-  OrientedSphereFit acc;
-  acc.begin(y, t, order, true);
-  for (const Neighbor& nb : ws.neighbors)
-    acc.add(samples.positions[nb.index], samples.normals[nb.index]);
-  OrientedSphereFitResult res = acc.finish(options.minNeighbors);
-  if (options.robust) {
-    const double sr2 = (kRobustSigmaR * t) * (kRobustSigmaR * t);
-    const double sn2 = kRobustSigmaN * kRobustSigmaN;
-    for (int it = 0; it < options.robustIterations && res.valid; ++it) {
-      const AlgebraicSphere s = res.sphere;
-      acc.begin(y, t, order, true);
-      for (const Neighbor& nb : ws.neighbors) {
-        const Vec3 q = samples.positions[nb.index] - y;
-        const Vec3 g = s.gradient(q);
-        const double gn = g.norm();
-        if (!(gn > 0)) continue;
-        const double r = s.value(q) / gn;
-        const double dn = (samples.normals[nb.index] - g / gn).squaredNorm();
-        const double rho = std::exp(-r * r / sr2) * std::exp(-dn / sn2);
-        acc.add(samples.positions[nb.index], samples.normals[nb.index], rho);
-      }
-      // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
-      OrientedSphereFitResult next = acc.finish(1);
-      next.neighbors = res.neighbors;
-      if (!next.valid) break;
-      res = next;
-    }
+/// Gathers the neighbours of y (offsets q = p - y and normals) into contiguous buffers: the
+/// robust passes read them several times.
+void gatherNeighbors(const Vec3& y, const SurfaceSamples& samples, FitWorkspace& ws) {
+  const std::size_t n = ws.neighbors.size();
+  ws.offsets.resize(n);
+  ws.normals.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    ws.offsets[k] = samples.positions[ws.neighbors[k].index] - y;
+    ws.normals[k] = samples.normals[ws.neighbors[k].index];
   }
+}
+
+/// One accumulation over the gathered neighbours with re-weighting factors `rho` (frame centred
+/// at y, so the offsets are the positions).
+OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::vector<double>& rho,
+                                   FitDerivatives order, bool scaleDerivatives, int minNeighbors) {
+  OrientedSphereFit acc;
+  acc.begin(Vec3::Zero(), t, order, scaleDerivatives);
+  for (std::size_t k = 0; k < ws.offsets.size(); ++k) acc.add(ws.offsets[k], ws.normals[k], rho[k]);
+  return acc.finish(minNeighbors);
+}
+
+/// RIMLS factors of the neighbours against sphere s (Oztireli 2009, see kRobustSigmaR).
+void robustWeights(const AlgebraicSphere& s, double t, const FitWorkspace& ws,
+                   std::vector<double>& rho) {
+  const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
+  const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
+  rho.resize(ws.offsets.size());
+  for (std::size_t k = 0; k < ws.offsets.size(); ++k) {
+    const Vec3 g = s.gradient(ws.offsets[k]);
+    const double gn = g.norm();
+    if (!(gn > 0)) {
+      rho[k] = 0;
+      continue;
+    }
+    const double r = s.value(ws.offsets[k]) / gn;
+    const double dn = (ws.normals[k] - g / gn).squaredNorm();
+    rho[k] = std::exp(-(r * r * invSr2 + dn * invSn2));
+  }
+}
+
+bool isAlgebraicSphere(EstimatorKind kind) {
+  return kind == EstimatorKind::W3 || kind == EstimatorKind::W2 || kind == EstimatorKind::W1;
+}
+
+FitDerivatives derivativesOf(EstimatorKind kind) {
+  return kind == EstimatorKind::W3   ? FitDerivatives::Second
+         : kind == EstimatorKind::W2 ? FitDerivatives::First
+                                     : FitDerivatives::None;
+}
+
+/// The pass whose result is reported again, with the spatial derivatives the estimator needs
+/// and the scale derivatives (nu), on the factors left in ws.weights.
+OrientedSphereFitResult reportedPass(double t, const FitOptions& options, const FitWorkspace& ws,
+                                     int neighbors) {
+  OrientedSphereFitResult res =
+      spherePass(t, ws, ws.weights, derivativesOf(options.estimator), true, 1);
+  res.neighbors = neighbors;
+  return res;
+}
+
+/// The (robust) APSS sphere at y over the gathered neighbours. Only the sums of the weights feed
+/// the next re-weighting, so every pass is made without derivatives except, when `reported` is
+/// set, the last one (redone with derivatives if a re-weighting failed and an earlier pass is
+/// kept). On return ws.weights holds the factors of the returned fit.
+OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWorkspace& ws,
+                                     bool reported) {
+  const int passes = options.robust ? std::max(0, options.robustIterations) : 0;
+  const FitDerivatives order = derivativesOf(options.estimator);
+  ws.weights.assign(ws.offsets.size(), 1.0);
+  bool full = reported && passes == 0;
+  OrientedSphereFitResult res = spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None,
+                                           full, options.minNeighbors);
+  for (int it = 0; it < passes && res.valid; ++it) {
+    robustWeights(res.sphere, t, ws, ws.trialWeights);
+    const bool last = reported && it + 1 == passes;
+    // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
+    OrientedSphereFitResult next =
+        spherePass(t, ws, ws.trialWeights, last ? order : FitDerivatives::None, last, 1);
+    if (!next.valid) break;
+    next.neighbors = res.neighbors;
+    res = next;
+    std::swap(ws.weights, ws.trialWeights);
+    full = last;
+  }
+  if (res.valid && reported && !full) res = reportedPass(t, options, ws, res.neighbors);
+  return res;
+}
+
+/// Differential quantities of a (robust) APSS fit made at y (W1, W2, W3 and the GLS fields).
+LocalFit sphereQuantities(const OrientedSphereFitResult& res, const Vec3& y, double t,
+                          const FitOptions& options) {
   LocalFit fit;
   fit.neighbors = res.neighbors;
   if (!res.valid) return fit;
@@ -140,14 +198,38 @@ LocalFit fitSphere(const Vec3& y, double t, const SurfaceSamples& samples,
   return fit;
 }
 
-LocalFit fitOnce(const Vec3& y, double t, const SurfaceSamples& samples, const FitOptions& options,
-                 FitWorkspace& ws) {
+/// APSS estimators with optional MLS (Eq. 1.12): intermediate steps only need the projection,
+/// so derivatives are computed once, at the step that is reported.
+LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
+                      const FitOptions& options, FitWorkspace& ws) {
+  const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
+  Vec3 y = x;
+  for (int step = 1;; ++step) {
+    samples.index.radiusSearch(y, t, ws.neighbors);
+    gatherNeighbors(y, samples, ws);
+    const bool lastStep = step == maxSteps;
+    OrientedSphereFitResult res = robustSphere(t, options, ws, lastStep);
+    if (res.valid && !lastStep) {
+      const Vec3 projection = y + res.sphere.project(Vec3::Zero());
+      if ((projection - y).norm() >= options.mlsTolerance * t) {
+        y = projection;
+        continue;
+      }
+      res = reportedPass(t, options, ws, res.neighbors);  // converged: this step is reported
+    }
+    LocalFit fit;
+    fit.neighbors = res.neighbors;
+    if (res.valid) fit = sphereQuantities(res, y, t, options);
+    fit.mlsSteps = step;
+    return fit;
+  }
+}
+
+/// The baselines: one fit at y over the neighbours within t.
+LocalFit fitBaseline(const Vec3& y, double t, const SurfaceSamples& samples,
+                     const FitOptions& options, FitWorkspace& ws) {
   samples.index.radiusSearch(y, t, ws.neighbors);
   switch (options.estimator) {
-    case EstimatorKind::W3:
-    case EstimatorKind::W2:
-    case EstimatorKind::W1:
-      return fitSphere(y, t, samples, options, ws);
     case EstimatorKind::Plane:
       return fitPlane(y, t, ws.neighbors, samples, options.minNeighbors);
     case EstimatorKind::Mean:
@@ -156,6 +238,8 @@ LocalFit fitOnce(const Vec3& y, double t, const SurfaceSamples& samples, const F
       return fitQuadric(y, t, ws.neighbors, samples, options.minNeighbors);
     case EstimatorKind::Jet:
       return fitJet(y, t, ws.neighbors, samples, options.minNeighbors);
+    default:
+      break;
   }
   return LocalFit{};
 }
@@ -175,11 +259,16 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
                       "quadric or jet)");
   }
   if (!x.allFinite()) return LocalFit{};
+  if (isAlgebraicSphere(options.estimator)) {
+    LocalFit fit = fitSphereMls(x, t, samples, options, workspace);
+    if (!fit.valid) markInvalid(fit);
+    return fit;
+  }
   Vec3 y = x;
   LocalFit fit;
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
   for (int step = 1; step <= maxSteps; ++step) {
-    fit = fitOnce(y, t, samples, options, workspace);
+    fit = fitBaseline(y, t, samples, options, workspace);
     fit.mlsSteps = step;
     if (!fit.valid) {
       markInvalid(fit);

@@ -90,7 +90,8 @@ struct SurfaceSamples {
 /// Per-thread scratch memory, reused across calls to avoid allocations in the hot loop.
 struct FitWorkspace {
   std::vector<Neighbor> neighbors;
-  std::vector<double> weights;
+  std::vector<Vec3> offsets, normals;         // neighbours gathered once per query: p - x and n
+  std::vector<double> weights, trialWeights;  // robust re-weighting factors
 };
 
 /// Estimates the differential quantities at x with support radius t.

@@ -138,6 +138,13 @@ std::uint64_t sampleOrderKey(std::uint64_t seed, Index i) {
   return splitmix64(splitmix64(seed) ^ std::uint64_t(i));
 }
 
+double poissonDiskSeparation(double alpha, double t) { return 2 * alpha * t; }
+
+std::uint64_t pyramidLevelSeed(std::uint64_t seed, std::size_t level) {
+  // Each level gets its own seed so that visiting orders are not correlated across levels.
+  return seed + 0x632be59bd9b4e019ULL * (level + 1);
+}
+
 std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
                                      const std::vector<Index>& candidates, double radius,
                                      std::uint64_t seed) {
@@ -215,11 +222,9 @@ SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
   std::vector<Index> previous(positions.size());
   std::iota(previous.begin(), previous.end(), Index(0));
   for (std::size_t j = 0; j < scales.size(); ++j) {
-    const double r = alpha * scales[j];
-    // Each level gets its own seed so that visiting orders are not correlated across levels.
-    std::vector<Index> level =
-        poissonDiskSample(positions, previous, r, seed + 0x632be59bd9b4e019ULL * (j + 1));
-    pyramid.radii.push_back(r);
+    std::vector<Index> level = poissonDiskSample(
+        positions, previous, poissonDiskSeparation(alpha, scales[j]), pyramidLevelSeed(seed, j));
+    pyramid.radii.push_back(alpha * scales[j]);
     pyramid.levels.push_back(level);
     previous = std::move(level);
     if (progress && !progress(double(j + 1) / double(scales.size()), "Poisson-disk pyramid"))

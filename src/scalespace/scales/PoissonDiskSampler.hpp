@@ -3,6 +3,11 @@
 // is drawn from the sample of scale j-1 with disk radius r_j = alpha t_j, so levels are nested
 // and coarse scales are fitted on few samples.
 //
+// The functions below take the *separation* r: the minimum distance between two samples. The
+// pyramid's disk radius r_j = alpha t_j gives a separation of 2 r_j: the thesis marks every point
+// within 2 r_j of a selected candidate unavailable, i.e. disks of radius r_j do not overlap (its
+// "91 disks of radius 0.095 in a circle of radius 1" bound on the neighbour count needs that).
+//
 // Rule (what the tests check): a candidate is rejected iff an already accepted sample lies at a
 // distance < r (adaptive: < max(r_candidate, r_sample)). Hence
 //   - separation: no two samples of a level are closer than r (adaptive: the larger radius);
@@ -42,14 +47,20 @@ std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
                                            const std::vector<Index>& candidates, double radius,
                                            std::uint64_t seed);
 
+/// Minimum distance between two samples of the level of scale t: 2 r = 2 alpha t (Eq. 1.41).
+double poissonDiskSeparation(double alpha, double t);
+/// The visiting-order seed of pyramid level j.
+std::uint64_t pyramidLevelSeed(std::uint64_t seed, std::size_t level);
+
 struct SamplePyramid {
   /// levels[j]: indices of the input points kept at scale j (sorted), levels[j] ⊂ levels[j-1].
   std::vector<std::vector<Index>> levels;
-  std::vector<double> radii;  // r_j = alpha t_j
+  std::vector<double> radii;  // disk radius r_j = alpha t_j; samples are >= 2 r_j apart
 };
 
-/// Level j drawn from level j-1 (level 0 from all points) with r_j = alpha scales[j]
-/// (Sec. 1.5.2). alpha = 0 keeps every point at every level. Throws OptionError if alpha < 0.
+/// Level j drawn from level j-1 (level 0 from all points) with disk radius r_j = alpha scales[j],
+/// i.e. separation 2 r_j (Sec. 1.5.2). alpha = 0 keeps every point at every level. Throws
+/// OptionError if alpha < 0.
 SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
                                  const std::vector<double>& scales, double alpha,
                                  std::uint64_t seed, const ProgressCallback& progress = {});

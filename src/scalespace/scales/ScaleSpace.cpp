@@ -108,9 +108,9 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     ScaleStats stats;
     stats.t = scales[j];
     auto t0 = std::chrono::steady_clock::now();
-    // Sec. 1.5.2: level j drawn from level j-1 with r_j = alpha t_j (nested pyramid).
-    level = poissonDiskSample(positions, level, options.alpha * scales[j],
-                              options.seed + 0x632be59bd9b4e019ULL * (j + 1));
+    // Sec. 1.5.2: level j drawn from level j-1 with disk radius r_j = alpha t_j (nested pyramid).
+    level = poissonDiskSample(positions, level, poissonDiskSeparation(options.alpha, scales[j]),
+                              pyramidLevelSeed(options.seed, j));
     stats.samplingSeconds = secondsSince(t0);
     stats.samples = level.size();
 
