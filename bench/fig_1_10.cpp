@@ -153,14 +153,15 @@ void timingBench(const PointCloud& cloud, const ScaleSpaceOptions& options, cons
   const ScaleSpaceSummary s = computeScaleStack(cloud, options, stackPath.string());
   const double total = seconds(t0);
   double sampling = 0, index = 0, projection = 0;
-  std::printf("%5s %10s %9s %10s %9s %9s %9s\n", "j", "t", "samples", "nbrs/proj", "sample_s",
-              "index_s", "proj_s");
+  std::printf("%5s %10s %9s %10s %9s %9s %9s %9s\n", "j", "t", "samples", "nbrs/proj", "mls_steps",
+              "sample_s", "index_s", "proj_s");
   Series samples{"samples", {}, {}}, nbrs{"neighbours / projection", {}, {}};
   Series ts{"sampling", {}, {}}, ti{"index build", {}, {}}, tp{"projection", {}, {}};
   for (std::size_t j = 0; j < s.stats.size(); ++j) {
     const ScaleStats& st = s.stats[j];
-    std::printf("%5zu %10.4g %9zu %10.1f %9.4f %9.4f %9.4f\n", j, st.t, st.samples,
-                st.meanNeighbors, st.samplingSeconds, st.indexSeconds, st.projectionSeconds);
+    std::printf("%5zu %10.4g %9zu %10.1f %9.2f %9.4f %9.4f %9.4f\n", j, st.t, st.samples,
+                st.meanNeighbors, st.meanMlsSteps, st.samplingSeconds, st.indexSeconds,
+                st.projectionSeconds);
     sampling += st.samplingSeconds, index += st.indexSeconds, projection += st.projectionSeconds;
     samples.x.push_back(st.t), samples.y.push_back(double(st.samples));
     nbrs.x.push_back(st.t), nbrs.y.push_back(st.meanNeighbors);

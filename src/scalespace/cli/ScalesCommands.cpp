@@ -248,12 +248,12 @@ bool printStackInfo(const std::string& path, std::ostream& out) {
   out << "  input checksum: " << std::hex << std::setw(16) << std::setfill('0')
       << info.inputChecksum << std::dec << std::setfill(' ')
       << "\n  parameters: " << info.parametersJson << "\n";
-  out << "  scale        t  samples  mean_nbrs  valid%  sample_s  project_s\n";
+  out << "  scale        t  samples  mean_nbrs  mls_steps  valid%  sample_s  project_s\n";
   for (std::size_t j = 0; j < info.stats.size(); ++j) {
     const ScaleStats& s = info.stats[j];
     char line[160];
-    std::snprintf(line, sizeof line, "  %5zu %8.4g %8zu %10.1f %7.2f %9.3f %10.3f\n", j, s.t,
-                  s.samples, s.meanNeighbors,
+    std::snprintf(line, sizeof line, "  %5zu %8.4g %8zu %10.1f %10.2f %7.2f %9.3f %10.3f\n", j, s.t,
+                  s.samples, s.meanNeighbors, s.meanMlsSteps,
                   info.pointCount ? 100.0 * double(s.validPoints) / double(info.pointCount) : 0.0,
                   s.samplingSeconds, s.projectionSeconds);
     out << line;

@@ -102,6 +102,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   layer.resize(n);
   tbb::enumerable_thread_specific<FitWorkspace> workspaces;
   std::vector<std::uint32_t> neighborCount(n);
+  std::vector<std::uint8_t> mlsSteps(n);
   std::vector<Vec3> samplePositions, sampleNormals;
 
   for (std::size_t j = 0; j < m; ++j) {
@@ -142,6 +143,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                           const LocalFit f = fitAt(current[k], t, samples, fit, ws);
                           const std::size_t i = order[k];  // input index
                           neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
+                          mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
                           layer.neighbors[i] = std::uint16_t(std::min(f.neighbors, 65535));
                           layer.valid[i] = f.valid ? 1 : 0;
                           if (f.valid) current[k] = f.projection;  // else keep the last one
@@ -162,9 +164,10 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                       });
     tracker.finish();
     stats.projectionSeconds = secondsSince(t0);
-    double sum = 0;
-    for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k];
+    double sum = 0, steps = 0;
+    for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k], steps += mlsSteps[k];
     stats.meanNeighbors = sum / double(n);
+    stats.meanMlsSteps = steps / double(n);
     for (std::uint8_t v : layer.valid) stats.validPoints += v;
     summary.stats.push_back(stats);
     if (sink) sink(j, layer, stats);

@@ -36,6 +36,7 @@ struct ScaleStats {
   double t = 0;
   std::size_t samples = 0;   // size of the Poisson-disk sample of this scale
   double meanNeighbors = 0;  // mean neighbours per projection (last fit of each point)
+  double meanMlsSteps = 0;   // mean MLS steps (fits) per point
   std::size_t validPoints = 0;
   double samplingSeconds = 0;    // this level's Poisson-disk sampling
   double indexSeconds = 0;       // building the kd-tree on the sample

@@ -173,6 +173,7 @@ nlohmann::json statsJson(const ScaleStats& s) {
   return {{"t", s.t},
           {"samples", s.samples},
           {"mean_neighbors", s.meanNeighbors},
+          {"mean_mls_steps", s.meanMlsSteps},
           {"valid_points", s.validPoints},
           {"sampling_seconds", s.samplingSeconds},
           {"index_seconds", s.indexSeconds},
@@ -506,6 +507,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
       st.t = s.at("t").get<double>();
       st.samples = s.at("samples").get<std::size_t>();
       st.meanNeighbors = s.at("mean_neighbors").get<double>();
+      st.meanMlsSteps = s.value("mean_mls_steps", 0.0);  // absent from stacks of version <= 0.1
       st.validPoints = s.at("valid_points").get<std::size_t>();
       st.samplingSeconds = s.at("sampling_seconds").get<double>();
       st.indexSeconds = s.at("index_seconds").get<double>();
