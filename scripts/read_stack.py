@@ -3,9 +3,15 @@
 
     /usr/bin/python3 scripts/read_stack.py NAME.stack [--scale J] [--point I]
 
-Every quantity is one .npy file shaped (M, N) or (M, N, 3): memory-map it and index it,
-arr[j] is scale j for all points, arr[:, i] is point i at every scale. Nothing is loaded
-until it is indexed. Needs Debian's python3-numpy.
+Every quantity is one .npy file shaped (M, N), (M, N, 3) or, for bit-packed flags,
+(M, ceil(N / 8)): memory-map it and index it, arr[j] is scale j for all points, arr[:, i] is
+point i at every scale. Nothing is loaded until it is indexed.
+
+Two encodings (manifest "encoding"; format version 1 is always float32):
+  float32  the values as they are (projection.npy, normal.npy, curv_max.npy, ...);
+  compact  quantised (projection_offset.npy, frame.npy, curv_max_t.npy, ...): decode_scale()
+           and decode_point() below turn them back into the float32 quantities.
+Needs Debian's python3-numpy and nothing else.
 """
 import argparse
 import json
@@ -14,6 +20,9 @@ import sys
 
 import numpy as np
 
+OCT_MAX = 1023  # octahedral components: signed-normalised 11 bits, stored as q + 1023
+ANGLE_STEPS = 1024  # dir_max angle: theta = q * pi / 1024, 10 bits
+
 
 def load_stack(path):
     """Returns (manifest, {name: memory-mapped array}, input positions (N, 3) float64)."""
@@ -21,6 +30,8 @@ def load_stack(path):
         manifest = json.load(f)
     if manifest.get("format") != "scalespace-stack":
         raise ValueError(f"{path}: not a scalespace stack")
+    if manifest["format_version"] not in (1, 2):
+        raise ValueError(f"{path}: format version {manifest['format_version']} is not supported")
     arrays = {}
     for name, q in manifest["quantities"].items():
         a = np.load(os.path.join(path, q["file"]), mmap_mode="r")
@@ -31,6 +42,85 @@ def load_stack(path):
     return manifest, arrays, xyz
 
 
+def encoding(manifest):
+    return manifest.get("encoding", "float32")  # version 1 has no "encoding": float32
+
+
+def decode_frame(code):
+    """uint32 frame codes (any shape) -> normal, dir_max, dir_min (shape + (3,), float64).
+
+    bits 0-10: qx + 1023, bits 11-21: qy + 1023 (octahedral normal), bits 22-31: q, the angle
+    theta = q pi / 1024 of dir_max in the tangent basis (b1, b2) of the decoded normal;
+    dir_min = dir_max x normal. Integer arithmetic decides the fold and the basis' sign.
+    """
+    code = np.asarray(code, dtype=np.uint32)
+    qx = np.clip((code & 0x7FF).astype(np.int64) - OCT_MAX, -OCT_MAX, OCT_MAX)
+    qy = np.clip(((code >> 11) & 0x7FF).astype(np.int64) - OCT_MAX, -OCT_MAX, OCT_MAX)
+    z = OCT_MAX - np.abs(qx) - np.abs(qy)
+    lower = z < 0  # lower hemisphere: unfold the corner triangles of the octahedral square
+    x = np.where(lower, (OCT_MAX - np.abs(qy)) * np.where(qx >= 0, 1, -1), qx)
+    y = np.where(lower, (OCT_MAX - np.abs(qx)) * np.where(qy >= 0, 1, -1), qy)
+    n = np.stack([x, y, z], axis=-1).astype(np.float64)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    # Tangent basis of Duff et al. 2017, with the sign of the integer z.
+    s = np.where(z >= 0, 1.0, -1.0)
+    nx, ny, nz = n[..., 0], n[..., 1], n[..., 2]
+    a = -1.0 / (s + nz)
+    b = nx * ny * a
+    b1 = np.stack([1 + s * nx * nx * a, s * b, -s * nx], axis=-1)
+    b2 = np.stack([b, s + ny * ny * a, -ny], axis=-1)
+    theta = (code >> 22).astype(np.float64) * (np.pi / ANGLE_STEPS)
+    dmax = np.cos(theta)[..., None] * b1 + np.sin(theta)[..., None] * b2
+    dmin = np.cross(dmax, n)
+    return n, dmax, dmin
+
+
+def _decode(manifest, arrays, rel, t, index, valid):
+    """Decodes compact arrays at `index` (scale j: (j,); point i: (slice(None), i)).
+    rel: input positions relative to the origin, broadcastable to the result; t: the scale
+    value(s), broadcastable (shape () or (M,)); valid: the fit flags (0/1) at `index`."""
+    def half(name):
+        return np.asarray(arrays[name][index], dtype=np.float64)
+
+    v = valid.astype(bool)
+    out = {"fit_valid": valid.astype(np.uint8),
+           "neighbors": np.asarray(arrays["neighbors"][index]),
+           # projection = input + offset * t, relative to the origin (also for invalid fits)
+           "projection": rel + half("projection_offset") * t[..., None]}
+    n, dmax, dmin = decode_frame(arrays["frame"][index])
+    out["normal"], out["dir_max"], out["dir_min"] = (np.where(v[..., None], a, 0.0) for a in (n, dmax, dmin))
+    out["curv_max"] = np.where(v, half("curv_max_t") / t, 0.0)
+    out["curv_min"] = np.where(v, half("curv_min_t") / t, 0.0)
+    out["curv_mean"] = 0.5 * (out["curv_max"] + out["curv_min"])
+    out["gls_tau"] = np.where(v, half("gls_tau_t") * t, 0.0)
+    out["gls_kappa"] = np.where(v, half("gls_kappa_t") / t, 0.0)
+    out["anisotropy"] = np.where(v, half("anisotropy"), 0.0)
+    out["geometric_variation"] = np.where(v, half("geometric_variation"), 0.0)
+    return out  # gls_fitness is not stored in the compact encoding
+
+
+def decode_scale(manifest, arrays, xyz, j):
+    """Scale j, every point: {name: array (N,) or (N, 3)} with the float32 encoding's names;
+    projection relative to manifest["origin"] as in the float32 files."""
+    if encoding(manifest) == "float32":
+        return {name: np.asarray(a[j]) for name, a in arrays.items()}
+    n = manifest["point_count"]
+    t = np.float64(manifest["scales"][j])
+    rel = np.asarray(xyz, dtype=np.float64) - np.array(manifest["origin"])
+    valid = np.unpackbits(arrays["fit_valid_bits"][j], count=n, bitorder="little")
+    return _decode(manifest, arrays, rel, t, (j,), valid)
+
+
+def decode_point(manifest, arrays, xyz, i):
+    """Point i, every scale: {name: array (M,) or (M, 3)}."""
+    if encoding(manifest) == "float32":
+        return {name: np.asarray(a[:, i]) for name, a in arrays.items()}
+    t = np.asarray(manifest["scales"], dtype=np.float64)
+    rel = np.asarray(xyz[i], dtype=np.float64) - np.array(manifest["origin"])
+    valid = (np.asarray(arrays["fit_valid_bits"][:, i // 8]) >> (i % 8)) & 1
+    return _decode(manifest, arrays, rel, t, (slice(None), i), valid)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("stack")
@@ -39,16 +129,24 @@ def main():
     a = p.parse_args()
     manifest, arrays, xyz = load_stack(a.stack)
     m, n = manifest["scale_count"], manifest["point_count"]
-    print(f"{a.stack}: {n} points x {m} scales, t = {manifest['scales'][0]:.6g} .. {manifest['scales'][-1]:.6g}")
+    print(f"{a.stack}: {n} points x {m} scales, t = {manifest['scales'][0]:.6g} .. {manifest['scales'][-1]:.6g}, "
+          f"encoding {encoding(manifest)}")
     j, i = a.scale, a.point
     origin = np.array(manifest["origin"])
+    scale = decode_scale(manifest, arrays, xyz, j)
     print(f"input position of point {i} = {xyz[i]}")
-    print(f"projection[{j}, {i}] (absolute) = {arrays['projection'][j, i] + origin}")
+    proj = scale["projection"][i] + origin
+    print(f"projection[{j}, {i}] (absolute) = {proj}")
+    for k, c in enumerate("xyz"):
+        print(f"projection_{c}[{j}, {i}] = {proj[k]:.17g}")
+    for name in ("normal", "dir_max", "dir_min"):
+        for k, c in enumerate("xyz"):
+            print(f"{name}_{c}[{j}, {i}] = {float(scale[name][i][k]):.9g}")
     for name in ("curv_mean", "curv_max", "curv_min", "gls_tau", "gls_kappa", "anisotropy"):
-        print(f"{name}[{j}, {i}] = {float(arrays[name][j, i]):.6g}")
-    valid = arrays["fit_valid"][j]
+        print(f"{name}[{j}, {i}] = {float(scale[name][i]):.6g}")
+    valid = scale["fit_valid"]
     print(f"valid fits at scale {j}: {int(valid.sum())} of {n}")
-    print(f"mean curvature of point {i} over the scales: {np.asarray(arrays['curv_mean'][:, i])}")
+    print(f"mean curvature of point {i} over the scales: {decode_point(manifest, arrays, xyz, i)['curv_mean']}")
     return 0
 
 

@@ -106,6 +106,37 @@ TEST_F(Cli, CurvatureOfASphereKeepsRowsAndNamesColumns) {
   }
 }
 
+TEST_F(Cli, ScalesWritesCompactByDefaultAndFloat32OnRequest) {
+  ASSERT_EQ(run("generate sphere -n 2000 --seed 3 -q -o " + path("s.ply")).code, 0);
+  auto info = [&](const std::string& stack) {
+    const std::string out = path("info.txt");
+    const std::string cmd =
+        std::string(SCALESPACE_CLI_PATH) + " stack-info " + stack + " >" + out + " 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  Result r = run("scales " + path("s.ply") + " -o " + path("c.stack") + " --scales 2 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(info(path("c.stack")).find("encoding: compact, 23.125 bytes per point per scale"),
+            std::string::npos)
+      << info(path("c.stack"));
+  r = run("scales " + path("s.ply") + " -o " + path("f.stack") +
+          " --scales 2 -q --encoding float32");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(info(path("f.stack")).find("encoding: float32, 83.000 bytes per point per scale"),
+            std::string::npos)
+      << info(path("f.stack"));
+  r = run("export " + path("c.stack") + " --scale 1 -o " + path("c1.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readCloud(path("c1.ply")).size(), 2000u);
+  r = run("scales " + path("s.ply") + " -o " + path("x.stack") + " --encoding float8");
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
 TEST_F(Cli, CurvatureEstimatesNormalsWhenMissingAndNeverOverwritesItsInput) {
   {
     std::ofstream xyz(path("plane.xyz"));

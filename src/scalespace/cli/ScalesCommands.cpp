@@ -69,7 +69,7 @@ void ensureNormals(PointCloud& cloud, bool quiet) {
 void addScalesCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
-    std::string output, spacing = "log", estimator = "w3";
+    std::string output, spacing = "log", estimator = "w3", encoding = "compact";
     ScaleSpaceOptions options;
     bool noRobust = false, quiet = false;
   };
@@ -97,6 +97,9 @@ void addScalesCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--estimator", args->estimator, "w3 | w2 | w1 | plane | mean | quadric | jet")
       ->capture_default_str();
+  cmd->add_option("--encoding", args->encoding,
+                  "compact (quantised, ~23 bytes per point per scale) | float32 (83 bytes)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "worker threads (0 = all cores)")
       ->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "Poisson-disk sampling seed")
@@ -111,11 +114,13 @@ void addScalesCommand(CLI::App& app) {
     // Validate the series options before the (possibly long) read.
     if (options.series.count < 1) throw OptionError("--scales must be >= 1");
     if (options.alpha < 0) throw OptionError("--alpha must be >= 0");
+    StackWriteOptions write;
+    write.encoding = parseStackEncoding(args->encoding);
     ThreadScope threads(options.threads);
     PointCloud cloud = loadCloud(args->input, args->quiet);
     ensureNormals(cloud, args->quiet);
     const ScaleSpaceSummary s =
-        computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet));
+        computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet), write);
     if (!args->quiet)
       std::fprintf(stderr, "%zu points x %zu scales (t = %.6g .. %.6g) -> %s\n", cloud.size(),
                    s.series.scales.size(), s.series.tMin, s.series.tMax, args->output.c_str());
@@ -243,6 +248,13 @@ bool printStackInfo(const std::string& path, std::ostream& out) {
   const StackInfo& info = reader.info();
   out << path << ": scale stack (format " << info.formatVersion << ", scalespace "
       << info.programVersion << ")\n";
+  char encoding[160];
+  std::snprintf(encoding, sizeof encoding, "  encoding: %s, %.3f bytes per point per scale",
+                stackEncodingName(info.encoding), info.bytesPerPointPerScale);
+  out << encoding;
+  if (info.encoding == StackEncoding::Compact)
+    out << ", " << info.clampedValues << " values clamped to +-65504";
+  out << "\n";
   out << "  points: " << info.pointCount << "\n  scales: " << info.scales.size()
       << " (t = " << info.scales.front() << " .. " << info.scales.back() << ")\n";
   out << "  input checksum: " << std::hex << std::setw(16) << std::setfill('0')

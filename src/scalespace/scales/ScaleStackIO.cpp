@@ -4,15 +4,20 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/scales/StackQuantization.hpp"
 
 #ifndef SCALESPACE_VERSION
 #define SCALESPACE_VERSION "unknown"
@@ -28,29 +33,88 @@ struct Quantity {
   const char* name;
   const char* dtype;
   std::size_t itemSize;
-  int components;  // 1: shape (M, N); 3: shape (M, N, 3)
+  int components;  // 1: shape (M, N); 3: shape (M, N, 3); 0: bit-packed, shape (M, ceil(N / 8))
   const char* description;
-  std::vector<float> ScaleLayer::*floats;  // nullptr for the integer quantities
+  std::vector<float> ScaleLayer::*floats;  // float32 encoding; nullptr for integers and compact
+  const char* scaling;                     // compact: how the stored value relates to t_j
 };
 
-const Quantity kQuantities[] = {
+// The float32 encoding (format version 1): the ScaleLayer fields as they are.
+const Quantity kFloat32Quantities[] = {
     {"projection", "<f4", 4, 3, "projected position relative to manifest origin",
-     &ScaleLayer::projection},
-    {"normal", "<f4", 4, 3, "unit normal", &ScaleLayer::normal},
-    {"dir_max", "<f4", 4, 3, "principal direction of k_max", &ScaleLayer::dirMax},
-    {"dir_min", "<f4", 4, 3, "principal direction of k_min", &ScaleLayer::dirMin},
-    {"curv_mean", "<f4", 4, 1, "mean curvature H", &ScaleLayer::meanCurvature},
-    {"curv_max", "<f4", 4, 1, "principal curvature k_max", &ScaleLayer::kMax},
-    {"curv_min", "<f4", 4, 1, "principal curvature k_min", &ScaleLayer::kMin},
-    {"gls_tau", "<f4", 4, 1, "GLS tau", &ScaleLayer::tau},
-    {"gls_kappa", "<f4", 4, 1, "GLS kappa", &ScaleLayer::kappa},
-    {"gls_fitness", "<f4", 4, 1, "GLS fitness (Pratt norm)", &ScaleLayer::fitness},
-    {"anisotropy", "<f4", 4, 1, "1 - |u_l| (Eq. 1.20)", &ScaleLayer::anisotropy},
+     &ScaleLayer::projection, "none"},
+    {"normal", "<f4", 4, 3, "unit normal", &ScaleLayer::normal, "none"},
+    {"dir_max", "<f4", 4, 3, "principal direction of k_max", &ScaleLayer::dirMax, "none"},
+    {"dir_min", "<f4", 4, 3, "principal direction of k_min", &ScaleLayer::dirMin, "none"},
+    {"curv_mean", "<f4", 4, 1, "mean curvature H", &ScaleLayer::meanCurvature, "none"},
+    {"curv_max", "<f4", 4, 1, "principal curvature k_max", &ScaleLayer::kMax, "none"},
+    {"curv_min", "<f4", 4, 1, "principal curvature k_min", &ScaleLayer::kMin, "none"},
+    {"gls_tau", "<f4", 4, 1, "GLS tau", &ScaleLayer::tau, "none"},
+    {"gls_kappa", "<f4", 4, 1, "GLS kappa", &ScaleLayer::kappa, "none"},
+    {"gls_fitness", "<f4", 4, 1, "GLS fitness (Pratt norm)", &ScaleLayer::fitness, "none"},
+    {"anisotropy", "<f4", 4, 1, "1 - |u_l| (Eq. 1.20)", &ScaleLayer::anisotropy, "none"},
     {"geometric_variation", "<f4", 4, 1, "GLS geometric variation nu",
-     &ScaleLayer::geometricVariation},
-    {"neighbors", "<u2", 2, 1, "samples in the last fit (saturated at 65535)", nullptr},
-    {"fit_valid", "|u1", 1, 1, "1 if the fit is valid", nullptr},
+     &ScaleLayer::geometricVariation, "none"},
+    {"neighbors", "<u2", 2, 1, "samples in the last fit (saturated at 65535)", nullptr, "none"},
+    {"fit_valid", "|u1", 1, 1, "1 if the fit is valid", nullptr, "none"},
 };
+
+// The compact encoding (format version 2, docs/STACK_FORMAT.md): 23.125 bytes per point and
+// scale. The order is the order of the buffers of encodeCompact / decodeCompact.
+enum CompactFile {
+  kOffset,
+  kFrame,
+  kCurvMax,
+  kCurvMin,
+  kTau,
+  kKappa,
+  kAnisotropy,
+  kVariation,
+  kNeighbors,
+  kValidBits,
+  kCompactFiles
+};
+const Quantity kCompactQuantities[] = {
+    {"projection_offset", "<f2", 2, 3, "(projection - input position) / t_j", nullptr, "over_t"},
+    {"frame", "<u4", 4, 1,
+     "bits 0-10, 11-21: octahedral normal (excess 1023); bits 22-31: dir_max angle q pi/1024",
+     nullptr, "none"},
+    {"curv_max_t", "<f2", 2, 1, "k_max * t_j", nullptr, "times_t"},
+    {"curv_min_t", "<f2", 2, 1, "k_min * t_j", nullptr, "times_t"},
+    {"gls_tau_t", "<f2", 2, 1, "GLS tau / t_j", nullptr, "over_t"},
+    {"gls_kappa_t", "<f2", 2, 1, "GLS kappa * t_j", nullptr, "times_t"},
+    {"anisotropy", "<f2", 2, 1, "1 - |u_l| (Eq. 1.20)", nullptr, "none"},
+    {"geometric_variation", "<f2", 2, 1, "GLS geometric variation nu", nullptr, "none"},
+    {"neighbors", "|u1", 1, 1, "samples in the last fit (saturated at 255)", nullptr, "none"},
+    {"fit_valid_bits", "|u1", 1, 0, "1 if the fit is valid, bit-packed (bitorder little)", nullptr,
+     "none"},
+};
+static_assert(sizeof kCompactQuantities / sizeof kCompactQuantities[0] == kCompactFiles);
+
+struct QuantityTable {
+  const Quantity* begin_;
+  const Quantity* end_;
+  const Quantity* begin() const { return begin_; }
+  const Quantity* end() const { return end_; }
+};
+QuantityTable quantities(StackEncoding e) {
+  if (e == StackEncoding::Compact)
+    return {std::begin(kCompactQuantities), std::end(kCompactQuantities)};
+  return {std::begin(kFloat32Quantities), std::end(kFloat32Quantities)};
+}
+
+// Bytes of one scale of a quantity, and of one point of it (bit-packed: the byte holding it).
+std::size_t sliceBytes(const Quantity& q, std::size_t n) {
+  return q.components == 0 ? quant::packedBytes(n) : n * std::size_t(q.components) * q.itemSize;
+}
+std::size_t pointBytes(const Quantity& q) {
+  return q.components == 0 ? 1 : std::size_t(q.components) * q.itemSize;
+}
+std::uint64_t pointOffset(const Quantity& q, std::size_t n, std::size_t j, std::size_t i) {
+  if (q.components == 0) return std::uint64_t(j) * quant::packedBytes(n) + i / 8;
+  return (std::uint64_t(j) * n + i) * pointBytes(q);
+}
+
 constexpr const char* kManifest = "manifest.json";
 
 const unsigned char* layerBytes(const Quantity& q, const ScaleLayer& layer) {
@@ -61,6 +125,89 @@ const unsigned char* layerBytes(const Quantity& q, const ScaleLayer& layer) {
 }
 unsigned char* layerBytes(const Quantity& q, ScaleLayer& layer) {
   return const_cast<unsigned char*>(layerBytes(q, static_cast<const ScaleLayer&>(layer)));
+}
+
+// float -> float16 with a count of the clamped (or non-finite) values per file.
+struct HalfWriter {
+  std::size_t* clamped;
+  void operator()(double v, unsigned char* out) const {
+    bool c = false;
+    const std::uint16_t h = quant::floatToHalf(float(v), c);
+    if (c) ++*clamped;
+    std::memcpy(out, &h, 2);
+  }
+};
+
+float readHalf(const unsigned char* p) {
+  std::uint16_t h;
+  std::memcpy(&h, p, 2);
+  return quant::halfToFloat(h);
+}
+
+// Encodes one scale (t: its scale value; rel: input positions relative to the origin, 3 N).
+void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel,
+                   std::vector<std::vector<unsigned char>>& buf,
+                   std::vector<std::size_t>& clamped) {
+  const std::size_t n = L.size();
+  for (int k = 0; k < kCompactFiles; ++k) buf[k].assign(sliceBytes(kCompactQuantities[k], n), 0);
+  auto half = [&](int k) { return HalfWriter{&clamped[std::size_t(k)]}; };
+  for (std::size_t i = 0; i < n; ++i) {
+    // The projection is meaningful for invalid fits too (the last valid one): always stored.
+    for (int c = 0; c < 3; ++c)
+      half(kOffset)((double(L.projection[3 * i + c]) - rel[3 * i + c]) / t,
+                    &buf[kOffset][6 * i + 2 * c]);
+    buf[kNeighbors][i] = std::uint8_t(std::min<unsigned>(L.neighbors[i], 255u));
+    if (!L.valid[i]) continue;  // zeros: decoded as zeros
+    const auto v3 = [&](const std::vector<float>& a) {
+      return Vec3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+    };
+    const std::uint32_t frame = quant::encodeFrame(v3(L.normal), v3(L.dirMax));
+    std::memcpy(&buf[kFrame][4 * i], &frame, 4);
+    half(kCurvMax)(double(L.kMax[i]) * t, &buf[kCurvMax][2 * i]);
+    half(kCurvMin)(double(L.kMin[i]) * t, &buf[kCurvMin][2 * i]);
+    half(kTau)(double(L.tau[i]) / t, &buf[kTau][2 * i]);
+    half(kKappa)(double(L.kappa[i]) * t, &buf[kKappa][2 * i]);
+    half(kAnisotropy)(double(L.anisotropy[i]), &buf[kAnisotropy][2 * i]);
+    half(kVariation)(double(L.geometricVariation[i]), &buf[kVariation][2 * i]);
+  }
+  quant::packBits(L.valid.data(), n, buf[kValidBits].data());
+}
+
+// Decodes `count` consecutive points of one scale: data[k] points at the first point's bytes of
+// file k (for the bit-packed flags: the byte holding it, whose bit is firstBit); rel are the
+// points' input positions relative to the origin. Point p goes to entry out0 + p of `out`.
+void decodeCompact(const std::vector<const unsigned char*>& data, std::size_t firstBit,
+                   std::size_t count, double t, const double* rel, ScaleLayer& out,
+                   std::size_t out0) {
+  for (std::size_t p = 0; p < count; ++p) {
+    const std::size_t o = out0 + p;
+    for (int c = 0; c < 3; ++c)
+      out.projection[3 * o + c] =
+          float(rel[3 * p + c] + double(readHalf(data[kOffset] + 6 * p + 2 * c)) * t);
+    out.neighbors[o] = data[kNeighbors][p];
+    const std::uint8_t valid = quant::unpackBit(data[kValidBits], firstBit + p);
+    out.valid[o] = valid;
+    if (!valid) continue;  // out was zero-initialised
+    std::uint32_t frame;
+    std::memcpy(&frame, data[kFrame] + 4 * p, 4);
+    Vec3 nrm, dmax, dmin;
+    quant::decodeFrame(frame, nrm, dmax, dmin);
+    for (int c = 0; c < 3; ++c) {
+      out.normal[3 * o + c] = float(nrm[c]);
+      out.dirMax[3 * o + c] = float(dmax[c]);
+      out.dirMin[3 * o + c] = float(dmin[c]);
+    }
+    const double kMax = double(readHalf(data[kCurvMax] + 2 * p)) / t;
+    const double kMin = double(readHalf(data[kCurvMin] + 2 * p)) / t;
+    out.kMax[o] = float(kMax);
+    out.kMin[o] = float(kMin);
+    out.meanCurvature[o] = float(0.5 * (kMax + kMin));
+    out.tau[o] = float(double(readHalf(data[kTau] + 2 * p)) * t);
+    out.kappa[o] = float(double(readHalf(data[kKappa] + 2 * p)) / t);
+    out.fitness[o] = 0;  // not stored in the compact encoding
+    out.anisotropy[o] = readHalf(data[kAnisotropy] + 2 * p);
+    out.geometricVariation[o] = readHalf(data[kVariation] + 2 * p);
+  }
 }
 
 // 64-bit FNV-1a-style hash over 8-byte little-endian words of the whole data stream (a final
@@ -128,6 +275,7 @@ std::string npyHeader(const std::string& dtype, const std::vector<std::size_t>& 
 }
 
 std::vector<std::size_t> quantityShape(const Quantity& q, std::size_t m, std::size_t n) {
+  if (q.components == 0) return {m, quant::packedBytes(n)};
   if (q.components == 1) return {m, n};
   return {m, n, std::size_t(q.components)};
 }
@@ -198,15 +346,30 @@ nlohmann::json optionsJson(const ScaleSpaceOptions& o) {
 
 }  // namespace
 
+const char* stackEncodingName(StackEncoding encoding) {
+  return encoding == StackEncoding::Compact ? "compact" : "float32";
+}
+
+StackEncoding parseStackEncoding(const std::string& name) {
+  if (name == "compact") return StackEncoding::Compact;
+  if (name == "float32") return StackEncoding::Float32;
+  throw OptionError("--encoding must be compact or float32, not '" + name + "'");
+}
+
 // ---------------------------------------------------------------------------------------- writer
 
 struct ScaleStackWriter::Impl {
   fs::path finalPath, tmpPath;
   std::size_t n = 0, m = 0, written = 0;
+  StackEncoding encoding = StackEncoding::Compact;
   std::vector<int> fds;
   std::vector<Checksum> sums;
   std::uint64_t positionsSum = 0;
   Vec3 origin;
+  std::vector<double> scales;                    // t_j given to writeScale
+  std::vector<double> inputRel;                  // compact: input positions - origin, 3 N
+  std::vector<std::vector<unsigned char>> bufs;  // compact: one scale, encoded
+  std::vector<std::size_t> clamped;              // compact: clamped values per file
   nlohmann::json parameters;
   bool finished = false;
 
@@ -220,7 +383,8 @@ struct ScaleStackWriter::Impl {
 };
 
 ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cloud,
-                                   const ScaleSpaceOptions& options, std::size_t scaleCount)
+                                   const ScaleSpaceOptions& options, std::size_t scaleCount,
+                                   const StackWriteOptions& write)
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   std::string clean = path;
@@ -231,6 +395,9 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
   d.m = scaleCount;
   d.origin = cloud.origin();
   d.parameters = optionsJson(options);
+  d.encoding = write.encoding;
+  d.clamped.assign(kCompactFiles, 0);
+  d.bufs.resize(kCompactFiles);
   std::error_code ec;
   fs::remove_all(d.tmpPath, ec);
   if (!fs::create_directories(d.tmpPath, ec) || ec)
@@ -238,7 +405,7 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
                     "cannot create the temporary stack directory: " + ec.message(),
                     "check that the parent directory exists and is writable");
   try {
-    for (const Quantity& q : kQuantities) {
+    for (const Quantity& q : quantities(d.encoding)) {
       const std::string file = (d.tmpPath / (std::string(q.name) + ".npy")).string();
       const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       if (fd < 0)
@@ -261,6 +428,11 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
       xyz[3 * i] = p.x(), xyz[3 * i + 1] = p.y(), xyz[3 * i + 2] = p.z();
     }
     writeAll(fd, xyz.data(), xyz.size() * 8, file);
+    if (d.encoding == StackEncoding::Compact) {
+      // Exactly what the reader computes: input - origin, from the stored doubles.
+      d.inputRel.resize(3 * d.n);
+      for (std::size_t k = 0; k < 3 * d.n; ++k) d.inputRel[k] = xyz[k] - d.origin[int(k % 3)];
+    }
     Checksum c;
     c.add(reinterpret_cast<const unsigned char*>(xyz.data()), xyz.size() * 8);
     d.positionsSum = c.value();
@@ -282,7 +454,7 @@ ScaleStackWriter::~ScaleStackWriter() {
   }
 }
 
-void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer) {
+void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double t) {
   Impl& d = *impl_;
   if (j != d.written || j >= d.m)
     throw Error("ScaleStackWriter: scale " + std::to_string(j) +
@@ -291,15 +463,26 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer) {
   if (layer.size() != d.n)
     throw Error("ScaleStackWriter: layer has " + std::to_string(layer.size()) +
                 " points, expected " + std::to_string(d.n));
+  if (!(t > 0) || !std::isfinite(t))
+    throw Error("ScaleStackWriter: scale " + std::to_string(j) + " has t = " + std::to_string(t));
+  const bool compact = d.encoding == StackEncoding::Compact;
+  if (compact) encodeCompact(layer, t, d.inputRel, d.bufs, d.clamped);
   std::size_t k = 0;
-  for (const Quantity& q : kQuantities) {
-    const std::size_t bytes = d.n * std::size_t(q.components) * q.itemSize;
-    const unsigned char* p = layerBytes(q, layer);
+  for (const Quantity& q : quantities(d.encoding)) {
+    const std::size_t bytes = sliceBytes(q, d.n);
+    const unsigned char* p = compact ? d.bufs[k].data() : layerBytes(q, layer);
     writeAll(d.fds[k], p, bytes, (d.tmpPath / q.name).string() + ".npy");
     d.sums[k].add(p, bytes);
     ++k;
   }
+  d.scales.push_back(t);
   ++d.written;
+}
+
+std::size_t ScaleStackWriter::clampedValues() const {
+  std::size_t total = 0;
+  for (std::size_t c : impl_->clamped) total += c;
+  return total;
 }
 
 void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
@@ -307,11 +490,23 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
   if (d.written != d.m)
     throw Error("ScaleStackWriter: " + std::to_string(d.written) + " of " + std::to_string(d.m) +
                 " scales written before finish()");
+  if (summary.series.scales.size() != d.m)
+    throw Error("ScaleStackWriter: the summary has " +
+                std::to_string(summary.series.scales.size()) + " scales, expected " +
+                std::to_string(d.m));
+  for (std::size_t j = 0; j < d.m; ++j)
+    if (std::abs(summary.series.scales[j] - d.scales[j]) > 1e-12 * d.scales[j])
+      throw Error("ScaleStackWriter: scale " + std::to_string(j) +
+                  " was written with t = " + std::to_string(d.scales[j]) +
+                  " but the summary says " + std::to_string(summary.series.scales[j]));
   for (int fd : d.fds) ::fsync(fd);
   d.closeAll();
   nlohmann::json manifest;
   manifest["format"] = "scalespace-stack";
-  manifest["format_version"] = kStackFormatVersion;
+  const bool compact = d.encoding == StackEncoding::Compact;
+  // Float32 stacks stay version 1 (readable by older programs); compact stacks are version 2.
+  manifest["format_version"] = compact ? 2 : 1;
+  manifest["encoding"] = stackEncodingName(d.encoding);
   manifest["program"] = "scalespace";
   manifest["program_version"] = SCALESPACE_VERSION;
   manifest["point_count"] = d.n;
@@ -322,21 +517,29 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
   manifest["origin"] = {d.origin.x(), d.origin.y(), d.origin.z()};
   manifest["input_checksum"] = hex64(summary.inputChecksum);
   manifest["checksum_algorithm"] = "fnv1a64-words";
-  manifest["quantisation"] = "none";
+  manifest["quantisation"] = compact ? "compact" : "none";
   manifest["parameters"] = d.parameters;
   nlohmann::json stats = nlohmann::json::array();
   for (const ScaleStats& s : summary.stats) stats.push_back(statsJson(s));
   manifest["stats"] = stats;
   manifest["total_seconds"] = summary.totalSeconds;
-  nlohmann::json quantities = nlohmann::json::object();
+  nlohmann::json entries = nlohmann::json::object();
   std::size_t k = 0;
-  for (const Quantity& q : kQuantities) {
-    quantities[q.name] = {
+  std::size_t clampedTotal = 0;
+  for (const Quantity& q : quantities(d.encoding)) {
+    entries[q.name] = {
         {"file", std::string(q.name) + ".npy"}, {"dtype", q.dtype},
         {"shape", quantityShape(q, d.m, d.n)},  {"scale_factor", 1.0},
-        {"description", q.description},         {"checksum", hex64(d.sums[k++].value())}};
+        {"description", q.description},         {"checksum", hex64(d.sums[k].value())}};
+    if (compact) {
+      entries[q.name]["scaling"] = q.scaling;
+      entries[q.name]["clamped"] = d.clamped[k];
+      clampedTotal += d.clamped[k];
+    }
+    ++k;
   }
-  manifest["quantities"] = quantities;
+  manifest["quantities"] = entries;
+  if (compact) manifest["clamped_values"] = clampedTotal;
   manifest["input_positions"] = {{"file", "input_positions.npy"},
                                  {"dtype", "<f8"},
                                  {"shape", {d.n, 3}},
@@ -377,16 +580,17 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
 }
 
 ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOptions& options,
-                                    const std::string& path, const ProgressCallback& progress) {
+                                    const std::string& path, const ProgressCallback& progress,
+                                    const StackWriteOptions& write) {
   std::unique_ptr<ScaleStackWriter> writer;
   ScaleSpaceSummary summary = runScaleSpace(
       cloud, options,
-      [&](std::size_t j, const ScaleLayer& layer, const ScaleStats&) {
+      [&](std::size_t j, const ScaleLayer& layer, const ScaleStats& stats) {
         // The series is known only once runScaleSpace resolved t_min; M is the option count.
         if (!writer)
           writer = std::make_unique<ScaleStackWriter>(path, cloud, options,
-                                                      std::size_t(options.series.count));
-        writer->writeScale(j, layer);
+                                                      std::size_t(options.series.count), write);
+        writer->writeScale(j, layer, stats.t);
       },
       progress);
   if (!writer) throw Error("computeScaleStack: no scale was computed");
@@ -395,9 +599,11 @@ ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOpt
 }
 
 void writeScaleStack(const std::string& path, const PointCloud& cloud,
-                     const ScaleSpaceOptions& options, const ScaleStack& stack) {
-  ScaleStackWriter writer(path, cloud, options, stack.layers.size());
-  for (std::size_t j = 0; j < stack.layers.size(); ++j) writer.writeScale(j, stack.layers[j]);
+                     const ScaleSpaceOptions& options, const ScaleStack& stack,
+                     const StackWriteOptions& write) {
+  ScaleStackWriter writer(path, cloud, options, stack.layers.size(), write);
+  for (std::size_t j = 0; j < stack.layers.size(); ++j)
+    writer.writeScale(j, stack.layers[j], stack.summary.series.scales.at(j));
   writer.finish(stack.summary);
 }
 
@@ -406,13 +612,26 @@ void writeScaleStack(const std::string& path, const PointCloud& cloud,
 struct ScaleStackReader::Impl {
   fs::path dir;
   StackInfo info;
-  std::vector<int> fds;  // one per kQuantities entry
+  std::vector<int> fds;  // one per quantity of the encoding
+  QuantityTable table = quantities(StackEncoding::Float32);
   std::vector<std::uint64_t> dataOffset;
   std::vector<std::string> files;
   std::vector<std::string> sums;
   int positionsFd = -1;
   std::uint64_t positionsOffset = 0;
   std::string positionsFile, positionsSum;
+  // Compact: input positions relative to the origin (3 N), read on the first readScale.
+  std::once_flag relOnce;
+  std::vector<double> rel;
+
+  const std::vector<double>& inputRel() {
+    std::call_once(relOnce, [&] {
+      rel.resize(3 * info.pointCount);
+      preadAll(positionsFd, rel.data(), rel.size() * 8, positionsOffset, positionsFile);
+      for (std::size_t k = 0; k < rel.size(); ++k) rel[k] -= info.origin[int(k % 3)];
+    });
+    return rel;
+  }
 
   ~Impl() {
     for (int fd : fds)
@@ -485,10 +704,10 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
       throw FileError(manifestPath, "", "not a scalespace stack manifest", fix);
     StackInfo& info = d.info;
     info.formatVersion = manifest.at("format_version").get<int>();
-    if (info.formatVersion != kStackFormatVersion)
+    if (info.formatVersion < 1 || info.formatVersion > kStackFormatVersion)
       throw FileError(manifestPath, "",
                       "format version " + std::to_string(info.formatVersion) +
-                          " is not supported (this program reads version " +
+                          " is not supported (this program reads versions 1 to " +
                           std::to_string(kStackFormatVersion) + ")",
                       "recompute the stack with this version of scalespace");
     info.programVersion = manifest.at("program_version").get<std::string>();
@@ -519,14 +738,30 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
                       "stats has " + std::to_string(info.stats.size()) + " entries for " +
                           std::to_string(info.scales.size()) + " scales",
                       fix);
-    if (manifest.at("quantisation").get<std::string>() != "none")
-      throw FileError(
-          manifestPath, "",
-          "unknown quantisation '" + manifest.at("quantisation").get<std::string>() + "'", fix);
+    // Version 1 is float32 only; version 2 names its encoding.
+    const std::string encoding =
+        info.formatVersion == 1 ? "float32" : manifest.at("encoding").get<std::string>();
+    if (encoding == "compact") {
+      info.encoding = StackEncoding::Compact;
+    } else if (encoding == "float32") {
+      info.encoding = StackEncoding::Float32;
+    } else {
+      throw FileError(manifestPath, "", "unknown encoding '" + encoding + "'", fix);
+    }
+    const std::string quantisation = manifest.at("quantisation").get<std::string>();
+    if (quantisation != (info.encoding == StackEncoding::Compact ? "compact" : "none"))
+      throw FileError(manifestPath, "", "unknown quantisation '" + quantisation + "'", fix);
+    info.clampedValues = manifest.value("clamped_values", std::size_t(0));
+    d.table = quantities(info.encoding);
+    for (std::size_t j = 0; j < info.scales.size(); ++j)
+      if (!(info.scales[j] > 0) || !std::isfinite(info.scales[j]))
+        throw FileError(manifestPath, "", "scale " + std::to_string(j) + " is not positive", fix);
     info.parametersJson = manifest.at("parameters").dump();
     info.manifestJson = manifest.dump(1);
     const std::size_t m = info.scales.size(), n = info.pointCount;
-    for (const Quantity& q : kQuantities) {
+    std::size_t perScale = 0;
+    for (const Quantity& q : d.table) {
+      perScale += sliceBytes(q, n);
       const auto& entry = manifest.at("quantities").at(q.name);
       if (entry.at("dtype").get<std::string>() != q.dtype ||
           entry.at("shape").get<std::vector<std::size_t>>() != quantityShape(q, m, n))
@@ -540,6 +775,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
       d.files.push_back(file);
       d.sums.push_back(entry.at("checksum").get<std::string>());
     }
+    info.bytesPerPointPerScale = n ? double(perScale) / double(n) : 0.0;
     const auto& pos = manifest.at("input_positions");
     d.positionsFile = (d.dir / pos.at("file").get<std::string>()).string();
     d.positionsSum = pos.at("checksum").get<std::string>();
@@ -558,7 +794,7 @@ ScaleStackReader::~ScaleStackReader() = default;
 const StackInfo& ScaleStackReader::info() const { return impl_->info; }
 
 ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
-  const Impl& d = *impl_;
+  Impl& d = *impl_;
   if (j >= scaleCount())
     throw OptionError("--scale " + std::to_string(j) + " is out of range: the stack has " +
                       std::to_string(scaleCount()) + " scales (0.." +
@@ -566,30 +802,57 @@ ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
   const std::size_t n = pointCount();
   ScaleLayer layer;
   layer.resize(n);
+  const bool compact = info().encoding == StackEncoding::Compact;
+  std::vector<std::vector<unsigned char>> bufs(compact ? kCompactFiles : 0);
+  std::vector<const unsigned char*> rows;
   std::size_t k = 0;
-  for (const Quantity& q : kQuantities) {
-    const std::size_t bytes = n * std::size_t(q.components) * q.itemSize;
-    preadAll(d.fds[k], layerBytes(q, layer), bytes, d.dataOffset[k] + std::uint64_t(j) * bytes,
-             d.files[k]);
+  for (const Quantity& q : d.table) {
+    const std::size_t bytes = sliceBytes(q, n);
+    unsigned char* out = layerBytes(q, layer);
+    if (compact) {
+      bufs[k].resize(bytes);
+      out = bufs[k].data();
+      rows.push_back(out);
+    }
+    preadAll(d.fds[k], out, bytes, d.dataOffset[k] + std::uint64_t(j) * bytes, d.files[k]);
     ++k;
   }
+  if (compact) decodeCompact(rows, 0, n, info().scales[j], d.inputRel().data(), layer, 0);
   return layer;
 }
 
 ScaleLayer ScaleStackReader::readPointSeries(std::size_t i) const {
-  const Impl& d = *impl_;
+  Impl& d = *impl_;
   if (i >= pointCount())
     throw OptionError("--point " + std::to_string(i) + " is out of range: the stack has " +
                       std::to_string(pointCount()) + " points");
   const std::size_t m = scaleCount(), n = pointCount();
   ScaleLayer series;
   series.resize(m);
+  if (info().encoding == StackEncoding::Compact) {
+    double rel[3];
+    preadAll(d.positionsFd, rel, 24, d.positionsOffset + std::uint64_t(i) * 24, d.positionsFile);
+    for (int c = 0; c < 3; ++c) rel[c] -= info().origin[c];
+    unsigned char item[kCompactFiles][8];
+    std::vector<const unsigned char*> ptrs(kCompactFiles);
+    for (std::size_t j = 0; j < m; ++j) {
+      std::size_t k = 0;
+      for (const Quantity& q : d.table) {
+        preadAll(d.fds[k], item[k], pointBytes(q), d.dataOffset[k] + pointOffset(q, n, j, i),
+                 d.files[k]);
+        ptrs[k] = item[k];
+        ++k;
+      }
+      decodeCompact(ptrs, i % 8, 1, info().scales[j], rel, series, j);
+    }
+    return series;
+  }
   std::size_t k = 0;
-  for (const Quantity& q : kQuantities) {
-    const std::size_t item = std::size_t(q.components) * q.itemSize;
+  for (const Quantity& q : d.table) {
+    const std::size_t item = pointBytes(q);
     unsigned char* out = layerBytes(q, series);
     for (std::size_t j = 0; j < m; ++j)
-      preadAll(d.fds[k], out + j * item, item, d.dataOffset[k] + (std::uint64_t(j) * n + i) * item,
+      preadAll(d.fds[k], out + j * item, item, d.dataOffset[k] + pointOffset(q, n, j, i),
                d.files[k]);
     ++k;
   }
@@ -625,8 +888,8 @@ void ScaleStackReader::verifyChecksums() const {
   };
   const std::uint64_t m = scaleCount(), n = pointCount();
   std::size_t k = 0;
-  for (const Quantity& q : kQuantities) {
-    check(d.fds[k], d.dataOffset[k], m * n * std::uint64_t(q.components) * q.itemSize, d.files[k],
+  for (const Quantity& q : d.table) {
+    check(d.fds[k], d.dataOffset[k], m * std::uint64_t(sliceBytes(q, std::size_t(n))), d.files[k],
           d.sums[k]);
     ++k;
   }

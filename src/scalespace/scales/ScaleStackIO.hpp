@@ -18,22 +18,44 @@
 
 namespace scalespace {
 
-constexpr int kStackFormatVersion = 1;
+/// The newest format version this program writes and reads. Version 1: float32 only; version 2
+/// adds the "encoding" key and the compact encoding. Float32 stacks are still written as version 1
+/// (identical to what older programs wrote and read); compact stacks are version 2.
+constexpr int kStackFormatVersion = 2;
+
+/// How the per-scale quantities are stored (docs/STACK_FORMAT.md).
+enum class StackEncoding {
+  Compact,  // quantised, 23.125 bytes per point per scale (float16, octahedral frame, bit flags)
+  Float32,  // every ScaleLayer field as float32 / uint16 / uint8, 83 bytes per point per scale
+};
+const char* stackEncodingName(StackEncoding encoding);
+/// "compact" | "float32"; OptionError otherwise.
+StackEncoding parseStackEncoding(const std::string& name);
+
+/// How a stack is written (kept apart from ScaleSpaceOptions: it does not change the results).
+struct StackWriteOptions {
+  StackEncoding encoding = StackEncoding::Compact;
+};
 
 /// Streams a stack to disk scale by scale (peak memory: one ScaleLayer).
 class ScaleStackWriter {
  public:
   /// Creates NAME.stack.tmp-<pid>/ beside `path`; throws FileError if it cannot.
   ScaleStackWriter(const std::string& path, const PointCloud& cloud,
-                   const ScaleSpaceOptions& options, std::size_t scaleCount);
+                   const ScaleSpaceOptions& options, std::size_t scaleCount,
+                   const StackWriteOptions& write = {});
   /// Removes the temporary directory unless finish() succeeded.
   ~ScaleStackWriter();
   ScaleStackWriter(const ScaleStackWriter&) = delete;
   ScaleStackWriter& operator=(const ScaleStackWriter&) = delete;
 
-  /// Appends scale j; scales must come in order 0, 1, ..., scaleCount-1.
-  void writeScale(std::size_t j, const ScaleLayer& layer);
-  /// Writes the manifest (scales, stats, checksums), syncs and renames into place.
+  /// Appends scale j of scale value t (the compact encoding stores lengths in units of t); scales
+  /// must come in order 0, 1, ..., scaleCount-1.
+  void writeScale(std::size_t j, const ScaleLayer& layer, double t);
+  /// Values clamped to +-65504 (or non-finite values zeroed) by the compact encoding so far.
+  std::size_t clampedValues() const;
+  /// Writes the manifest (scales, stats, checksums), syncs and renames into place. Throws Error if
+  /// the summary's scale values differ from those given to writeScale.
   void finish(const ScaleSpaceSummary& summary);
 
  private:
@@ -43,15 +65,20 @@ class ScaleStackWriter {
 
 /// Computes the scale space of `cloud` and streams it into the stack `path`.
 ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOptions& options,
-                                    const std::string& path, const ProgressCallback& progress = {});
+                                    const std::string& path, const ProgressCallback& progress = {},
+                                    const StackWriteOptions& write = {});
 
 /// Writes an in-memory stack.
 void writeScaleStack(const std::string& path, const PointCloud& cloud,
-                     const ScaleSpaceOptions& options, const ScaleStack& stack);
+                     const ScaleSpaceOptions& options, const ScaleStack& stack,
+                     const StackWriteOptions& write = {});
 
 /// What the manifest says, besides the arrays.
 struct StackInfo {
   int formatVersion = 0;
+  StackEncoding encoding = StackEncoding::Float32;
+  double bytesPerPointPerScale = 0;  // the per-scale files' data, divided by N
+  std::size_t clampedValues = 0;     // compact: values clamped to +-65504 when written
   std::string programVersion;
   std::size_t pointCount = 0;
   std::vector<double> scales;
@@ -76,7 +103,8 @@ class ScaleStackReader {
   std::size_t pointCount() const { return info().pointCount; }
   std::size_t scaleCount() const { return info().scales.size(); }
 
-  /// Scale j for every point (input order).
+  /// Scale j for every point (input order). A compact stack is decoded (docs/STACK_FORMAT.md):
+  /// invalid fits read as zeros, never NaN.
   ScaleLayer readScale(std::size_t j) const;
   /// Point i at every scale: entry j of each array is scale j.
   ScaleLayer readPointSeries(std::size_t i) const;

@@ -1,0 +1,177 @@
+#include "scalespace/scales/StackQuantization.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace scalespace::quant {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+// ------------------------------------------------------------------------------------ float16
+
+std::uint16_t floatToHalf(float value, bool& clamped) {
+  // Integer-only, so the result does not depend on the FPU rounding mode or on _Float16 support.
+  std::uint32_t x;
+  std::memcpy(&x, &value, 4);
+  const std::uint16_t sign = std::uint16_t((x >> 16) & 0x8000u);
+  x &= 0x7fffffffu;
+  if (x > 0x7f800000u) {  // NaN: never written; counted with the clamped values
+    clamped = true;
+    return 0;
+  }
+  if (x >= 0x38800000u) {  // |value| >= 2^-14: a normal half (or an overflow)
+    // Rebias the exponent (127 -> 15) and round the 13 dropped mantissa bits to nearest even; a
+    // carry out of the mantissa correctly bumps the exponent.
+    std::uint32_t h = x - ((127u - 15u) << 23);
+    const std::uint32_t odd = (h >> 13) & 1u;
+    h += 0xfffu + odd;
+    h >>= 13;
+    if (h >= 0x7c00u) {  // would be inf: clamp to the largest finite half
+      clamped = true;
+      return std::uint16_t(sign | 0x7bffu);
+    }
+    return std::uint16_t(sign | h);
+  }
+  if (x < 0x33000000u) return sign;  // |value| <= 2^-25 (the tie rounds to the even 0)
+  // Subnormal half: value = m * 2^(e - 150), in units of 2^-24 that is m >> (126 - e).
+  const std::uint32_t e = x >> 23;
+  const std::uint32_t m = (x & 0x7fffffu) | 0x800000u;
+  const std::uint32_t shift = 126u - e;  // 14..24
+  std::uint32_t h = m >> shift;
+  const std::uint32_t rem = m & ((1u << shift) - 1u), half = 1u << (shift - 1u);
+  if (rem > half || (rem == half && (h & 1u))) ++h;  // may carry into the smallest normal: right
+  return std::uint16_t(sign | h);
+}
+
+float halfToFloat(std::uint16_t bits) {
+  const std::uint32_t sign = std::uint32_t(bits & 0x8000u) << 16;
+  const std::uint32_t exp = (bits >> 10) & 0x1fu, mant = bits & 0x3ffu;
+  std::uint32_t x;
+  if (exp == 0) {
+    // Zero or subnormal: mant * 2^-24 is exact in float32.
+    const float f = std::ldexp(float(mant), -24);
+    std::memcpy(&x, &f, 4);
+    x |= sign;
+  } else if (exp == 31) {
+    x = sign | 0x7f800000u | (mant << 13);
+  } else {
+    x = sign | ((exp + 127u - 15u) << 23) | (mant << 13);
+  }
+  float out;
+  std::memcpy(&out, &x, 4);
+  return out;
+}
+
+// -------------------------------------------------------------------------------- octahedral
+
+namespace {
+
+// Decodes an octahedral code; zInt is the integer z of the unfolded octahedron point, whose sign
+// picks the tangent basis (exact, unlike the sign of a rounded float).
+Vec3 decodeOct(std::uint32_t code, int& zInt) {
+  const int qx = std::clamp(int(code & 0x7ffu) - kOctMax, -kOctMax, kOctMax);
+  const int qy = std::clamp(int((code >> kOctBits) & 0x7ffu) - kOctMax, -kOctMax, kOctMax);
+  int x = qx, y = qy;
+  const int z = kOctMax - std::abs(qx) - std::abs(qy);
+  if (z < 0) {  // lower hemisphere: unfold the triangles of the square's corners
+    x = (kOctMax - std::abs(qy)) * (qx >= 0 ? 1 : -1);
+    y = (kOctMax - std::abs(qx)) * (qy >= 0 ? 1 : -1);
+  }
+  zInt = z;
+  return Vec3(x, y, z).normalized();  // |x| + |y| + |z| = 1023: never zero
+}
+
+std::uint32_t octCode(int qx, int qy) {
+  return std::uint32_t(qx + kOctMax) | (std::uint32_t(qy + kOctMax) << kOctBits);
+}
+
+}  // namespace
+
+std::uint32_t encodeOctahedral(const Vec3& nIn) {
+  Vec3 n = nIn;
+  double l1 = n.cwiseAbs().sum();
+  if (!(l1 > 0) || !std::isfinite(l1)) {
+    n = Vec3::UnitZ();
+    l1 = 1;
+  }
+  double u = n.x() / l1, v = n.y() / l1;
+  if (n.z() < 0) {
+    const double fu = (1 - std::abs(v)) * (u >= 0 ? 1 : -1);
+    const double fv = (1 - std::abs(u)) * (v >= 0 ? 1 : -1);
+    u = fu, v = fv;
+  }
+  const Vec3 unit = n.normalized();
+  const double su = u * kOctMax, sv = v * kOctMax;
+  std::uint32_t best = 0;
+  double bestDot = -2;
+  for (const double cu : {std::floor(su), std::ceil(su)})
+    for (const double cv : {std::floor(sv), std::ceil(sv)}) {
+      const int qx = std::clamp(int(cu), -kOctMax, kOctMax);
+      const int qy = std::clamp(int(cv), -kOctMax, kOctMax);
+      const std::uint32_t code = octCode(qx, qy);
+      int z;
+      const double dot = decodeOct(code, z).dot(unit);
+      if (dot > bestDot) bestDot = dot, best = code;
+    }
+  return best;
+}
+
+Vec3 decodeOctahedral(std::uint32_t code) {
+  int z;
+  return decodeOct(code, z);
+}
+
+// --------------------------------------------------------------------- frame (normal, dir_max)
+
+void tangentBasis(const Vec3& n, int zSign, Vec3& b1, Vec3& b2) {
+  const double s = zSign >= 0 ? 1.0 : -1.0;
+  const double a = -1.0 / (s + n.z());
+  const double b = n.x() * n.y() * a;
+  b1 = Vec3(1 + s * n.x() * n.x() * a, s * b, -s * n.x());
+  b2 = Vec3(b, s + n.y() * n.y() * a, -n.y());
+}
+
+std::uint32_t encodeFrame(const Vec3& normal, const Vec3& dirMax) {
+  const std::uint32_t oct = encodeOctahedral(normal);
+  int z;
+  const Vec3 n = decodeOct(oct, z);
+  Vec3 b1, b2;
+  tangentBasis(n, z, b1, b2);
+  std::uint32_t q = 0;
+  const double c = dirMax.dot(b1), s = dirMax.dot(b2);
+  if (std::isfinite(c) && std::isfinite(s) && (c != 0 || s != 0)) {
+    double theta = std::atan2(s, c);  // [-pi, pi]
+    if (theta < 0) theta += kPi;      // an axis: theta and theta + pi are the same line
+    q = std::uint32_t(std::lround(theta * (kAngleSteps / kPi))) % std::uint32_t(kAngleSteps);
+  }
+  return oct | (q << (2 * kOctBits));
+}
+
+void decodeFrame(std::uint32_t code, Vec3& normal, Vec3& dirMax, Vec3& dirMin) {
+  int z;
+  normal = decodeOct(code, z);
+  Vec3 b1, b2;
+  tangentBasis(normal, z, b1, b2);
+  const double theta = double(code >> (2 * kOctBits)) * (kPi / kAngleSteps);
+  dirMax = std::cos(theta) * b1 + std::sin(theta) * b2;
+  dirMin = dirMax.cross(normal);
+}
+
+double axisAngle(const Vec3& a, const Vec3& b) {
+  // atan2 of |a x b| and |a . b| is accurate for small angles, unlike acos.
+  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
+}
+
+// ------------------------------------------------------------------------------- bit packing
+
+void packBits(const std::uint8_t* flags, std::size_t n, std::uint8_t* out) {
+  std::fill(out, out + packedBytes(n), std::uint8_t(0));
+  for (std::size_t i = 0; i < n; ++i)
+    if (flags[i]) out[i / 8] = std::uint8_t(out[i / 8] | (1u << (i % 8)));
+}
+
+}  // namespace scalespace::quant
