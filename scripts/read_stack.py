@@ -2,6 +2,8 @@
 """Example reader of a scalespace stack (docs/STACK_FORMAT.md) with plain NumPy.
 
     /usr/bin/python3 scripts/read_stack.py NAME.stack [--scale J] [--point I]
+    /usr/bin/python3 scripts/read_stack.py COMPACT.stack --compare FLOAT32.stack
+        (quantisation errors of a compact stack against its float32 twin, same input/options)
 
 Every quantity is one .npy file shaped (M, N), (M, N, 3) or, for bit-packed flags,
 (M, ceil(N / 8)): memory-map it and index it, arr[j] is scale j for all points, arr[:, i] is
@@ -51,7 +53,7 @@ def decode_frame(code):
 
     bits 0-10: qx + 1023, bits 11-21: qy + 1023 (octahedral normal), bits 22-31: q, the angle
     theta = q pi / 1024 of dir_max in the tangent basis (b1, b2) of the decoded normal;
-    dir_min = dir_max x normal. Integer arithmetic decides the fold and the basis' sign.
+    dir_min = normal x dir_max. Integer arithmetic decides the fold and the basis' sign.
     """
     code = np.asarray(code, dtype=np.uint32)
     qx = np.clip((code & 0x7FF).astype(np.int64) - OCT_MAX, -OCT_MAX, OCT_MAX)
@@ -71,7 +73,7 @@ def decode_frame(code):
     b2 = np.stack([b, s + ny * ny * a, -ny], axis=-1)
     theta = (code >> 22).astype(np.float64) * (np.pi / ANGLE_STEPS)
     dmax = np.cos(theta)[..., None] * b1 + np.sin(theta)[..., None] * b2
-    dmin = np.cross(dmax, n)
+    dmin = np.cross(n, dmax)
     return n, dmax, dmin
 
 
@@ -121,12 +123,61 @@ def decode_point(manifest, arrays, xyz, i):
     return _decode(manifest, arrays, rel, t, (slice(None), i), valid)
 
 
+def compare(compact_path, float32_path):
+    """Prints the max and 99th percentile of the quantisation errors over every valid fit."""
+    mc, ac, xc = load_stack(compact_path)
+    mf, af, xf = load_stack(float32_path)
+    if encoding(mc) != "compact" or encoding(mf) != "float32":
+        raise ValueError("--compare needs a compact stack and its float32 twin")
+    if mc["input_checksum"] != mf["input_checksum"] or mc["scales"] != mf["scales"]:
+        raise ValueError("the two stacks were not computed from the same input and scales")
+    errors = {k: [] for k in ("position / t", "normal angle (deg)", "dir_max angle (deg)",
+                              "dir_min angle (deg)", "|d k_max| t", "|d k_min| t",
+                              "|d k_max| / |k_max| (|k_max| t > 0.01)",
+                              "|d k_min| / |k_min| (|k_min| t > 0.01)",
+                              "|d kappa| / |kappa| (|kappa| t > 0.01)")}
+    flags_differ = 0
+
+    def axis_angle(a, b):
+        return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.abs(np.sum(a * b, axis=-1))))
+
+    for j, t in enumerate(mc["scales"]):
+        c = decode_scale(mc, ac, xc, j)
+        f = decode_scale(mf, af, xf, j)
+        flags_differ += int(np.count_nonzero(c["fit_valid"] != f["fit_valid"]))
+        v = (c["fit_valid"] == 1) & (f["fit_valid"] == 1)
+        errors["position / t"].append(np.linalg.norm(c["projection"] - f["projection"], axis=-1) / t)
+        fn = f["normal"][v] / np.linalg.norm(f["normal"][v], axis=-1, keepdims=True)
+        errors["normal angle (deg)"].append(np.degrees(np.arccos(np.clip(np.sum(c["normal"][v] * fn, axis=-1), -1, 1))))
+        errors["dir_max angle (deg)"].append(axis_angle(c["dir_max"][v], f["dir_max"][v]))
+        errors["dir_min angle (deg)"].append(axis_angle(c["dir_min"][v], f["dir_min"][v]))
+        for name, key in (("curv_max", "k_max"), ("curv_min", "k_min"), ("gls_kappa", "kappa")):
+            d = np.abs(c[name][v] - f[name][v].astype(np.float64))
+            k = np.abs(f[name][v].astype(np.float64))
+            if name != "gls_kappa":
+                errors[f"|d {key}| t"].append(d * t)
+            big = k * t > 0.01
+            errors[f"|d {key}| / |{key}| (|{key}| t > 0.01)"].append(d[big] / k[big])
+    print(f"{compact_path} vs {float32_path}: {mc['point_count']} points x {mc['scale_count']} scales, "
+          f"valid flags differing: {flags_differ}, values clamped: {mc.get('clamped_values', 0)}")
+    print(f"{'error':42s} {'max':>10s} {'99th pct':>10s} {'count':>10s}")
+    for name, parts in errors.items():
+        e = np.concatenate(parts) if parts else np.zeros(0)
+        if e.size:
+            print(f"{name:42s} {e.max():10.3g} {np.percentile(e, 99):10.3g} {e.size:10d}")
+    return 0
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("stack")
     p.add_argument("--scale", type=int, default=0)
     p.add_argument("--point", type=int, default=0)
+    p.add_argument("--compare", metavar="FLOAT32_STACK",
+                   help="print the quantisation errors of STACK (compact) against its float32 twin")
     a = p.parse_args()
+    if a.compare:
+        return compare(a.stack, a.compare)
     manifest, arrays, xyz = load_stack(a.stack)
     m, n = manifest["scale_count"], manifest["point_count"]
     print(f"{a.stack}: {n} points x {m} scales, t = {manifest['scales'][0]:.6g} .. {manifest['scales'][-1]:.6g}, "

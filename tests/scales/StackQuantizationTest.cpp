@@ -127,7 +127,7 @@ TEST(StackQuantization, FrameRoundTripAsAxes) {
   for (int k = 0; k < 100000; ++k) {
     const Vec3 n = randomUnit(rng);
     const Vec3 t = (randomUnit(rng).cross(n)).normalized();
-    const Vec3 dmin = t.cross(n);  // the sign of our shape-operator fits: dirMin = dirMax x n
+    const Vec3 dmin = n.cross(t);  // the compact encoding's handedness: dirMin = n x dirMax
     const std::uint32_t code = encodeFrame(n, t);
     Vec3 n2, max2, min2;
     decodeFrame(code, n2, max2, min2);
@@ -138,7 +138,7 @@ TEST(StackQuantization, FrameRoundTripAsAxes) {
     worstNormal = std::max(worstNormal, axisAngle(n, n2));
     worstMax = std::max(worstMax, axisAngle(t, max2));
     worstMin = std::max(worstMin, axisAngle(dmin, min2));
-    // The frame keeps its handedness: dir_min has the sign of dirMax x normal up to dir_max's.
+    // The frame keeps its handedness: dir_min has the sign of n x dirMax up to dir_max's.
     if (t.dot(max2) > 0) {
       ASSERT_GT(dmin.dot(min2), 0.99);
     }

@@ -158,7 +158,7 @@ void decodeFrame(std::uint32_t code, Vec3& normal, Vec3& dirMax, Vec3& dirMin) {
   tangentBasis(normal, z, b1, b2);
   const double theta = double(code >> (2 * kOctBits)) * (kPi / kAngleSteps);
   dirMax = std::cos(theta) * b1 + std::sin(theta) * b2;
-  dirMin = dirMax.cross(normal);
+  dirMin = normal.cross(dirMax);
 }
 
 double axisAngle(const Vec3& a, const Vec3& b) {

@@ -67,7 +67,10 @@ void tangentBasis(const Vec3& n, int zSign, Vec3& b1, Vec3& b2);
 /// bits 22..31 the angle q of dir_max in the tangent basis of the *decoded* normal:
 /// dir_max = cos(theta) b1 + sin(theta) b2, theta = q pi / 1024.
 std::uint32_t encodeFrame(const Vec3& normal, const Vec3& dirMax);
-/// Decodes a frame; dirMin = dirMax x normal (the sign our shape-operator and quadric fits use).
+/// Decodes a frame; dirMin = normal x dirMax, so (dirMax, dirMin, normal) is right-handed. Our
+/// fits return either handedness (the shape operator's dirMax = n x dirMin is computed before the
+/// normal is oriented like the input normals; tangentBasis gives the other one): principal
+/// directions are axes, so only the line of dirMin is meaningful, in both encodings.
 void decodeFrame(std::uint32_t code, Vec3& normal, Vec3& dirMax, Vec3& dirMin);
 
 /// Angle (radians, in [0, pi/2]) between the lines spanned by a and b.
