@@ -1,7 +1,9 @@
 #pragma once
 // The scale stack on disk (docs/STACK_FORMAT.md): a directory NAME.stack/ holding manifest.json
-// and one NumPy .npy file per quantity, shaped (M, N) or (M, N, 3), so that
-// numpy.load(f, mmap_mode='r')[j] is scale j and [:, i] is point i without our code.
+// and one NumPy .npy file per quantity, shaped (M, N), (M, N, 3) or (M, ceil(N / 8)) for
+// bit-packed flags, so that numpy.load(f, mmap_mode='r')[j] is scale j and [:, i] is point i
+// without our code. Two encodings: float32 (format version 1) and compact (version 2: float16 in
+// units of t, octahedral frames, bit-packed flags; the pure codecs are in StackQuantization.hpp).
 //
 // Writing is atomic: everything goes to NAME.stack.tmp-<pid>/, each file is fsync'ed, the
 // manifest is written last, and only then is the directory renamed to NAME.stack (an older stack
