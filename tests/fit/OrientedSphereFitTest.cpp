@@ -122,3 +122,27 @@ TEST(OrientedSphereFit, PlaneBranchOfTheProjection) {
   EXPECT_TRUE(s.isPlane(1));
   EXPECT_NEAR(s.project(Vec3(0.2, 0.1, 0.7)).z(), 0.15, 1e-9);
 }
+
+TEST(OrientedSphereFit, BatchAccumulationEqualsOneByOne) {
+  const auto c = genericCloud();
+  std::vector<double> extra(c->positions.size());
+  for (std::size_t i = 0; i < extra.size(); ++i) extra[i] = 0.25 + 0.5 * double(i % 3);
+  extra[7] = 0;  // a zeroed sample is not counted
+  const Vec3 x(0.05, -0.02, 0.01);
+  for (FitDerivatives order :
+       {FitDerivatives::None, FitDerivatives::First, FitDerivatives::Second}) {
+    OrientedSphereFit one, batch;
+    one.begin(x, 0.8, order);
+    batch.begin(x, 0.8, order);
+    for (std::size_t i = 0; i < c->positions.size(); ++i)
+      one.add(c->positions[i], c->normals[i], extra[i]);
+    batch.addBatch(c->positions.data(), c->normals.data(), extra.data(), c->positions.size());
+    const OrientedSphereFitResult a = one.finish(6), b = batch.finish(6);
+    ASSERT_TRUE(a.valid);
+    EXPECT_EQ(a.neighbors, b.neighbors);
+    EXPECT_EQ(a.sphere.uc, b.sphere.uc);
+    EXPECT_EQ(a.sphere.uq, b.sphere.uq);
+    EXPECT_EQ(a.sphere.ul, b.sphere.ul);
+    EXPECT_EQ(a.hessianW3, b.hessianW3);
+  }
+}

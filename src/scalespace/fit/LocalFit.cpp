@@ -4,6 +4,7 @@
 #include <string>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/fit/FastExp.hpp"
 #include "scalespace/fit/JetFit.hpp"
 #include "scalespace/fit/MeanFit.hpp"
 #include "scalespace/fit/OrientedSphereFit.hpp"
@@ -76,27 +77,31 @@ OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::
                                    FitDerivatives order, bool scaleDerivatives, int minNeighbors) {
   OrientedSphereFit acc;
   acc.begin(Vec3::Zero(), t, order, scaleDerivatives);
-  for (std::size_t k = 0; k < ws.offsets.size(); ++k) acc.add(ws.offsets[k], ws.normals[k], rho[k]);
+  acc.addBatch(ws.offsets.data(), ws.normals.data(), rho.data(), ws.offsets.size());
   return acc.finish(minNeighbors);
 }
 
-/// RIMLS factors of the neighbours against sphere s (Oztireli 2009, see kRobustSigmaR).
-void robustWeights(const AlgebraicSphere& s, double t, const FitWorkspace& ws,
-                   std::vector<double>& rho) {
+/// RIMLS factors of the neighbours against sphere s (Oztireli 2009, see kRobustSigmaR), and
+/// the largest change from the current factors ws.weights.
+double robustWeights(const AlgebraicSphere& s, double t, const FitWorkspace& ws,
+                     std::vector<double>& rho) {
   const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
   const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
   rho.resize(ws.offsets.size());
+  double change = 0;
   for (std::size_t k = 0; k < ws.offsets.size(); ++k) {
     const Vec3 g = s.gradient(ws.offsets[k]);
     const double gn = g.norm();
-    if (!(gn > 0)) {
-      rho[k] = 0;
-      continue;
+    double factor = 0;
+    if (gn > 0) {
+      const double r = s.value(ws.offsets[k]) / gn;
+      const double dn = (ws.normals[k] - g / gn).squaredNorm();
+      factor = expNegative(r * r * invSr2 + dn * invSn2);
     }
-    const double r = s.value(ws.offsets[k]) / gn;
-    const double dn = (ws.normals[k] - g / gn).squaredNorm();
-    rho[k] = std::exp(-(r * r * invSr2 + dn * invSn2));
+    rho[k] = factor;
+    change = std::max(change, std::abs(factor - ws.weights[k]));
   }
+  return change;
 }
 
 bool isAlgebraicSphere(EstimatorKind kind) {
@@ -132,7 +137,8 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
   OrientedSphereFitResult res = spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None,
                                            full, options.minNeighbors);
   for (int it = 0; it < passes && res.valid; ++it) {
-    robustWeights(res.sphere, t, ws, ws.trialWeights);
+    // Converged: the next fit would be (nearly) the current one.
+    if (robustWeights(res.sphere, t, ws, ws.trialWeights) <= options.robustTolerance) break;
     const bool last = reported && it + 1 == passes;
     // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
     OrientedSphereFitResult next =

@@ -40,6 +40,9 @@ struct FitOptions {
   /// (fit/LocalFit.cpp); the re-weighting factors are constants when differentiating (W2, W3).
   bool robust = false;
   int robustIterations = 5;
+  /// Stop re-weighting early once no factor changes by more than this between two passes (the
+  /// re-weighted fit has converged); 0 always makes robustIterations passes.
+  double robustTolerance = 0;
   /// Fits with fewer neighbours are invalid (NOTES.md: < 6).
   int minNeighbors = 6;
 };

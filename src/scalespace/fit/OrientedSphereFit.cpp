@@ -90,6 +90,37 @@ void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
   if (scale_) dt_.noalias() += (kernel_.scaleDerivative(r) * extraWeight) * item;
 }
 
+void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* extraWeight,
+                                 std::size_t count) {
+  if (order_ != FitDerivatives::None || scale_) {
+    for (std::size_t k = 0; k < count; ++k) add(p[k], n[k], extraWeight[k]);
+    return;
+  }
+  // Same arithmetic as add(), accumulated in locals: the member sums would be reloaded and
+  // stored at every sample (a loop-carried dependency through memory).
+  double s0 = 0, sq0 = 0, sq1 = 0, sq2 = 0, sn0 = 0, sn1 = 0, sn2 = 0, sqn = 0, sqq = 0;
+  int used = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Vec3 q = p[k] - x_;
+    const double d2 = q.squaredNorm();
+    const double r = kernel_.ratio(d2);
+    if (r >= 1) continue;
+    const double rm1 = r - 1;
+    const double w = rm1 * rm1 * extraWeight[k];
+    if (!(w > 0)) continue;
+    ++used;
+    s0 += w;
+    sq0 += w * q.x(), sq1 += w * q.y(), sq2 += w * q.z();
+    sn0 += w * n[k].x(), sn1 += w * n[k].y(), sn2 += w * n[k].z();
+    sqn += w * q.dot(n[k]);
+    sqq += w * d2;
+  }
+  count_ += used;
+  Item item;
+  item << s0, sq0, sq1, sq2, sn0, sn1, sn2, sqn, sqq;
+  s_ += item;
+}
+
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
   OrientedSphereFitResult res;
   res.neighbors = count_;

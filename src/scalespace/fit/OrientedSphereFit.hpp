@@ -7,6 +7,7 @@
 // u_q, hence the complete gradient (Eq. 1.33) and Hessians of Eq. 1.34 (W2) and 1.36 (W3) of the
 // scalar field f(y) = u_c(y) + u_l(y).(y - x) + u_q(y) |y - x|^2 at y = x.
 #include <Eigen/Core>
+#include <cstddef>
 
 #include "scalespace/core/Types.hpp"
 #include "scalespace/fit/AlgebraicSphere.hpp"
@@ -40,6 +41,9 @@ class OrientedSphereFit {
   /// Adds sample p with unit normal n; `extraWeight` multiplies the kernel weight (robust
   /// re-weighting; treated as a constant when differentiating).
   void add(const Vec3& p, const Vec3& n, double extraWeight = 1.0);
+  /// add(p[k], n[k], extraWeight[k]) for k < count. Without derivatives this runs a tight loop
+  /// that keeps the sums in registers (the robust passes of fit/LocalFit make most calls).
+  void addBatch(const Vec3* p, const Vec3* n, const double* extraWeight, std::size_t count);
   /// Solves Eq. 1.7-1.9 (and the derivatives). Invalid when fewer than minNeighbors samples
   /// have weight, when the positions are degenerate (all equal) or Delta <= 0.
   OrientedSphereFitResult finish(int minNeighbors) const;

@@ -93,6 +93,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   fit.mlsTolerance = options.mlsTolerance;
   fit.robust = options.robust;
   fit.robustIterations = options.robustIterations;
+  fit.robustTolerance = options.robustTolerance;
   fit.minNeighbors = options.minNeighbors;
 
   std::vector<Vec3> current = positions;  // projection at the previous scale (Fig. 1.9)

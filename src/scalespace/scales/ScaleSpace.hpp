@@ -20,7 +20,8 @@ struct ScaleSpaceOptions {
   ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
   double alpha = 0.1;  // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2): samples >= 2 r_j apart
   bool robust = true;  // robust APSS (Sec. 2.3, NOTES.md)
-  int robustIterations = 5;  // re-weightings per fit (NOTES.md: 5)
+  int robustIterations = 5;    // re-weightings per fit (NOTES.md: 5)
+  double robustTolerance = 0;  // stop re-weighting once factors change less (FitOptions)
   /// MLS projection steps per scale; each scale starts from the previous scale's projection,
   /// so few steps are needed (NOTES.md: the authors allow up to 10, stop below 0.01 t).
   int mlsSteps = 10;
