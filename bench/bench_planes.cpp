@@ -154,6 +154,7 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
              const char* sceneName, double noise) {
   ScaleSpaceOptions stack;
   stack.series.count = scales;
+  stack.robust = true;  // as `scalespace planes` (Sec. 2.3)
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
   std::vector<std::size_t> faceSize(std::size_t(faceCount), 0);

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -188,3 +189,38 @@ TEST_F(Cli, ThreadCountDoesNotChangeTheResult) {
 }
 
 }  // namespace
+
+TEST_F(Cli, PlanesEstimateNormalsWhenMissingAndFindTheBoxFaces) {
+  // A 2 x 1.5 x 1 box surface without normals, as a scanner's XYZ file would be.
+  {
+    std::ofstream xyz(path("box.xyz"));
+    const double size[3] = {2.0, 1.5, 1.0}, step = 0.05;
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        for (double a = 0; a <= size[u] + 1e-9; a += step)
+          for (double b = 0; b <= size[v] + 1e-9; b += step) {
+            double p[3];
+            p[axis] = side * size[axis], p[u] = a, p[v] = b;
+            xyz << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+          }
+      }
+  }
+  const Result r = run("planes " + path("box.xyz") + " -o " + path("planes") + " --scales 8");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("no normals"), std::string::npos);
+  std::ifstream json(path("planes/components.json"));
+  std::stringstream ss;
+  ss << json.rdbuf();
+  const auto doc = nlohmann::json::parse(ss.str());
+  // Every face of the box is a component: at least six planes, with normals along the axes.
+  ASSERT_TRUE(doc.contains("components"));
+  int axisAligned = 0;
+  for (const auto& c : doc["components"]) {
+    const auto& n = c["normal"];
+    const double m = std::max(
+        {std::abs(n[0].get<double>()), std::abs(n[1].get<double>()), std::abs(n[2].get<double>())});
+    if (m > 0.999) ++axisAligned;
+  }
+  EXPECT_GE(axisAligned, 6);
+}

@@ -5,7 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 
@@ -32,6 +36,18 @@ PointCloud loadCloud(const InputOptions& input, bool quiet) {
     std::fprintf(stderr, "%s: skipped %zu points with NaN/Inf coordinates\n", input.path.c_str(),
                  report.droppedNonFinite);
   return cloud;
+}
+
+void ensureNormals(PointCloud& cloud, bool quiet) {
+  if (cloud.hasNormals()) return;
+  if (!quiet)
+    std::fprintf(stderr,
+                 "input has no normals: estimating (PCA, 10 neighbours) and orienting (MST)\n");
+  auto index = makeSpatialIndex(cloud.positions());
+  NormalEstimationResult est =
+      estimateNormals(cloud.positions(), *index, {}, makeProgressBar(quiet));
+  orientNormals(cloud.positions(), est.normals, *index, {}, est.valid, makeProgressBar(quiet));
+  cloud.setNormals(std::move(est.normals));
 }
 
 void checkOutputPath(const std::string& input, const std::string& output) {

@@ -22,6 +22,10 @@ void addInputOptions(CLI::App& command, InputOptions& input);
 PointCloud loadCloud(const InputOptions& input, bool quiet);
 
 /// Throws OptionError when `output` names the same file as `input` (we never overwrite inputs).
+/// Estimates (PCA, 10 neighbours) and orients (MST) normals when the cloud has none; says so on
+/// stderr unless quiet. The APSS fits need oriented normals.
+void ensureNormals(PointCloud& cloud, bool quiet);
+
 void checkOutputPath(const std::string& input, const std::string& output);
 
 /// OUT.ply -> OUT.json

@@ -213,8 +213,7 @@ void addSegmentCommand(CLI::App& app) {
       if (!args->quiet) std::fprintf(stderr, "%zu similar components\n", found.size());
     }
     if (args->coverage) {
-      if (!cloud.hasNormals())
-        throw OptionError("--extend-coverage needs normals in the input cloud");
+      ensureNormals(cloud, args->quiet);
       labels = extendCoverage(model, labels, cloud.positions(), cloud.normals(),
                               buildKnnGraph(cloud.positions()), args->coverageOptions);
     }
@@ -244,7 +243,7 @@ void addPlanesCommand(CLI::App& app) {
     int scales = 50;
     double alpha = 0.1, angle = 5.0;
     int threads = 0;
-    bool quiet = false;
+    bool quiet = false, robust = true;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -262,6 +261,8 @@ void addPlanesCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--angle", args->angle, "region growing angle theta (degrees)")
       ->capture_default_str();
+  cmd->add_flag("--robust,!--no-robust", args->robust,
+                "robust APSS for the stack (Sec. 2.3; default on; --no-robust is ~3x faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
@@ -269,12 +270,10 @@ void addPlanesCommand(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     ThreadScope threads(args->threads);
     if (args->scales < 2) throw OptionError("--scales must be >= 2 (persistence needs levels)");
-    const PointCloud cloud = loadCloud(args->input, args->quiet);
-    if (args->stack.empty() && !cloud.hasNormals())
-      throw OptionError(args->input.path +
-                        " has no normals: the stack needs oriented normals (run `scalespace "
-                        "normals` first)");
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    if (args->stack.empty()) ensureNormals(cloud, args->quiet);
     ScaleSpaceOptions stack;
+    stack.robust = args->robust;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
     stack.series.count = args->scales;
     stack.alpha = args->alpha;
     stack.threads = args->threads;

@@ -54,18 +54,6 @@ const ExportColumn kColumns[] = {
 #undef SS_VEC
 #undef SS_SCALAR
 
-void ensureNormals(PointCloud& cloud, bool quiet) {
-  if (cloud.hasNormals()) return;
-  if (!quiet)
-    std::fprintf(stderr,
-                 "input has no normals: estimating (PCA, 10 neighbours) and orienting (MST)\n");
-  auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationResult est =
-      estimateNormals(cloud.positions(), *index, {}, makeProgressBar(quiet));
-  orientNormals(cloud.positions(), est.normals, *index, {}, est.valid, makeProgressBar(quiet));
-  cloud.setNormals(std::move(est.normals));
-}
-
 void addScalesCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
@@ -92,7 +80,7 @@ void addScalesCommand(CLI::App& app) {
                   "Poisson-disk radius / scale (0 = keep all points)")
       ->capture_default_str();
   cmd->add_flag("--robust,!--no-robust", args->options.robust,
-                "robust APSS re-weighting (default on)");
+                "robust APSS re-weighting (RIMLS, as the planes use; default off)");
   cmd->add_option("--mls-steps", args->options.mlsSteps, "MLS projection steps per scale")
       ->capture_default_str();
   cmd->add_option("--estimator", args->estimator, "w3 | w2 | w1 | plane | mean | quadric | jet")

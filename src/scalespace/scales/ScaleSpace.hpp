@@ -19,7 +19,9 @@ namespace scalespace {
 struct ScaleSpaceOptions {
   ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
   double alpha = 0.1;  // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2): samples >= 2 r_j apart
-  bool robust = true;  // robust APSS (Sec. 2.3, NOTES.md)
+  /// Robust APSS (RIMLS re-weighting, Sec. 2.3, NOTES.md): what the planes of Chapter 2 use.
+  /// Off by default: Sec. 1.5 builds the representation with the plain APSS, ~3x faster.
+  bool robust = false;
   int robustIterations = 5;    // re-weightings per fit (NOTES.md: 5)
   double robustTolerance = 0;  // stop re-weighting once factors change less (FitOptions)
   /// MLS projection steps per scale; each scale starts from the previous scale's projection,
