@@ -90,10 +90,51 @@ void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
   if (scale_) dt_.noalias() += (kernel_.scaleDerivative(r) * extraWeight) * item;
 }
 
+void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
+                                                const double* extraWeight, std::size_t count) {
+  // add()'s sums as one product: with the items of a chunk of samples as rows of I (m x 9) and
+  // their weight factors as rows of D (m x 12: w, grad_x w, a, b qq^T, dw/dt), every sum is a
+  // column of I^T D. The product runs in registers instead of updating 108 member sums per sample.
+  constexpr int kChunk = 32;
+  Eigen::Matrix<double, kChunk, 9> items;
+  Eigen::Matrix<double, kChunk, 12> factors;
+  Eigen::Matrix<double, 9, 12> sums = Eigen::Matrix<double, 9, 12>::Zero();
+  std::size_t k = 0;
+  while (k < count) {
+    int m = 0;
+    for (; k < count && m < kChunk; ++k) {
+      const Vec3 q = p[k] - x_;
+      const double d2 = q.squaredNorm();
+      const double r = kernel_.ratio(d2);
+      if (r >= 1) continue;
+      const double rm1 = r - 1;
+      const double e = extraWeight[k];
+      const double w = rm1 * rm1 * e;
+      if (!(w > 0)) continue;
+      items.row(m) << 1.0, q.x(), q.y(), q.z(), n[k].x(), n[k].y(), n[k].z(), q.dot(n[k]), d2;
+      const double g = -4 * rm1 * kernel_.invT2 * e;  // grad_x w = g q
+      const double b = 8 * kernel_.invT2 * kernel_.invT2 * e;
+      factors.row(m) << w, g * q.x(), g * q.y(), g * q.z(), 4 * rm1 * kernel_.invT2 * e,
+          b * q.x() * q.x(), b * q.y() * q.y(), b * q.z() * q.z(), b * q.x() * q.y(),
+          b * q.x() * q.z(), b * q.y() * q.z(), kernel_.scaleDerivative(r) * e;
+      ++m;
+    }
+    count_ += m;
+    sums.noalias() += items.topRows(m).transpose().lazyProduct(factors.topRows(m));
+  }
+  s_ += sums.col(0);
+  if (order_ >= FitDerivatives::First) g_ += sums.middleCols<3>(1);
+  if (order_ >= FitDerivatives::Second) {
+    a_ += sums.col(4);
+    b_ += sums.middleCols<6>(5);
+  }
+  if (scale_) dt_ += sums.col(11);
+}
+
 void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* extraWeight,
                                  std::size_t count) {
   if (order_ != FitDerivatives::None || scale_) {
-    for (std::size_t k = 0; k < count; ++k) add(p[k], n[k], extraWeight[k]);
+    addBatchWithDerivatives(p, n, extraWeight, count);
     return;
   }
   // Same arithmetic as add(), accumulated in locals: the member sums would be reloaded and

@@ -52,6 +52,8 @@ class OrientedSphereFit {
   double support() const { return kernel_.t; }
 
  private:
+  void addBatchWithDerivatives(const Vec3* p, const Vec3* n, const double* extraWeight,
+                               std::size_t count);
   using Item = Eigen::Matrix<double, 9, 1>;  // 1, q, n, q.n, |q|^2
   Vec3 x_ = Vec3::Zero();
   WeightKernel kernel_{1.0};

@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -150,26 +152,34 @@ void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel
                    std::vector<std::size_t>& clamped) {
   const std::size_t n = L.size();
   for (int k = 0; k < kCompactFiles; ++k) buf[k].assign(sliceBytes(kCompactQuantities[k], n), 0);
-  auto half = [&](int k) { return HalfWriter{&clamped[std::size_t(k)]}; };
-  for (std::size_t i = 0; i < n; ++i) {
-    // The projection is meaningful for invalid fits too (the last valid one): always stored.
-    for (int c = 0; c < 3; ++c)
-      half(kOffset)((double(L.projection[3 * i + c]) - rel[3 * i + c]) / t,
-                    &buf[kOffset][6 * i + 2 * c]);
-    buf[kNeighbors][i] = std::uint8_t(std::min<unsigned>(L.neighbors[i], 255u));
-    if (!L.valid[i]) continue;  // zeros: decoded as zeros
-    const auto v3 = [&](const std::vector<float>& a) {
-      return Vec3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
-    };
-    const std::uint32_t frame = quant::encodeFrame(v3(L.normal), v3(L.dirMax));
-    std::memcpy(&buf[kFrame][4 * i], &frame, 4);
-    half(kCurvMax)(double(L.kMax[i]) * t, &buf[kCurvMax][2 * i]);
-    half(kCurvMin)(double(L.kMin[i]) * t, &buf[kCurvMin][2 * i]);
-    half(kTau)(double(L.tau[i]) / t, &buf[kTau][2 * i]);
-    half(kKappa)(double(L.kappa[i]) * t, &buf[kKappa][2 * i]);
-    half(kAnisotropy)(double(L.anisotropy[i]), &buf[kAnisotropy][2 * i]);
-    half(kVariation)(double(L.geometricVariation[i]), &buf[kVariation][2 * i]);
-  }
+  // Points are independent: encoded in parallel blocks (a tenth of a 1M x 50 stack's time when
+  // sequential), each block counting its clamped values; the sums do not depend on the blocks.
+  std::mutex countLock;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& range) {
+    std::vector<std::size_t> local(clamped.size(), 0);
+    auto half = [&](int k) { return HalfWriter{&local[std::size_t(k)]}; };
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      // The projection is meaningful for invalid fits too (the last valid one): always stored.
+      for (int c = 0; c < 3; ++c)
+        half(kOffset)((double(L.projection[3 * i + c]) - rel[3 * i + c]) / t,
+                      &buf[kOffset][6 * i + 2 * c]);
+      buf[kNeighbors][i] = std::uint8_t(std::min<unsigned>(L.neighbors[i], 255u));
+      if (!L.valid[i]) continue;  // zeros: decoded as zeros
+      const auto v3 = [&](const std::vector<float>& a) {
+        return Vec3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+      };
+      const std::uint32_t frame = quant::encodeFrame(v3(L.normal), v3(L.dirMax));
+      std::memcpy(&buf[kFrame][4 * i], &frame, 4);
+      half(kCurvMax)(double(L.kMax[i]) * t, &buf[kCurvMax][2 * i]);
+      half(kCurvMin)(double(L.kMin[i]) * t, &buf[kCurvMin][2 * i]);
+      half(kTau)(double(L.tau[i]) / t, &buf[kTau][2 * i]);
+      half(kKappa)(double(L.kappa[i]) * t, &buf[kKappa][2 * i]);
+      half(kAnisotropy)(double(L.anisotropy[i]), &buf[kAnisotropy][2 * i]);
+      half(kVariation)(double(L.geometricVariation[i]), &buf[kVariation][2 * i]);
+    }
+    const std::lock_guard<std::mutex> hold(countLock);
+    for (std::size_t k = 0; k < clamped.size(); ++k) clamped[k] += local[k];
+  });
   quant::packBits(L.valid.data(), n, buf[kValidBits].data());
 }
 
