@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/render/ColorMap.hpp"
@@ -55,6 +56,20 @@ TEST(ColorMap, LabelColoursAreDistinct) {
       const int d = std::abs(x.r - y.r) + std::abs(x.g - y.g) + std::abs(x.b - y.b);
       EXPECT_GT(d, 20) << a << " vs " << b;
     }
+}
+
+TEST(ColorMap, LabelsAreColouredByRankOfSize) {
+  // Ids 1525 and 2190 land on nearly the same golden-ratio hue; ranked by size they get the
+  // colours of ranks 0 and 1, which differ strongly.
+  std::vector<double> labels = {2190, 1525, 2190, -1, 2190, 1525, 7};
+  const std::vector<Rgb> c = colorizeLabels(labels);
+  auto same = [](Rgb a, Rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; };
+  EXPECT_TRUE(same(c[0], labelColor(0)));  // 3 points: rank 0
+  EXPECT_TRUE(same(c[1], labelColor(1)));  // 2 points: rank 1
+  EXPECT_TRUE(same(c[6], labelColor(2)));  // 1 point: rank 2
+  EXPECT_TRUE(same(c[3], kUnlabelledGrey));
+  EXPECT_TRUE(same(c[2], c[4]));
+  EXPECT_TRUE(same(c[1], c[5]));
 }
 
 TEST(PointRenderer, SingleRedPointAtTheCentre) {
@@ -123,7 +138,7 @@ TEST(PointRenderer, ViewsAndLabels) {
   opt.labelAttribute = "plane_id";
   const auto colors = pointColors(cloud, opt);
   EXPECT_EQ(colors[0], kUnlabelledGrey);
-  EXPECT_EQ(colors[1], labelColor(3));
+  EXPECT_EQ(colors[1], labelColor(0));  // the only (hence largest) label: rank 0
   opt.labelAttribute = "missing";
   EXPECT_THROW(renderPoints(cloud, opt), OptionError);
   opt.labelAttribute.clear();

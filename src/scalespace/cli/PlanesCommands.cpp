@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "scalespace/cli/CliCommon.hpp"
@@ -195,7 +196,22 @@ void addSegmentCommand(CLI::App& app) {
     if (*pers) {
       labels = labelsByPersistence(model, args->minPersistence);
     } else if (*scale) {
+      if (model.scales.empty()) throw OptionError(args->directory + " holds no scales");
+      const int level = nearestLevel(model, args->scale);
       labels = labelsAtScale(model, args->scale);
+      std::set<int> planes(labels.begin(), labels.end());
+      planes.erase(-1);
+      if (!args->quiet) {
+        const double lo = model.scales.front(), hi = model.scales.back();
+        if (args->scale < lo || args->scale > hi)
+          std::fprintf(stderr,
+                       "warning: --scale %g is outside the computed scales [%g, %g]; using the "
+                       "nearest\n",
+                       args->scale, lo, hi);
+        std::fprintf(stderr, "scale t = %g (level %d of %d, nearest to %g): %zu planes\n",
+                     model.scales[std::size_t(level)], level, model.scaleCount(), args->scale,
+                     planes.size());
+      }
     } else if (*brush) {
       const auto matches = rankByBrush(model, readIndexFile(args->brush));
       labels.assign(cloud.size(), -1);
@@ -222,8 +238,10 @@ void addSegmentCommand(CLI::App& app) {
     auto& green = cloud.addAttribute("green", ScalarType::UInt8);
     auto& blue = cloud.addAttribute("blue", ScalarType::UInt8);
     std::size_t labelled = 0;
+    const std::vector<Rgb> colors =
+        colorizeLabels(std::vector<double>(labels.begin(), labels.end()));
     for (std::size_t i = 0; i < labels.size(); ++i) {
-      const Rgb c = labelColor(labels[i]);
+      const Rgb& c = colors[i];
       id.values[i] = labels[i];
       red.values[i] = c.r;
       green.values[i] = c.g;
@@ -261,8 +279,8 @@ void addPlanesCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--angle", args->angle, "region growing angle theta (degrees)")
       ->capture_default_str();
-  cmd->add_flag("--robust,!--no-robust", args->robust,
-                "robust APSS for the stack (Sec. 2.3; default on; --no-robust is ~3x faster)");
+  cmd->add_flag("--no-robust{false}", args->robust,
+                "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <utility>
 
 namespace scalespace {
 
@@ -96,9 +98,19 @@ Rgb labelColor(long long label) {
 }
 
 std::vector<Rgb> colorizeLabels(const std::vector<double>& labels) {
-  std::vector<Rgb> colors(labels.size());
+  std::map<long long, std::size_t> counts;
+  for (double v : labels)
+    if (std::isfinite(v) && v >= 0) ++counts[std::llround(v)];
+  std::vector<std::pair<long long, std::size_t>> byCount(counts.begin(), counts.end());
+  std::sort(byCount.begin(), byCount.end(), [](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second > b.second : a.first < b.first;
+  });
+  std::map<long long, Rgb> colorOf;
+  for (std::size_t k = 0; k < byCount.size(); ++k)
+    colorOf[byCount[k].first] = labelColor((long long)k);
+  std::vector<Rgb> colors(labels.size(), kUnlabelledGrey);
   for (std::size_t i = 0; i < labels.size(); ++i)
-    colors[i] = std::isfinite(labels[i]) ? labelColor(std::llround(labels[i])) : kUnlabelledGrey;
+    if (std::isfinite(labels[i]) && labels[i] >= 0) colors[i] = colorOf[std::llround(labels[i])];
   return colors;
 }
 

@@ -26,6 +26,10 @@ std::vector<Rgb> colorizeScalars(const std::vector<double>& values, const Scalar
 /// Distinct colour for an integer label: hues spaced by the golden ratio so consecutive labels
 /// differ strongly; negative labels (unlabelled, -1) are grey.
 Rgb labelColor(long long label);
+/// Colours for the labels present: they are ranked by decreasing point count (ties: smaller
+/// label first) and label of rank k gets labelColor(k). Ranking rather than using the label value
+/// keeps the largest labels far apart in hue whatever their ids (component ids run into the
+/// thousands, where two ids can land on nearly the same hue). Negative or non-finite: grey.
 std::vector<Rgb> colorizeLabels(const std::vector<double>& labels);
 
 /// Grey used for unlabelled points and invalid values.

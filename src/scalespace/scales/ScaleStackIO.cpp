@@ -483,6 +483,9 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
     const unsigned char* p = compact ? d.bufs[k].data() : layerBytes(q, layer);
     writeAll(d.fds[k], p, bytes, (d.tmpPath / q.name).string() + ".npy");
     d.sums[k].add(p, bytes);
+    // Start writing this scale to disk now (asynchronous): the fsync of finish() then waits for
+    // the last scale only, instead of flushing the whole stack (~10 s for 1.2 GB) at the end.
+    ::sync_file_range(d.fds[k], 0, 0, SYNC_FILE_RANGE_WRITE);
     ++k;
   }
   d.scales.push_back(t);
