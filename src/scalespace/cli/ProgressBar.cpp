@@ -43,7 +43,8 @@ ProgressCallback makeProgressBar(bool quiet) {
     } else {
       // Not a terminal: a line at the start, every 5 s, and at the end.
       const bool due = std::chrono::duration<double>(now - state->lastLine).count() >= 5.0;
-      if (state->lastPercent < 0 || percent >= 100 || due) {
+      const bool finished = percent >= 100 && state->lastPercent < 100;  // once per stage
+      if (state->lastPercent < 0 || finished || (due && percent < 100)) {
         std::fprintf(stderr, "%s: %d%% (%.1f s)\n", state->stage.c_str(), percent, elapsed);
         state->lastLine = now;
       }
