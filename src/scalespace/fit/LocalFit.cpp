@@ -59,15 +59,43 @@ namespace {
 constexpr double kRobustSigmaR = 0.2;  // times t
 constexpr double kRobustSigmaN = 0.5;
 
-/// Gathers the neighbours of y (offsets q = p - y and normals) into contiguous buffers: the
-/// robust passes read them several times.
-void gatherNeighbors(const Vec3& y, const SurfaceSamples& samples, FitWorkspace& ws) {
-  const std::size_t n = ws.neighbors.size();
-  ws.offsets.resize(n);
-  ws.normals.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    ws.offsets[k] = samples.positions[ws.neighbors[k].index] - y;
-    ws.normals[k] = samples.normals[ws.neighbors[k].index];
+/// Gathers the samples within t of y (offsets q = p - y and normals) into contiguous buffers:
+/// the robust passes read them several times. Reads the driver's prefetched samples when they
+/// cover the ball, else queries the index.
+void gatherNeighbors(const Vec3& y, double t, const SurfaceSamples& samples, FitWorkspace& ws) {
+  ws.offsets.clear();
+  ws.normals.clear();
+  if (ws.cache.covers(samples, y, t)) {
+    ++ws.cache.hits;
+    const std::vector<Vec3>& p = ws.cache.positions();
+    const std::vector<Vec3>& n = ws.cache.normals();
+    const double t2 = t * t;
+    // Branch-free: about half of the candidates are kept, in no predictable pattern.
+    // Raw pointers: stores through ws.offsets[...] could alias ws itself, and the compiler would
+    // reload the vectors' data pointers at every candidate.
+    ws.offsets.resize(p.size());
+    ws.normals.resize(p.size());
+    const Vec3* pIn = p.data();
+    const Vec3* nIn = n.data();
+    Vec3* qOut = ws.offsets.data();
+    Vec3* nOut = ws.normals.data();
+    const std::size_t count = p.size();
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      const Vec3 q = pIn[k] - y;
+      qOut[kept] = q;
+      nOut[kept] = nIn[k];
+      kept += q.squaredNorm() < t2 ? 1 : 0;  // the index's test: |p - y|^2 < t^2
+    }
+    ws.offsets.resize(kept);
+    ws.normals.resize(kept);
+    return;
+  }
+  ++ws.cache.misses;
+  samples.index.radiusSearch(y, t, ws.neighbors);
+  for (const Neighbor& nb : ws.neighbors) {
+    ws.offsets.push_back(samples.positions[nb.index] - y);
+    ws.normals.push_back(samples.normals[nb.index]);
   }
 }
 
@@ -211,8 +239,7 @@ LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
   Vec3 y = x;
   for (int step = 1;; ++step) {
-    samples.index.radiusSearch(y, t, ws.neighbors);
-    gatherNeighbors(y, samples, ws);
+    gatherNeighbors(y, t, samples, ws);
     const bool lastStep = step == maxSteps;
     OrientedSphereFitResult res = robustSphere(t, options, ws, lastStep);
     if (res.valid && !lastStep) {

@@ -7,6 +7,7 @@
 
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Types.hpp"
+#include "scalespace/fit/NeighborhoodCache.hpp"
 
 namespace scalespace {
 
@@ -92,6 +93,9 @@ struct SurfaceSamples {
 
 /// Per-thread scratch memory, reused across calls to avoid allocations in the hot loop.
 struct FitWorkspace {
+  /// Samples prefetched by the driver for nearby fits (the APSS fits read them when they cover
+  /// the support ball, fit/NeighborhoodCache.hpp); empty unless the driver fills it.
+  NeighborhoodCache cache;
   std::vector<Neighbor> neighbors;
   std::vector<Vec3> offsets, normals;         // neighbours gathered once per query: p - x and n
   std::vector<double> weights, trialWeights;  // robust re-weighting factors
