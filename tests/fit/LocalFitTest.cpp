@@ -313,3 +313,29 @@ TEST(LocalFit, PlaneAndMeanMlsMeasureHFromTheTotalDisplacement) {
     EXPECT_LT(mls.meanCurvature, 3) << estimatorName(k);
   }
 }
+
+// The MLS hint only changes which pass computes the derivatives: on the surface (converges at
+// once) and off it (several steps), the fit is the same with and without it.
+TEST(LocalFit, FirstStepHintGivesTheSameFit) {
+  const auto c = sampleCloud(SurfaceShape::Saddle, Vec3::Zero(), 1.0, 3000, 5);
+  for (bool robust : {false, true}) {
+    for (const Vec3& x : {Vec3(0.05, -0.02, 0.0), Vec3(0.05, -0.02, 0.08)}) {
+      FitOptions o;
+      o.mls = true;
+      o.mlsTolerance = 1e-2;
+      o.robust = robust;
+      FitWorkspace ws;
+      const LocalFit a = fitAt(x, 0.3, c->samples(), o, ws);
+      o.expectFirstStepConverged = true;
+      const LocalFit b = fitAt(x, 0.3, c->samples(), o, ws);
+      ASSERT_TRUE(a.valid && b.valid);
+      EXPECT_EQ(a.mlsSteps, b.mlsSteps);
+      EXPECT_LT((a.projection - b.projection).norm(), 1e-12);
+      EXPECT_LT((a.normal - b.normal).norm(), 1e-10);
+      EXPECT_NEAR(a.kMax, b.kMax, 1e-8);
+      EXPECT_NEAR(a.kMin, b.kMin, 1e-8);
+      EXPECT_NEAR(a.geometricVariation, b.geometricVariation, 1e-10);
+      if (x.z() > 0) EXPECT_GT(a.mlsSteps, 1);
+    }
+  }
+}

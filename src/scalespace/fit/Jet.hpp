@@ -47,6 +47,8 @@ inline Dual operator+(const Dual& a, const Dual& b) { return {a.v + b.v, a.d + b
 inline Dual operator-(const Dual& a, const Dual& b) { return {a.v - b.v, a.d - b.d}; }
 inline Dual operator*(double s, const Dual& a) { return {s * a.v, s * a.d}; }
 inline Dual operator*(const Dual& a, const Dual& b) { return {a.v * b.v, a.v * b.d + b.v * a.d}; }
+inline Dual inverse(const Dual& b) { return {1 / b.v, -b.d / (b.v * b.v)}; }
+inline double inverse(double b) { return 1 / b; }
 inline Dual operator/(const Dual& a, const Dual& b) {
   return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)};
 }

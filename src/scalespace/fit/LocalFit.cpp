@@ -241,14 +241,16 @@ LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
   for (int step = 1;; ++step) {
     gatherNeighbors(y, t, samples, ws);
     const bool lastStep = step == maxSteps;
-    OrientedSphereFitResult res = robustSphere(t, options, ws, lastStep);
+    const bool speculative = step == 1 && options.expectFirstStepConverged;
+    OrientedSphereFitResult res = robustSphere(t, options, ws, lastStep || speculative);
     if (res.valid && !lastStep) {
       const Vec3 projection = y + res.sphere.project(Vec3::Zero());
       if ((projection - y).norm() >= options.mlsTolerance * t) {
         y = projection;
         continue;
       }
-      res = reportedPass(t, options, ws, res.neighbors);  // converged: this step is reported
+      // Converged: this step is reported.
+      if (!speculative) res = reportedPass(t, options, ws, res.neighbors);
     }
     LocalFit fit;
     fit.neighbors = res.neighbors;

@@ -44,6 +44,10 @@ struct FitOptions {
   /// Stop re-weighting early once no factor changes by more than this between two passes (the
   /// re-weighted fit has converged); 0 always makes robustIterations passes.
   double robustTolerance = 0;
+  /// MLS hint: compute the derivatives at the first step already. When that step converges this
+  /// saves a pass over the neighbours; when it does not, the derivatives are wasted. Drivers set
+  /// it for points that converged at once in a similar fit (scales/: the previous scale).
+  bool expectFirstStepConverged = false;
   /// Fits with fewer neighbours are invalid (NOTES.md: < 6).
   int minNeighbors = 6;
 };

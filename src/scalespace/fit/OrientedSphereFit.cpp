@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "scalespace/fit/DerivativeSums.hpp"
 #include "scalespace/fit/Jet.hpp"
 
 namespace scalespace {
@@ -37,9 +38,11 @@ SphereTerms<S> solveSphere(const S* item, double degenerate) {
   const S den = s0 * spp - (sp[0] * sp[0] + sp[1] * sp[1] + sp[2] * sp[2]);
   if (!(valueOf(den) > degenerate)) return r;  // all samples (numerically) at one position
   r.uq = 0.5 * (num / den);                    // Eq. 1.7
-  for (int k = 0; k < 3; ++k) r.ul[k] = (sn[k] - 2.0 * (r.uq * sp[k])) / s0;  // Eq. 1.8
+  // One reciprocal of s0 shared by the four divisions (a Jet2 reciprocal is ~30 flops).
+  const S invS0 = inverse(s0);
+  for (int k = 0; k < 3; ++k) r.ul[k] = (sn[k] - 2.0 * (r.uq * sp[k])) * invS0;  // Eq. 1.8
   const S dot = r.ul[0] * sp[0] + r.ul[1] * sp[1] + r.ul[2] * sp[2];
-  r.uc = -1.0 * ((dot + r.uq * spp) / s0);  // Eq. 1.9
+  r.uc = -1.0 * ((dot + r.uq * spp) * invS0);  // Eq. 1.9
   r.ok = true;
   return r;
 }
@@ -92,17 +95,14 @@ void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
 
 void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
                                                 const double* extraWeight, std::size_t count) {
-  // add()'s sums as one product: with the items of a chunk of samples as rows of I (m x 9) and
-  // their weight factors as rows of D (m x 12: w, grad_x w, a, b qq^T, dw/dt), every sum is a
-  // column of I^T D. The product runs in registers instead of updating 108 member sums per sample.
-  constexpr int kChunk = 32;
-  Eigen::Matrix<double, kChunk, 9> items;
-  Eigen::Matrix<double, kChunk, 12> factors;
-  Eigen::Matrix<double, 9, 12> sums = Eigen::Matrix<double, 9, 12>::Zero();
+  // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
+  // instead of updating 108 member sums per sample.
+  DerivativeChunk chunk;
+  DerivativeSums sums = {};
   std::size_t k = 0;
   while (k < count) {
     int m = 0;
-    for (; k < count && m < kChunk; ++k) {
+    for (; k < count && m < DerivativeChunk::kSize; ++k) {
       const Vec3 q = p[k] - x_;
       const double d2 = q.squaredNorm();
       const double r = kernel_.ratio(d2);
@@ -111,24 +111,36 @@ void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
       const double e = extraWeight[k];
       const double w = rm1 * rm1 * e;
       if (!(w > 0)) continue;
-      items.row(m) << 1.0, q.x(), q.y(), q.z(), n[k].x(), n[k].y(), n[k].z(), q.dot(n[k]), d2;
+      double* item = chunk.items[m];
+      item[0] = 1.0;
+      item[1] = q.x(), item[2] = q.y(), item[3] = q.z();
+      item[4] = n[k].x(), item[5] = n[k].y(), item[6] = n[k].z();
+      item[7] = q.dot(n[k]);
+      item[8] = d2;
       const double g = -4 * rm1 * kernel_.invT2 * e;  // grad_x w = g q
       const double b = 8 * kernel_.invT2 * kernel_.invT2 * e;
-      factors.row(m) << w, g * q.x(), g * q.y(), g * q.z(), 4 * rm1 * kernel_.invT2 * e,
-          b * q.x() * q.x(), b * q.y() * q.y(), b * q.z() * q.z(), b * q.x() * q.y(),
-          b * q.x() * q.z(), b * q.y() * q.z(), kernel_.scaleDerivative(r) * e;
+      double* f = chunk.factors[m];
+      f[0] = w;
+      f[1] = g * q.x(), f[2] = g * q.y(), f[3] = g * q.z();
+      f[4] = 4 * rm1 * kernel_.invT2 * e;
+      f[5] = b * q.x() * q.x(), f[6] = b * q.y() * q.y(), f[7] = b * q.z() * q.z();
+      f[8] = b * q.x() * q.y(), f[9] = b * q.x() * q.z(), f[10] = b * q.y() * q.z();
+      f[11] = kernel_.scaleDerivative(r) * e;
       ++m;
     }
     count_ += m;
-    sums.noalias() += items.topRows(m).transpose().lazyProduct(factors.topRows(m));
+    accumulateDerivativeSums(chunk, m, sums);
   }
-  s_ += sums.col(0);
-  if (order_ >= FitDerivatives::First) g_ += sums.middleCols<3>(1);
-  if (order_ >= FitDerivatives::Second) {
-    a_ += sums.col(4);
-    b_ += sums.middleCols<6>(5);
+  for (int i = 0; i < 9; ++i) {
+    s_[i] += sums[i][0];
+    if (order_ >= FitDerivatives::First)
+      for (int c = 0; c < 3; ++c) g_(i, c) += sums[i][1 + c];
+    if (order_ >= FitDerivatives::Second) {
+      a_[i] += sums[i][4];
+      for (int c = 0; c < 6; ++c) b_(i, c) += sums[i][5 + c];
+    }
+    if (scale_) dt_[i] += sums[i][11];
   }
-  if (scale_) dt_ += sums.col(11);
 }
 
 void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* extraWeight,

@@ -181,7 +181,9 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                             const std::size_t blockEnd =
                                 prefetchBlock(current, k, groupEnd, samples, t, ws.cache);
                             for (; k < blockEnd; ++k) {
-                              const LocalFit f = fitAt(current[k], t, samples, fit, ws);
+                              FitOptions pointFit = fit;
+                              pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
+                              const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
                               const std::size_t i = order[k];  // input index
                               neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
                               mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));

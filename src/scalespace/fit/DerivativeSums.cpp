@@ -1,0 +1,64 @@
+#include "scalespace/fit/DerivativeSums.hpp"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SCALESPACE_HAVE_AVX2_KERNEL 1
+#include <immintrin.h>
+#endif
+
+namespace scalespace {
+namespace {
+
+void accumulatePortable(const DerivativeChunk& c, int m, DerivativeSums& sums) {
+  for (int k = 0; k < m; ++k)
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 12; ++j) sums[i][j] += c.items[k][i] * c.factors[k][j];
+}
+
+#ifdef SCALESPACE_HAVE_AVX2_KERNEL
+// 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by. The
+// project builds for baseline x86-64 (SSE2: 2-wide, no FMA; -march=native was measured no faster
+// overall), so only this function is compiled for AVX2 + FMA and chosen at run time. Measured
+// with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
+__attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c, int m,
+                                                        DerivativeSums& sums) {
+  for (int jb = 0; jb < 12; jb += 4) {
+    __m256d acc[9];
+    for (__m256d& a : acc) a = _mm256_setzero_pd();
+    for (int k = 0; k < m; ++k) {
+      const __m256d f = _mm256_load_pd(&c.factors[k][jb]);
+      for (int i = 0; i < 9; ++i)
+        acc[i] = _mm256_fmadd_pd(_mm256_broadcast_sd(&c.items[k][i]), f, acc[i]);
+    }
+    for (int i = 0; i < 9; ++i) {
+      alignas(32) double lane[4];
+      _mm256_store_pd(lane, acc[i]);
+      for (int l = 0; l < 4; ++l) sums[i][jb + l] += lane[l];
+    }
+  }
+}
+#endif
+
+}  // namespace
+
+bool avx2FmaKernelAvailable() {
+#ifdef SCALESPACE_HAVE_AVX2_KERNEL
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+#else
+  return false;
+#endif
+}
+
+void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,
+                              SumsKernel kernel) {
+#ifdef SCALESPACE_HAVE_AVX2_KERNEL
+  if (kernel != SumsKernel::Portable && avx2FmaKernelAvailable()) {
+    accumulateAvx2(chunk, m, sums);
+    return;
+  }
+#endif
+  (void)kernel;
+  accumulatePortable(chunk, m, sums);
+}
+
+}  // namespace scalespace
