@@ -1,6 +1,6 @@
 #include "scalespace/fit/ShapeOperator.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace scalespace {
@@ -25,15 +25,25 @@ PrincipalCurvatures shapeOperatorCurvatures(const Vec3& gradient, const Mat3& he
   P.col(0) = u;
   P.col(1) = v;
   Eigen::Matrix2d W = P.transpose() * hessian * P / gn;  // Eq. 1.28
-  W = 0.5 * (W + W.transpose());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(W);  // ascending eigenvalues
-  if (eig.info() != Eigen::Success) return pc;
-  pc.kMin = eig.eigenvalues()(0);
-  pc.kMax = eig.eigenvalues()(1);
-  pc.mean = 0.5 * (pc.kMax + pc.kMin);
-  pc.dirMin = (P * eig.eigenvectors().col(0)).normalized();
+  // Closed-form eigen-decomposition of the symmetric 2 x 2 [[a, b], [b, d]] (Eigen's iterative
+  // solver took a third of this function): lambda = (a + d) / 2 +- hypot((a - d) / 2, b).
+  const double a = W(0, 0), d = W(1, 1), b = 0.5 * (W(0, 1) + W(1, 0));
+  const double half = 0.5 * (a - d);
+  const double radius = std::hypot(half, b);
+  pc.kMax = 0.5 * (a + d) + radius;
+  pc.kMin = 0.5 * (a + d) - radius;
+  pc.mean = 0.5 * (a + d);
+  // Eigenvector of kMax: (half + radius, b) or, equivalently, (b, radius - half); take the one
+  // without cancellation. Umbilic (radius 0): any direction, u.
+  Eigen::Vector2d vMax(1, 0);
+  if (radius > 0) {
+    vMax = half >= 0 ? Eigen::Vector2d(half + radius, b) : Eigen::Vector2d(b, radius - half);
+    vMax.normalize();
+  }
+  const Eigen::Vector2d vMin(-vMax.y(), vMax.x());
+  pc.dirMin = (P * vMin).normalized();
   pc.dirMax = n.cross(pc.dirMin);  // exactly orthogonal, unit
-  if (pc.dirMax.dot(P * eig.eigenvectors().col(1)) < 0) pc.dirMax = -pc.dirMax;
+  if (pc.dirMax.dot(P * vMax) < 0) pc.dirMax = -pc.dirMax;
   pc.normal = n;
   pc.valid = std::isfinite(pc.kMax) && std::isfinite(pc.kMin);
   if (!pc.valid) pc = PrincipalCurvatures{};

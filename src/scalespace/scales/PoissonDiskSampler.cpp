@@ -76,11 +76,23 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
         int(((key >> (2 * kCellBits)) & 1) | (((key >> kCellBits) & 1) << 1) | ((key & 1) << 2));
     byColour[std::size_t(colour)].push_back(q);
   }
-  auto findCell = [&](std::uint64_t key) -> std::ptrdiff_t {
-    auto it = std::lower_bound(cellBegin.begin(), cellBegin.end() - 1, key,
-                               [&](std::size_t b, std::uint64_t v) { return c[b].cell < v; });
-    if (it == cellBegin.end() - 1 || c[*it].cell != key) return -1;
-    return it - cellBegin.begin();
+  // The 27 neighbours of a cell, in 9 binary searches: for fixed (dx, dy) the keys of z - 1, z,
+  // z + 1 are consecutive, and keys grow with (dx, dy), so each search starts where the last one
+  // ended. (27 independent searches made this pass a third of the sampler's time at t_min.)
+  auto neighbourCells = [&](std::int64_t x, std::int64_t y, std::int64_t z, std::size_t* near) {
+    int count = 0;
+    auto from = cellBegin.begin();
+    const auto end = cellBegin.end() - 1;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) {
+        const std::uint64_t first = packCell(x + dx, y + dy, z - 1);
+        const std::uint64_t last = packCell(x + dx, y + dy, z + 1);
+        from = std::lower_bound(from, end, first,
+                                [&](std::size_t b, std::uint64_t v) { return c[b].cell < v; });
+        for (auto it = from; it != end && c[*it].cell <= last; ++it)
+          near[count++] = std::size_t(it - cellBegin.begin());
+      }
+    return count;
   };
   // Accepted samples of cell q are kept compactly in accepted[cellBegin[q] .. + acceptedCount[q]):
   // a cell of size >= r holds a bounded number of samples, so checking a candidate costs O(1)
@@ -98,13 +110,7 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
                              y = std::int64_t((key >> kCellBits) & mask),
                              z = std::int64_t(key & mask);
           std::size_t near[27];
-          int nearCount = 0;
-          for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dz = -1; dz <= 1; ++dz) {
-                const std::ptrdiff_t f = findCell(packCell(x + dx, y + dy, z + dz));
-                if (f >= 0) near[nearCount++] = std::size_t(f);
-              }
+          const int nearCount = neighbourCells(x, y, z, near);
           for (std::size_t k = cellBegin[q]; k < cellBegin[q + 1]; ++k) {
             const Index candidate = c[k].point;
             const Vec3& p = positions[candidate];
