@@ -207,17 +207,10 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
   } else {
     Jet2 items[9];
     for (int k = 0; k < 9; ++k) {
-      Mat3 h = a_[k] * Mat3::Identity();
-      h(0, 0) += b_(k, 0);
-      h(1, 1) += b_(k, 1);
-      h(2, 2) += b_(k, 2);
-      h(0, 1) += b_(k, 3);
-      h(1, 0) += b_(k, 3);
-      h(0, 2) += b_(k, 4);
-      h(2, 0) += b_(k, 4);
-      h(1, 2) += b_(k, 5);
-      h(2, 1) += b_(k, 5);
-      items[k] = {s_[k], g_.row(k).transpose(), h};
+      // hess_x of the sum: a I + b qq^T (add(): xx, yy, zz, xy, xz, yz)
+      items[k].v = s_[k];
+      items[k].g = g_.row(k).transpose();
+      for (int e = 0; e < 6; ++e) items[k].h[e] = b_(k, e) + (e < 3 ? a_[k] : 0.0);
     }
     const auto u = solveSphere<Jet2>(items, degenerate);
     if (!u.ok) return res;
@@ -230,8 +223,8 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
     res.gradUc = u.uc.g;
     res.gradUq = u.uq.g;
     // Eq. 1.36 at x = 0: the terms in x vanish, leaving hess u_c + J + J^T + 2 u_q I.
-    res.hessianW3 =
-        u.uc.h + res.jacobianUl + res.jacobianUl.transpose() + 2 * sphere.uq * Mat3::Identity();
+    res.hessianW3 = u.uc.hessian() + res.jacobianUl + res.jacobianUl.transpose() +
+                    2 * sphere.uq * Mat3::Identity();
   }
   if (order_ >= FitDerivatives::First) {
     // Eq. 1.33 at x = 0: grad u_c + u_l; Eq. 1.34 at x = 0: J + 2 u_q I.
