@@ -335,7 +335,9 @@ TEST(LocalFit, FirstStepHintGivesTheSameFit) {
       EXPECT_NEAR(a.kMax, b.kMax, 1e-8);
       EXPECT_NEAR(a.kMin, b.kMin, 1e-8);
       EXPECT_NEAR(a.geometricVariation, b.geometricVariation, 1e-10);
-      if (x.z() > 0) EXPECT_GT(a.mlsSteps, 1);
+      if (x.z() > 0) {
+        EXPECT_GT(a.mlsSteps, 1);
+      }
     }
   }
 }

@@ -4,13 +4,14 @@
 #include <string>
 
 #include "scalespace/core/Error.hpp"
-#include "scalespace/fit/FastExp.hpp"
 #include "scalespace/fit/JetFit.hpp"
 #include "scalespace/fit/MeanFit.hpp"
 #include "scalespace/fit/OrientedSphereFit.hpp"
 #include "scalespace/fit/PlaneFit.hpp"
 #include "scalespace/fit/QuadricFit.hpp"
+#include "scalespace/fit/RobustReweighting.hpp"
 #include "scalespace/fit/ShapeOperator.hpp"
+#include "scalespace/fit/WeightKernel.hpp"
 
 namespace scalespace {
 
@@ -109,27 +110,22 @@ OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::
   return acc.finish(minNeighbors);
 }
 
-/// RIMLS factors of the neighbours against sphere s (Oztireli 2009, see kRobustSigmaR), and
-/// the largest change from the current factors ws.weights.
-double robustWeights(const AlgebraicSphere& s, double t, const FitWorkspace& ws,
-                     std::vector<double>& rho) {
-  const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
-  const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
-  rho.resize(ws.offsets.size());
-  double change = 0;
+/// The sphere of precomputed sums (no derivatives): the intermediate robust passes.
+OrientedSphereFitResult sumsPass(double t, const SphereSums& sums, int minNeighbors) {
+  OrientedSphereFit acc;
+  acc.begin(Vec3::Zero(), t, FitDerivatives::None, false);
+  acc.addSums(sums.s, sums.used);
+  return acc.finish(minNeighbors);
+}
+
+/// The gathered neighbours as columns with their kernel weights (what reweight() reads).
+void fillColumns(double t, FitWorkspace& ws) {
+  const WeightKernel kernel(t);
+  ws.columns.clear();
   for (std::size_t k = 0; k < ws.offsets.size(); ++k) {
-    const Vec3 g = s.gradient(ws.offsets[k]);
-    const double gn = g.norm();
-    double factor = 0;
-    if (gn > 0) {
-      const double r = s.value(ws.offsets[k]) / gn;
-      const double dn = (ws.normals[k] - g / gn).squaredNorm();
-      factor = expNegative(r * r * invSr2 + dn * invSn2);
-    }
-    rho[k] = factor;
-    change = std::max(change, std::abs(factor - ws.weights[k]));
+    const double r = kernel.ratio(ws.offsets[k].squaredNorm());
+    ws.columns.push(ws.offsets[k], ws.normals[k], r < 1 ? (r - 1) * (r - 1) : 0.0);  // Eq. 1.6
   }
-  return change;
 }
 
 bool isAlgebraicSphere(EstimatorKind kind) {
@@ -162,15 +158,23 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
   const FitDerivatives order = derivativesOf(options.estimator);
   ws.weights.assign(ws.offsets.size(), 1.0);
   bool full = reported && passes == 0;
-  OrientedSphereFitResult res = spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None,
-                                           full, options.minNeighbors);
+  if (passes == 0)
+    return spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None, full,
+                      options.minNeighbors);
+  fillColumns(t, ws);
+  OrientedSphereFitResult res = sumsPass(t, kernelSums(ws.columns), options.minNeighbors);
+  const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
+  const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
+  SphereSums sums;
   for (int it = 0; it < passes && res.valid; ++it) {
     // Converged: the next fit would be (nearly) the current one.
-    if (robustWeights(res.sphere, t, ws, ws.trialWeights) <= options.robustTolerance) break;
+    const double change =
+        reweight(res.sphere, invSr2, invSn2, ws.columns, ws.weights, ws.trialWeights, sums);
+    if (change <= options.robustTolerance) break;
     const bool last = reported && it + 1 == passes;
     // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
     OrientedSphereFitResult next =
-        spherePass(t, ws, ws.trialWeights, last ? order : FitDerivatives::None, last, 1);
+        last ? spherePass(t, ws, ws.trialWeights, order, true, 1) : sumsPass(t, sums, 1);
     if (!next.valid) break;
     next.neighbors = res.neighbors;
     res = next;

@@ -8,6 +8,7 @@
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Types.hpp"
 #include "scalespace/fit/NeighborhoodCache.hpp"
+#include "scalespace/fit/RobustReweighting.hpp"
 
 namespace scalespace {
 
@@ -103,6 +104,7 @@ struct FitWorkspace {
   std::vector<Neighbor> neighbors;
   std::vector<Vec3> offsets, normals;         // neighbours gathered once per query: p - x and n
   std::vector<double> weights, trialWeights;  // robust re-weighting factors
+  NeighborColumns columns;                    // the neighbours as columns (robust passes)
 };
 
 /// Estimates the differential quantities at x with support radius t.

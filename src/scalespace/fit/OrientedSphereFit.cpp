@@ -174,6 +174,11 @@ void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* ext
   s_ += item;
 }
 
+void OrientedSphereFit::addSums(const double* sums, int count) {
+  for (int k = 0; k < 9; ++k) s_[k] += sums[k];
+  count_ += count;
+}
+
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
   OrientedSphereFitResult res;
   res.neighbors = count_;

@@ -44,6 +44,9 @@ class OrientedSphereFit {
   /// add(p[k], n[k], extraWeight[k]) for k < count. Without derivatives this runs a tight loop
   /// that keeps the sums in registers (the robust passes of fit/LocalFit make most calls).
   void addBatch(const Vec3* p, const Vec3* n, const double* extraWeight, std::size_t count);
+  /// Adds sums made elsewhere (fit/RobustReweighting: sum w, w q, w n, w q.n, w |q|^2 over
+  /// `count` samples of positive weight, frame centred at x). Only for fits without derivatives.
+  void addSums(const double* sums, int count);
   /// Solves Eq. 1.7-1.9 (and the derivatives). Invalid when fewer than minNeighbors samples
   /// have weight, when the positions are degenerate (all equal) or Delta <= 0.
   OrientedSphereFitResult finish(int minNeighbors) const;

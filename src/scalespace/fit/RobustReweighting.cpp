@@ -1,0 +1,187 @@
+#include "scalespace/fit/RobustReweighting.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "scalespace/fit/FastExp.hpp"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SCALESPACE_HAVE_AVX2_REWEIGHT 1
+#include <immintrin.h>
+#endif
+
+namespace scalespace {
+
+void NeighborColumns::clear() {
+  for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->clear();
+}
+
+void NeighborColumns::push(const Vec3& q, const Vec3& n, double kernelWeight) {
+  qx.push_back(q.x()), qy.push_back(q.y()), qz.push_back(q.z());
+  nx.push_back(n.x()), ny.push_back(n.y()), nz.push_back(n.z());
+  d2.push_back(q.squaredNorm());
+  weight.push_back(kernelWeight);
+}
+
+namespace {
+
+std::atomic<bool> forcePortable{false};
+
+inline void addSample(SphereSums& out, const NeighborColumns& c, std::size_t k, double w) {
+  out.s[0] += w;
+  out.s[1] += w * c.qx[k], out.s[2] += w * c.qy[k], out.s[3] += w * c.qz[k];
+  out.s[4] += w * c.nx[k], out.s[5] += w * c.ny[k], out.s[6] += w * c.nz[k];
+  out.s[7] += w * (c.qx[k] * c.nx[k] + c.qy[k] * c.ny[k] + c.qz[k] * c.nz[k]);
+  out.s[8] += w * c.d2[k];
+  out.used += w > 0 ? 1 : 0;
+}
+
+/// The factor of neighbour k (scalar; also the tail of the vector loop).
+inline double factorOf(const AlgebraicSphere& s, double invSr2, double invSn2,
+                       const NeighborColumns& c, std::size_t k) {
+  const Vec3 q(c.qx[k], c.qy[k], c.qz[k]);
+  const Vec3 g = s.ul + 2 * s.uq * q;
+  const double gn = g.norm();
+  if (!(gn > 0)) return 0;
+  const double r = (s.uc + s.ul.dot(q) + s.uq * c.d2[k]) / gn;
+  const double dn = (Vec3(c.nx[k], c.ny[k], c.nz[k]) - g / gn).squaredNorm();
+  return expNegative(r * r * invSr2 + dn * invSn2);
+}
+
+double reweightPortable(const AlgebraicSphere& s, double invSr2, double invSn2,
+                        const NeighborColumns& c, const std::vector<double>& previous,
+                        std::size_t from, std::vector<double>& rho, SphereSums& next) {
+  double change = 0;
+  for (std::size_t k = from; k < c.size(); ++k) {
+    rho[k] = factorOf(s, invSr2, invSn2, c, k);
+    change = std::max(change, std::abs(rho[k] - previous[k]));
+    addSample(next, c, k, c.weight[k] * rho[k]);
+  }
+  return change;
+}
+
+#ifdef SCALESPACE_HAVE_AVX2_REWEIGHT
+bool cpuHasAvx2Fma() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+}
+
+/// expNegative (fit/FastExp.hpp) on four lanes: the same reduction and polynomial; the scaling by
+/// 2^-n goes through the exponent bits for every lane (FastExp uses ldexp for n > 1000, where
+/// exp(-x) < 1e-301: a weight that small is 0 for any purpose). x >= 708 and NaN give 0.
+__attribute__((target("avx2,fma"))) inline __m256d expNegative4(__m256d x) {
+  const __m256d valid = _mm256_cmp_pd(x, _mm256_set1_pd(708.0), _CMP_LT_OQ);  // false for NaN
+  x = _mm256_max_pd(_mm256_min_pd(x, _mm256_set1_pd(708.0)), _mm256_setzero_pd());
+  const __m256d n =
+      _mm256_floor_pd(_mm256_fmadd_pd(x, _mm256_set1_pd(1.4426950408889634), _mm256_set1_pd(0.5)));
+  const __m256d y =
+      _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(n, _mm256_set1_pd(6.93147180369123816490e-01)), x),
+                    _mm256_mul_pd(n, _mm256_set1_pd(1.90821492927058770002e-10)));
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d y2 = _mm256_mul_pd(y, y);
+  const __m256d a = _mm256_add_pd(
+      _mm256_add_pd(one, y),
+      _mm256_mul_pd(y2, _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 6), _mm256_set1_pd(0.5))));
+  const __m256d b = _mm256_add_pd(
+      _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 120), _mm256_set1_pd(1.0 / 24)),
+      _mm256_mul_pd(y2, _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 5040), _mm256_set1_pd(1.0 / 720))));
+  const __m256d p = _mm256_fmadd_pd(_mm256_mul_pd(y2, y2), b, a);
+  // 2^-n: the biased exponent 1023 - n (an integer-valued double in [1, 1023]) read as an
+  // integer by adding 2^52, then shifted into the exponent field.
+  const __m256d biased =
+      _mm256_add_pd(_mm256_sub_pd(_mm256_set1_pd(1023.0), n), _mm256_set1_pd(4503599627370496.0));
+  const __m256i e = _mm256_slli_epi64(
+      _mm256_sub_epi64(_mm256_castpd_si256(biased), _mm256_set1_epi64x(0x4330000000000000LL)), 52);
+  return _mm256_and_pd(_mm256_mul_pd(p, _mm256_castsi256_pd(e)), valid);
+}
+
+__attribute__((target("avx2,fma"))) double reweightAvx2(const AlgebraicSphere& s, double invSr2,
+                                                        double invSn2, const NeighborColumns& c,
+                                                        const std::vector<double>& previous,
+                                                        std::vector<double>& rho,
+                                                        SphereSums& next) {
+  const __m256d uc = _mm256_set1_pd(s.uc), uq = _mm256_set1_pd(s.uq);
+  const __m256d two_uq = _mm256_set1_pd(2 * s.uq);
+  const __m256d ulx = _mm256_set1_pd(s.ul.x()), uly = _mm256_set1_pd(s.ul.y()),
+                ulz = _mm256_set1_pd(s.ul.z());
+  const __m256d sr = _mm256_set1_pd(invSr2), sn = _mm256_set1_pd(invSn2);
+  const __m256d signMask = _mm256_set1_pd(-0.0);
+  __m256d acc[9];
+  for (__m256d& v : acc) v = _mm256_setzero_pd();
+  __m256d change = _mm256_setzero_pd();
+  __m256i used = _mm256_setzero_si256();
+  const std::size_t n = c.size(), n4 = n & ~std::size_t(3);
+  for (std::size_t k = 0; k < n4; k += 4) {
+    const __m256d qx = _mm256_loadu_pd(&c.qx[k]), qy = _mm256_loadu_pd(&c.qy[k]),
+                  qz = _mm256_loadu_pd(&c.qz[k]);
+    const __m256d nx = _mm256_loadu_pd(&c.nx[k]), ny = _mm256_loadu_pd(&c.ny[k]),
+                  nz = _mm256_loadu_pd(&c.nz[k]);
+    const __m256d d2 = _mm256_loadu_pd(&c.d2[k]);
+    const __m256d gx = _mm256_fmadd_pd(two_uq, qx, ulx), gy = _mm256_fmadd_pd(two_uq, qy, uly),
+                  gz = _mm256_fmadd_pd(two_uq, qz, ulz);
+    const __m256d gn =
+        _mm256_sqrt_pd(_mm256_fmadd_pd(gx, gx, _mm256_fmadd_pd(gy, gy, _mm256_mul_pd(gz, gz))));
+    const __m256d inv = _mm256_div_pd(_mm256_set1_pd(1.0), gn);  // inf where gn = 0: rho 0
+    const __m256d f = _mm256_fmadd_pd(
+        uq, d2, _mm256_fmadd_pd(ulx, qx, _mm256_fmadd_pd(uly, qy, _mm256_fmadd_pd(ulz, qz, uc))));
+    const __m256d r = _mm256_mul_pd(f, inv);
+    const __m256d dx = _mm256_fnmadd_pd(gx, inv, nx), dy = _mm256_fnmadd_pd(gy, inv, ny),
+                  dz = _mm256_fnmadd_pd(gz, inv, nz);
+    const __m256d dn = _mm256_fmadd_pd(dx, dx, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dz, dz)));
+    const __m256d rh =
+        expNegative4(_mm256_fmadd_pd(_mm256_mul_pd(r, r), sr, _mm256_mul_pd(dn, sn)));
+    _mm256_storeu_pd(&rho[k], rh);
+    change = _mm256_max_pd(
+        change, _mm256_andnot_pd(signMask, _mm256_sub_pd(rh, _mm256_loadu_pd(&previous[k]))));
+    const __m256d w = _mm256_mul_pd(_mm256_loadu_pd(&c.weight[k]), rh);
+    used = _mm256_sub_epi64(used,
+                            _mm256_castpd_si256(_mm256_cmp_pd(w, _mm256_setzero_pd(), _CMP_GT_OQ)));
+    acc[0] = _mm256_add_pd(acc[0], w);
+    acc[1] = _mm256_fmadd_pd(w, qx, acc[1]);
+    acc[2] = _mm256_fmadd_pd(w, qy, acc[2]);
+    acc[3] = _mm256_fmadd_pd(w, qz, acc[3]);
+    acc[4] = _mm256_fmadd_pd(w, nx, acc[4]);
+    acc[5] = _mm256_fmadd_pd(w, ny, acc[5]);
+    acc[6] = _mm256_fmadd_pd(w, nz, acc[6]);
+    acc[7] = _mm256_fmadd_pd(
+        w, _mm256_fmadd_pd(qx, nx, _mm256_fmadd_pd(qy, ny, _mm256_mul_pd(qz, nz))), acc[7]);
+    acc[8] = _mm256_fmadd_pd(w, d2, acc[8]);
+  }
+  alignas(32) double lane[4];
+  for (int i = 0; i < 9; ++i) {
+    _mm256_store_pd(lane, acc[i]);
+    next.s[i] += (lane[0] + lane[1]) + (lane[2] + lane[3]);
+  }
+  _mm256_store_pd(lane, change);
+  double maxChange = std::max(std::max(lane[0], lane[1]), std::max(lane[2], lane[3]));
+  alignas(32) long long counts[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(counts), used);
+  next.used += int(counts[0] + counts[1] + counts[2] + counts[3]);
+  return std::max(maxChange, reweightPortable(s, invSr2, invSn2, c, previous, n4, rho, next));
+}
+#endif
+
+}  // namespace
+
+SphereSums kernelSums(const NeighborColumns& c) {
+  SphereSums out;
+  for (std::size_t k = 0; k < c.size(); ++k) addSample(out, c, k, c.weight[k]);
+  return out;
+}
+
+double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
+                const NeighborColumns& c, const std::vector<double>& previous,
+                std::vector<double>& rho, SphereSums& next) {
+  rho.resize(c.size());
+  next = SphereSums{};
+#ifdef SCALESPACE_HAVE_AVX2_REWEIGHT
+  if (!forcePortable.load(std::memory_order_relaxed) && cpuHasAvx2Fma())
+    return reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
+#endif
+  return reweightPortable(sphere, invSr2, invSn2, c, previous, 0, rho, next);
+}
+
+void setPortableReweightingForTesting(bool portable) { forcePortable.store(portable); }
+
+}  // namespace scalespace

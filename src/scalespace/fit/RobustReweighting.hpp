@@ -1,0 +1,47 @@
+#pragma once
+// One RIMLS re-weighting pass of the robust APSS (Oztireli, Guennebaud, Gross 2009; constants in
+// fit/LocalFit.cpp): for every neighbour k, its factor against the current sphere s,
+//   rho_k = exp(-(r_k / sigma_r)^2 - (|n_k - grad s(q_k)/|grad s(q_k)|| / sigma_n)^2),
+//   r_k = s(q_k) / |grad s(q_k)|,
+// fused with the accumulation of the next fit's sums (Eq. 1.7-1.9 inputs) with weights
+// w_k rho_k, w_k the kernel weight of Eq. 1.6. The robust stack spends most of its time here
+// (5 passes per fit), so the neighbours are read as columns and, on CPUs with AVX2 + FMA, four at
+// a time.
+#include <cstddef>
+#include <vector>
+
+#include "scalespace/fit/AlgebraicSphere.hpp"
+
+namespace scalespace {
+
+/// Neighbours as columns (structure of arrays), offsets q = p - y from the evaluation point.
+struct NeighborColumns {
+  std::vector<double> qx, qy, qz, nx, ny, nz;
+  std::vector<double> d2;      // |q|^2
+  std::vector<double> weight;  // kernel weight w(|q|) (Eq. 1.6)
+  std::size_t size() const { return qx.size(); }
+  void clear();
+  void push(const Vec3& q, const Vec3& n, double kernelWeight);
+};
+
+/// The 9 sums of a sphere fit: sum w, sum w q, sum w n, sum w q.n, sum w |q|^2, and how many
+/// samples had a positive weight.
+struct SphereSums {
+  double s[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  int used = 0;
+};
+
+/// Sums with weights w_k (rho = 1): the first, unweighted pass.
+SphereSums kernelSums(const NeighborColumns& c);
+
+/// Re-weights against `sphere`: writes rho_k to rho (resized), accumulates the sums with weights
+/// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]|. invSr2 = 1 /
+/// sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets rho = 0.
+double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
+                const NeighborColumns& c, const std::vector<double>& previous,
+                std::vector<double>& rho, SphereSums& next);
+
+/// Forces the portable (scalar) implementation of reweight, for tests on CPUs with AVX2.
+void setPortableReweightingForTesting(bool portable);
+
+}  // namespace scalespace
