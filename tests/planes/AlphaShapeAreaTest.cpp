@@ -1,3 +1,8 @@
+#include <CGAL/Alpha_shape_2.h>
+#include <CGAL/Alpha_shape_face_base_2.h>
+#include <CGAL/Alpha_shape_vertex_base_2.h>
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -55,19 +60,42 @@ TEST(AlphaShape, RandomSquareAreaAndSeparateParts) {
   EXPECT_EQ(alphaShape2({Vec2(0, 0), Vec2(1, 0)}, 1.0).area, 0.0);
 }
 
-TEST(AlphaShape, AreaWithoutOutlinesMatchesTheFullAlphaShape) {
-  // The area-only path sums Delaunay triangles by circumradius; it must agree with CGAL's
-  // Alpha_shape_2 classification (the path with outlines) for any alpha.
+TEST(AlphaShape, MatchesCgalAlphaShape2Regularized) {
+  // Our shape is read off the Delaunay triangulation; it must be CGAL's Alpha_shape_2 in
+  // REGULARIZED mode: same interior area, same boundary (regular) edges, for any alpha.
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Tds = CGAL::Triangulation_data_structure_2<CGAL::Alpha_shape_vertex_base_2<K>,
+                                                   CGAL::Alpha_shape_face_base_2<K>>;
+  using Shape = CGAL::Alpha_shape_2<CGAL::Delaunay_triangulation_2<K, Tds>>;
   std::mt19937_64 rng(11);
   std::normal_distribution<double> g(0, 1);
   std::vector<Vec2> pts;
-  for (int i = 0; i < 3000; ++i) pts.emplace_back(g(rng), 0.3 * g(rng));
+  std::vector<K::Point_2> cgalPts;
+  for (int i = 0; i < 3000; ++i) {
+    pts.emplace_back(g(rng), 0.3 * g(rng));
+    cgalPts.emplace_back(pts.back().x(), pts.back().y());
+  }
   for (double radius : {0.02, 0.05, 0.1, 0.3, 1.0, 10.0}) {
-    const double a = alphaShape2(pts, radius * radius, false).area;
-    const double b = alphaShape2(pts, radius * radius, true).area;
-    EXPECT_NEAR(a, b, 1e-12 * std::max(1.0, b)) << radius;
+    const AlphaShape ours = alphaShape2(pts, radius * radius, true);
+    EXPECT_EQ(alphaShape2(pts, radius * radius, false).area, ours.area);
+    const Shape cgal(cgalPts.begin(), cgalPts.end(), K::FT(radius * radius), Shape::REGULARIZED);
+    double area = 0;
+    for (auto f = cgal.finite_faces_begin(); f != cgal.finite_faces_end(); ++f)
+      if (cgal.classify(f) == Shape::INTERIOR)
+        area += std::abs(CGAL::to_double(cgal.triangle(f).area()));
+    EXPECT_NEAR(ours.area, area, 1e-12 * std::max(1.0, area)) << radius;
+    std::size_t edges = 0, loopEdges = 0;
+    double signedSum = 0;
+    for (auto e = cgal.alpha_shape_edges_begin(); e != cgal.alpha_shape_edges_end(); ++e) ++edges;
+    for (const auto& loop : ours.outlines) {
+      loopEdges += loop.size();
+      signedSum += signedArea(loop);
+    }
+    EXPECT_EQ(loopEdges, edges) << radius;
+    // Counter-clockwise outer loops and clockwise holes enclose exactly the interior area.
+    EXPECT_NEAR(signedSum, ours.area, 1e-9 * std::max(1.0, ours.area)) << radius;
     if (radius > 0.02) {
-      EXPECT_GT(a, 0.0);
+      EXPECT_GT(ours.area, 0.0);
     }
   }
 }
