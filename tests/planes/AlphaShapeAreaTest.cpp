@@ -133,3 +133,31 @@ TEST(PlaneFit, TiltedPlaneExact) {
     EXPECT_NEAR((liftFromPlane(fit, flat[k]) - pts[idx[k]]).norm(), 0, 1e-12);
   EXPECT_FALSE(fitPlane(pts, {0, 1}).valid);
 }
+
+TEST(AlphaShape, AreaAtLeastAgreesWithTheFullShape) {
+  // Early answers (bounding box, convex hull, a certified patch) must equal the full shape's.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<std::vector<Vec2>> sets(3);
+  for (int i = 0; i < 4000; ++i) sets[0].emplace_back(20 * u(rng), u(rng));  // long strip
+  for (int i = 0; i < 3000; ++i) {  // L shape: its hull is much larger than its area
+    const Vec2 p(u(rng), 6 * u(rng));
+    sets[1].push_back(i % 2 ? p : Vec2(p.y(), p.x()));
+  }
+  for (int i = 0; i < 40; ++i) sets[2].emplace_back(u(rng), u(rng));  // small: no patch
+  for (const auto& pts : sets)
+    for (double radius : {0.03, 0.1, 0.5, 3.0}) {
+      const double alpha = radius * radius;
+      const double area = alphaShape2(pts, alpha).area;
+      for (double f : {0.3, 0.97, 1.03, 3.0}) {
+        const double minArea = f * area + (area == 0 ? f : 0);
+        EXPECT_EQ(alphaShapeAreaAtLeast(pts, alpha, minArea), area >= minArea)
+            << pts.size() << " points, radius " << radius << ", threshold x" << f;
+      }
+      // The region filter's question (area >= radius^2): on the large sets a patch around the
+      // middle answers it.
+      EXPECT_EQ(alphaShapeAreaAtLeast(pts, alpha, alpha), area >= alpha) << radius;
+    }
+  EXPECT_FALSE(alphaShapeAreaAtLeast({Vec2(0, 0), Vec2(1, 0)}, 1.0, 1e-9));
+  EXPECT_TRUE(alphaShapeAreaAtLeast({Vec2(0, 0), Vec2(1, 0)}, 1.0, 0.0));
+}

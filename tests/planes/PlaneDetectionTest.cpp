@@ -79,7 +79,7 @@ TEST(RegionGrowing, SeedNormalCriterionAndDeterminism) {
 TEST(RegionGraph, ChainsJaccardAndPersistence) {
   EXPECT_DOUBLE_EQ(jaccardIndex({1, 2, 3, 4}, {3, 4, 5}), 2.0 / 5.0);
   EXPECT_DOUBLE_EQ(jaccardIndex({}, {}), 0.0);
-  auto region = [](std::vector<Index> p) { return FilteredRegion{std::move(p), 1.0}; };
+  auto region = [](std::vector<Index> p) { return FilteredRegion{std::move(p)}; };
   std::vector<RegionLevel> levels(4);
   for (int j = 0; j < 4; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
   levels[0].regions = {region({0, 1, 2, 3}), region({4, 5, 6, 7})};

@@ -20,6 +20,11 @@ struct AlphaShape {
 /// SQUARED radius (NOTES.md: radius 2t -> alpha = (2t)^2). Fewer than 3 points: area 0.
 AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withOutlines = false);
 
+/// alphaShape2(points, alpha).area >= minArea, decided without triangulating every point when
+/// the triangles near the middle of the set already cover minArea (the region filter of
+/// Sec. 2.3.1 only needs this answer; large regions pass it from a small patch).
+bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double minArea);
+
 struct PlaneFit {
   Vec3 normal = Vec3::UnitZ();  // unit; the plane is {x : normal . x = offset}
   double offset = 0.0;

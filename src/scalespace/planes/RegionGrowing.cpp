@@ -71,7 +71,6 @@ std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
     throw OptionError("region filter: scale and alpha factor must be positive");
   const double radius = options.alphaFactor * t;
   const auto& regions = segmentation.regions;
-  std::vector<double> area(regions.size(), 0.0);
   std::vector<std::uint8_t> keep(regions.size(), 0);
   ProgressTracker tracker(progress, "region filter", regions.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, regions.size(), 1), [&](const auto& range) {
@@ -80,15 +79,15 @@ std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
       // fewer than 3 points have zero area.
       if (regions[r].size() < 3) continue;
       const PlaneFit plane = fitPlane(positions, regions[r]);
-      area[r] = alphaShape2(projectOnPlane(plane, positions, regions[r]), radius * radius).area;
-      keep[r] = std::sqrt(area[r]) >= radius;
+      keep[r] = alphaShapeAreaAtLeast(projectOnPlane(plane, positions, regions[r]), radius * radius,
+                                      radius * radius);
     }
     tracker.advance(range.size());
   });
   tracker.finish();
   std::vector<FilteredRegion> kept;
   for (std::size_t r = 0; r < regions.size(); ++r)
-    if (keep[r]) kept.push_back({regions[r], area[r]});
+    if (keep[r]) kept.push_back({regions[r]});
   return kept;
 }
 

@@ -33,11 +33,12 @@ struct RegionFilterOptions {
 /// A region kept by the filter.
 struct FilteredRegion {
   std::vector<Index> points;  // increasing
-  double area = 0.0;          // alpha-shape area on its best-fit plane
 };
 
 /// Keeps the regions with sqrt(alpha-shape area) >= alphaFactor * t (NOTES.md reading of
-/// "a < 2t"), in their input order. Alpha shapes of different regions run in parallel.
+/// "a < 2t"), in their input order. Regions run in parallel; a large region is usually accepted
+/// from the alpha shape of a patch around its middle (alphaShapeAreaAtLeast), so the area itself
+/// is not computed (the components compute theirs at their representative level).
 std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
                                           const Segmentation& segmentation, double t,
                                           const RegionFilterOptions& options = {},
