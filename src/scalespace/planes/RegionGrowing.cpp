@@ -1,6 +1,7 @@
 #include "scalespace/planes/RegionGrowing.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,16 +24,18 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
 
   // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2; a stable sort of
   // indices keeps the lower index first on ties, so the result does not depend on anything else.
-  std::vector<double> curvedness(n);
-  std::vector<Index> seeds;
-  seeds.reserve(n);
+  // Sorted as (key, index) pairs: the same order as a stable sort of the indices, with the key
+  // next to its index (no indirection) and both cores at work.
+  std::vector<std::pair<double, Index>> order;
+  order.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    curvedness[i] = double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
-    if (scale.valid[i] && std::isfinite(curvedness[i]) && scale.normals[i].allFinite())
-      seeds.push_back(Index(i));
+    const double c = double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
+    if (scale.valid[i] && std::isfinite(c) && scale.normals[i].allFinite())
+      order.emplace_back(c, Index(i));
   }
-  std::stable_sort(seeds.begin(), seeds.end(),
-                   [&](Index a, Index b) { return curvedness[a] < curvedness[b]; });
+  tbb::parallel_sort(order.begin(), order.end());
+  std::vector<Index> seeds(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) seeds[k] = order[k].second;
 
   Segmentation seg;
   seg.labels.assign(n, -1);
