@@ -12,7 +12,10 @@ point i at every scale. Nothing is loaded until it is indexed.
 Two encodings (manifest "encoding"; format version 1 is always float32):
   float32  the values as they are (projection.npy, normal.npy, curv_max.npy, ...);
   compact  quantised (projection_offset.npy, frame.npy, curv_max_t.npy, ...): decode_scale()
-           and decode_point() below turn them back into the float32 quantities.
+           and decode_point() below turn them back into the float32 quantities. Format version 3
+           (the default, 19.125 bytes per point per scale) stores the offsets with a shared
+           exponent and anisotropy / geometric_variation as 8-bit log codes; version 2 (23.125
+           bytes) stores them as float16.
 Needs Debian's python3-numpy and nothing else.
 """
 import argparse
@@ -32,7 +35,7 @@ def load_stack(path):
         manifest = json.load(f)
     if manifest.get("format") != "scalespace-stack":
         raise ValueError(f"{path}: not a scalespace stack")
-    if manifest["format_version"] not in (1, 2):
+    if manifest["format_version"] not in (1, 2, 3):
         raise ValueError(f"{path}: format version {manifest['format_version']} is not supported")
     arrays = {}
     for name, q in manifest["quantities"].items():
@@ -41,7 +44,23 @@ def load_stack(path):
             raise ValueError(f"{path}/{q['file']}: shape/dtype differ from the manifest")
         arrays[name] = a
     xyz = np.load(os.path.join(path, manifest["input_positions"]["file"]), mmap_mode="r")
+    if encoding(manifest) == "compact" and manifest["format_version"] >= 3:
+        check_codecs(path, manifest)
     return manifest, arrays, xyz
+
+
+def check_codecs(path, manifest):
+    """Version 3: the parameters the decoders read from the manifest must be sane."""
+    q = manifest["quantities"]
+    off = q["projection_offset"]
+    bias = off.get("bias")
+    if off.get("codec") != "shared_exponent" or not isinstance(bias, int) or not 0 <= bias <= 64:
+        raise ValueError(f"{path}: projection_offset: expected codec shared_exponent, bias 0..64")
+    for name in ("anisotropy", "geometric_variation"):
+        lo, hi = q[name].get("log_min"), q[name].get("log_max")
+        if (q[name].get("codec") != "log8" or not isinstance(lo, (int, float))
+                or not isinstance(hi, (int, float)) or not 0 < lo < hi < np.inf):
+            raise ValueError(f"{path}: {name}: expected codec log8, 0 < log_min < log_max < inf")
 
 
 def encoding(manifest):
@@ -77,6 +96,31 @@ def decode_frame(code):
     return n, dmax, dmin
 
 
+def decode_offset(code, bias):
+    """uint32 shared-exponent codes (any shape) -> offsets in units of t (shape + (3,), float64).
+
+    bits 0-8, 9-17, 18-26: x, y, z, each a sign (bit 8) and a magnitude m (bits 0-7); bits 27-31:
+    the exponent e shared by the three; component = (-1)^sign * m * 2^(e - bias), exact in float64
+    (integer operations, then ldexp): the same doubles as ScaleStackReader.
+    """
+    code = np.asarray(code, dtype=np.uint32)
+    e = (code >> 27).astype(np.int32) - np.int32(bias)
+    comps = []
+    for c in range(3):
+        field = (code >> (9 * c)) & 0x1FF
+        m = (field & 0xFF).astype(np.float64)
+        comps.append(np.ldexp(np.where((field & 0x100) != 0, -m, m), e))
+    return np.stack(comps, axis=-1)
+
+
+def decode_log8(code, log_min, log_max):
+    """uint8 log codes (any shape) -> float64: code 0 is 0, code k = 1..255 the geometric centre
+    log_min * (log_max / log_min) ** ((k - 0.5) / 255) of the k-th of 255 equal-ratio bins."""
+    code = np.asarray(code, dtype=np.uint8)
+    k = code.astype(np.float64)
+    return np.where(code == 0, 0.0, log_min * np.power(log_max / log_min, (k - 0.5) / 255))
+
+
 def _decode(manifest, arrays, rel, t, index, valid):
     """Decodes compact arrays at `index` (scale j: (j,); point i: (slice(None), i)).
     rel: input positions relative to the origin, broadcastable to the result; t: the scale
@@ -85,10 +129,16 @@ def _decode(manifest, arrays, rel, t, index, valid):
         return np.asarray(arrays[name][index], dtype=np.float64)
 
     v = valid.astype(bool)
+    q = manifest["quantities"]
+    v3 = manifest["format_version"] >= 3
+    if v3:
+        offset = decode_offset(arrays["projection_offset"][index], q["projection_offset"]["bias"])
+    else:
+        offset = half("projection_offset")
     out = {"fit_valid": valid.astype(np.uint8),
            "neighbors": np.asarray(arrays["neighbors"][index]),
            # projection = input + offset * t, relative to the origin (also for invalid fits)
-           "projection": rel + half("projection_offset") * t[..., None]}
+           "projection": rel + offset * t[..., None]}
     n, dmax, dmin = decode_frame(arrays["frame"][index])
     out["normal"], out["dir_max"], out["dir_min"] = (np.where(v[..., None], a, 0.0) for a in (n, dmax, dmin))
     out["curv_max"] = np.where(v, half("curv_max_t") / t, 0.0)
@@ -96,8 +146,12 @@ def _decode(manifest, arrays, rel, t, index, valid):
     out["curv_mean"] = 0.5 * (out["curv_max"] + out["curv_min"])
     out["gls_tau"] = np.where(v, half("gls_tau_t") * t, 0.0)
     out["gls_kappa"] = np.where(v, half("gls_kappa_t") / t, 0.0)
-    out["anisotropy"] = np.where(v, half("anisotropy"), 0.0)
-    out["geometric_variation"] = np.where(v, half("geometric_variation"), 0.0)
+    for name in ("anisotropy", "geometric_variation"):
+        if v3:
+            value = decode_log8(arrays[name][index], q[name]["log_min"], q[name]["log_max"])
+        else:
+            value = half(name)
+        out[name] = np.where(v, value, 0.0)
     return out  # gls_fitness is not stored in the compact encoding
 
 
@@ -136,6 +190,15 @@ def compare(compact_path, float32_path):
                               "|d k_max| / |k_max| (|k_max| t > 0.01)",
                               "|d k_min| / |k_min| (|k_min| t > 0.01)",
                               "|d kappa| / |kappa| (|kappa| t > 0.01)")}
+    # Log-coded quantities (version 3): relative error inside the code's range, absolute below it
+    # (version 2: float16's normal range).
+    ranges = {}
+    for name, key in (("anisotropy", "aniso"), ("geometric_variation", "nu")):
+        qc = mc["quantities"][name]
+        ranges[name] = (key, qc.get("log_min", 2.0 ** -14), qc.get("log_max", 65504.0))
+        errors[f"|d {key}| / {key} ({key} in [log_min, log_max])"] = []
+        errors[f"|d {key}| ({key} < log_min, negative included)"] = []
+    negative = {name: 0 for name in ranges}
     flags_differ = 0
 
     def axis_angle(a, b):
@@ -158,13 +221,23 @@ def compare(compact_path, float32_path):
                 errors[f"|d {key}| t"].append(d * t)
             big = k * t > 0.01
             errors[f"|d {key}| / |{key}| (|{key}| t > 0.01)"].append(d[big] / k[big])
+        for name, (key, lo, hi) in ranges.items():
+            fv = f[name][v].astype(np.float64)
+            d = np.abs(c[name][v] - fv)
+            inside = (fv >= lo) & (fv <= hi)
+            errors[f"|d {key}| / {key} ({key} in [log_min, log_max])"].append(d[inside] / fv[inside])
+            errors[f"|d {key}| ({key} < log_min, negative included)"].append(d[fv < lo])
+            negative[name] += int(np.count_nonzero(fv < 0))
+    per_file = ", ".join(f"{k} {q['clamped']}" for k, q in mc["quantities"].items() if q.get("clamped"))
     print(f"{compact_path} vs {float32_path}: {mc['point_count']} points x {mc['scale_count']} scales, "
-          f"valid flags differing: {flags_differ}, values clamped: {mc.get('clamped_values', 0)}")
-    print(f"{'error':42s} {'max':>10s} {'99th pct':>10s} {'count':>10s}")
+          f"valid flags differing: {flags_differ}, values clamped: {mc.get('clamped_values', 0)}"
+          + (f" ({per_file})" if per_file else ""))
+    print("negative float32 values (valid fits): " + ", ".join(f"{k} {c}" for k, c in negative.items()))
+    print(f"{'error':52s} {'max':>10s} {'99th pct':>10s} {'count':>10s}")
     for name, parts in errors.items():
         e = np.concatenate(parts) if parts else np.zeros(0)
         if e.size:
-            print(f"{name:42s} {e.max():10.3g} {np.percentile(e, 99):10.3g} {e.size:10d}")
+            print(f"{name:52s} {e.max():10.3g} {np.percentile(e, 99):10.3g} {e.size:10d}")
     return 0
 
 
@@ -193,7 +266,8 @@ def main():
     for name in ("normal", "dir_max", "dir_min"):
         for k, c in enumerate("xyz"):
             print(f"{name}_{c}[{j}, {i}] = {float(scale[name][i][k]):.9g}")
-    for name in ("curv_mean", "curv_max", "curv_min", "gls_tau", "gls_kappa", "anisotropy"):
+    for name in ("curv_mean", "curv_max", "curv_min", "gls_tau", "gls_kappa", "anisotropy",
+                 "geometric_variation"):
         print(f"{name}[{j}, {i}] = {float(scale[name][i]):.6g}")
     valid = scale["fit_valid"]
     print(f"valid fits at scale {j}: {int(valid.sum())} of {n}")

@@ -5,8 +5,10 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
+#include "scalespace/core/Error.hpp"
 #include "scalespace/scales/StackQuantization.hpp"
 
 namespace scalespace::quant {
@@ -172,6 +174,221 @@ TEST(StackQuantization, BitPackingRoundTrip) {
   packBits(f, 9, p);
   EXPECT_EQ(p[0], 0x81);
   EXPECT_EQ(p[1], 0x01);
+}
+
+// ------------------------------------------------------------ shared-exponent offsets (v3)
+
+std::uint32_t offsetCode(const Vec3& o, bool* clampedOut = nullptr) {
+  bool clamped = false;
+  const std::uint32_t code = encodeSharedExponent(o, clamped);
+  if (clampedOut) *clampedOut = clamped;
+  return code;
+}
+
+TEST(StackQuantization, SharedExponentKnownValues) {
+  EXPECT_EQ(offsetCode(Vec3::Zero()), 0u);
+  EXPECT_EQ(offsetCode(Vec3(-0.0, 0.0, -0.0)), 0u);  // no negative zero
+  // 1 = 128 2^-7: e = 27 - 7 = 20, x magnitude 128, y = -0.5 = -64 2^-7 (sign bit 8 of y).
+  const std::uint32_t one = offsetCode(Vec3(1, -0.5, 0));
+  EXPECT_EQ(one, (20u << 27) | 128u | ((0x100u | 64u) << 9));
+  EXPECT_EQ(decodeSharedExponent(one), Vec3(1, -0.5, 0));
+  // 255.4 2^-7 stays at e = 20 (m = 255), 255.5 2^-7 rounds to 256: one exponent more.
+  EXPECT_EQ(offsetCode(Vec3(0, 0, 255.4 / 128)) >> 27, 20u);
+  EXPECT_EQ((offsetCode(Vec3(0, 0, 255.4 / 128)) >> 18) & 0x1ffu, 255u);
+  EXPECT_EQ(offsetCode(Vec3(0, 0, 255.5 / 128)) >> 27, 21u);
+  EXPECT_EQ((offsetCode(Vec3(0, 0, 255.5 / 128)) >> 18) & 0x1ffu, 128u);
+  // The smallest exponent: steps of 2^-27, ties away from zero, below half a step -> 0.
+  EXPECT_EQ(offsetCode(Vec3(std::ldexp(1.0, -27), 0, 0)), 1u);
+  EXPECT_EQ(offsetCode(Vec3(std::ldexp(1.0, -28), 0, 0)), 1u);
+  EXPECT_EQ(offsetCode(Vec3(std::ldexp(0.99, -28), 0, 0)), 0u);
+  EXPECT_EQ(offsetCode(Vec3(1e-300, -1e-300, 0)), 0u);
+  EXPECT_EQ(decodeSharedExponent(1u), Vec3(std::ldexp(1.0, -27), 0, 0));
+  // 2^-20 is the first offset with a full 8-bit magnitude at e = 0.
+  EXPECT_EQ(offsetCode(Vec3(std::ldexp(1.0, -20), 0, 0)), 128u);
+  // The decoding uses the bias it is given (the manifest's).
+  EXPECT_EQ(decodeSharedExponent(one, 20), Vec3(128, -64, 0));
+}
+
+TEST(StackQuantization, SharedExponentClampsAndNeverReturnsNaN) {
+  const double maxDecoded = 255.0 * 16;  // 255 2^(31 - 27)
+  bool clamped = true;
+  const std::uint32_t below = offsetCode(Vec3(4087.9, -1, 0), &clamped);
+  EXPECT_FALSE(clamped);
+  EXPECT_EQ(decodeSharedExponent(below).x(), maxDecoded);
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const Vec3& o : {Vec3(4088, 0, 0), Vec3(0, -1e300, 3), Vec3(inf, 0, 0), Vec3(1, -inf, inf),
+                        Vec3(-inf, -inf, -inf)}) {
+    const Vec3 d = decodeSharedExponent(offsetCode(o, &clamped));
+    EXPECT_TRUE(clamped) << o.transpose();
+    ASSERT_TRUE(d.allFinite()) << o.transpose();
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LE(std::abs(d[c]), maxDecoded);
+      if (std::abs(o[c]) >= 4088) {
+        EXPECT_EQ(d[c], std::copysign(maxDecoded, o[c]));
+      }
+      EXPECT_FALSE(std::signbit(d[c]) != std::signbit(o[c]) && d[c] != 0) << o.transpose();
+    }
+  }
+  // NaN components are zeroed (and counted); the others are kept.
+  const Vec3 d = decodeSharedExponent(offsetCode(Vec3(nan, 0.25, -0.5), &clamped));
+  EXPECT_TRUE(clamped);
+  EXPECT_EQ(d, Vec3(0, 0.25, -0.5));
+  EXPECT_EQ(offsetCode(Vec3(nan, nan, nan), &clamped), 0u);
+  EXPECT_TRUE(clamped);
+}
+
+TEST(StackQuantization, SharedExponentCanonicalCodesRoundTrip) {
+  // Every exponent and every x field (sign, magnitude) with a range of y, z: a code the encoder can
+  // produce (largest magnitude >= 128 unless e = 0, no negative zero) decodes and re-encodes to
+  // itself, and every code decodes to finite values.
+  std::size_t checked = 0;
+  for (std::uint32_t e = 0; e <= 31; ++e)
+    for (std::uint32_t x = 0; x < 512; ++x)
+      for (std::uint32_t y = 0; y < 512; y += 37)
+        for (const std::uint32_t z : {0u, 1u, 200u, 0x100u | 255u}) {
+          const std::uint32_t code = (e << 27) | x | (y << 9) | (z << 18);
+          const Vec3 o = decodeSharedExponent(code);
+          ASSERT_TRUE(o.allFinite());
+          const std::uint32_t fields[3] = {x, y, z};
+          std::uint32_t largest = 0;
+          bool negativeZero = false;
+          for (const std::uint32_t f : fields) {
+            largest = std::max(largest, f & 0xffu);
+            negativeZero = negativeZero || f == 0x100u;
+          }
+          if (negativeZero || (e > 0 && largest < 128)) continue;
+          ASSERT_EQ(offsetCode(o), code) << std::hex << code;
+          ++checked;
+        }
+  EXPECT_GT(checked, 200000u);
+}
+
+TEST(StackQuantization, SharedExponentMeetsTheDocumentedBound) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> logMag(-12, std::log10(4000.0)), u(-1, 1);
+  double worstRelative = 0;
+  for (int k = 0; k < 300000; ++k) {
+    // Random directions and lengths over 15 decades; a third with a zero or tiny component.
+    Vec3 o = std::pow(10.0, logMag(rng)) * Vec3(u(rng), u(rng), u(rng));
+    if (k % 3 == 1) o[int(rng() % 3)] = 0;
+    if (k % 3 == 2) o[int(rng() % 3)] *= 1e-6;
+    bool clamped = false;
+    const std::uint32_t code = encodeSharedExponent(o, clamped);
+    ASSERT_FALSE(clamped);
+    const Vec3 d = decodeSharedExponent(code);
+    const double a = o.cwiseAbs().maxCoeff();
+    const double bound = std::max(kOffsetRelativeError * a, kOffsetAbsoluteFloor);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_LE(std::abs(d[c] - o[c]), bound * (1 + 1e-12)) << o.transpose();
+      if (o[c] == 0) {
+        ASSERT_EQ(d[c], 0.0);
+      }
+    }
+    // The largest component uses the top half of the magnitudes unless e = 0.
+    if ((code >> 27) > 0) {
+      std::uint32_t largest = 0;
+      for (int c = 0; c < 3; ++c) largest = std::max(largest, (code >> (9 * c)) & 0xffu);
+      ASSERT_GE(largest, 128u) << o.transpose();
+    }
+    if (a > 1e-6) worstRelative = std::max(worstRelative, (d - o).cwiseAbs().maxCoeff() / a);
+  }
+  EXPECT_GT(worstRelative, 0.9 * kOffsetRelativeError);  // the bound is tight
+  std::printf("shared exponent: max error / max |o_i| %.4g (bound %.4g)\n", worstRelative,
+              kOffsetRelativeError);
+}
+
+// ------------------------------------------------------------ 8-bit logarithmic codes (v3)
+
+TEST(StackQuantization, Log8EveryCodeRoundTrips) {
+  for (const auto& [lo, hi] :
+       {std::pair{kAnisotropyLogMin, kAnisotropyLogMax},
+        std::pair{kVariationLogMin, kVariationLogMax}, std::pair{0.5, 2.0}}) {
+    const Log8Code code(lo, hi);
+    EXPECT_EQ(code.decode(0), 0.0);
+    EXPECT_NEAR(code.decode(1), lo * std::sqrt(code.stepRatio()), 1e-12 * lo);
+    EXPECT_NEAR(code.decode(255), hi / std::sqrt(code.stepRatio()), 1e-12 * hi);
+    for (int k = 0; k <= 255; ++k) {
+      bool clamped = false;
+      const double v = code.decode(std::uint8_t(k));
+      ASSERT_TRUE(std::isfinite(v));
+      ASSERT_EQ(code.encode(v, clamped), k) << v;
+      ASSERT_FALSE(clamped);
+      if (k > 1) {
+        ASSERT_NEAR(v / code.decode(std::uint8_t(k - 1)), code.stepRatio(), 1e-12);
+      }
+      // The bin edges go to a neighbouring code, within half a step either way.
+      const double edge = lo * std::pow(code.stepRatio(), k);
+      if (k >= 1) {
+        const std::uint8_t e = code.encode(edge, clamped);
+        ASSERT_TRUE(e == k || e == k + 1 || (k == 255 && e == 255)) << k << " " << int(e);
+        ASSERT_LE(std::abs(code.decode(e) - edge), code.maxRelativeError() * edge * (1 + 1e-12));
+      }
+    }
+  }
+  EXPECT_THROW(Log8Code(0, 1), Error);
+  EXPECT_THROW(Log8Code(1, 1), Error);
+  EXPECT_THROW(Log8Code(1e-7, std::numeric_limits<double>::infinity()), Error);
+  EXPECT_THROW(Log8Code(std::numeric_limits<double>::quiet_NaN(), 1), Error);
+}
+
+TEST(StackQuantization, Log8MeetsTheDocumentedBound) {
+  // Documented figures (docs/STACK_FORMAT.md).
+  const Log8Code aniso(kAnisotropyLogMin, kAnisotropyLogMax);
+  const Log8Code nu(kVariationLogMin, kVariationLogMax);
+  EXPECT_NEAR(aniso.stepRatio(), 1.06525, 1e-5);
+  EXPECT_NEAR(aniso.maxRelativeError(), 0.03211, 1e-5);
+  EXPECT_NEAR(aniso.absoluteFloor(), 5.161e-8, 1e-11);
+  EXPECT_NEAR(nu.stepRatio(), 1.15543, 1e-5);
+  EXPECT_NEAR(nu.maxRelativeError(), 0.07491, 1e-5);
+  EXPECT_NEAR(nu.absoluteFloor(), 5.375e-11, 1e-14);
+  std::mt19937_64 rng(17);
+  for (const Log8Code* code : {&aniso, &nu}) {
+    std::uniform_real_distribution<double> logV(std::log(code->lo()) - 3, std::log(code->hi()));
+    double worst = 0;
+    for (int k = 0; k < 200000; ++k) {
+      const double v = std::exp(logV(rng));
+      bool clamped = false;
+      const double d = code->decode(code->encode(v, clamped));
+      ASSERT_FALSE(clamped) << v;
+      ASSERT_LE(std::abs(d - v), code->maxRelativeError() * v * (1 + 1e-12) + code->absoluteFloor())
+          << v;
+      if (v >= code->lo()) {
+        ASSERT_LE(std::abs(d - v), code->maxRelativeError() * v * (1 + 1e-12)) << v;
+        worst = std::max(worst, std::abs(d - v) / v);
+      } else {
+        ASSERT_LE(std::abs(d - v), code->absoluteFloor() * (1 + 1e-12)) << v;
+      }
+    }
+    EXPECT_GT(worst, 0.95 * code->maxRelativeError());
+  }
+}
+
+TEST(StackQuantization, Log8ClampsAndNeverReturnsNaN) {
+  const Log8Code code(kAnisotropyLogMin, kAnisotropyLogMax);
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    double v;
+    int expected;
+    bool clamped;
+  };
+  for (const Case& c :
+       {Case{0.0, 0, false}, Case{-0.0, 0, false}, Case{-kLogNegativeTolerance, 0, false},
+        Case{-1e-16, 0, false}, Case{-2.4e-7, 0, true}, Case{-0.15, 0, true}, Case{-inf, 0, true},
+        Case{std::numeric_limits<double>::quiet_NaN(), 0, true}, Case{1e-300, 0, false},
+        Case{1.0, 255, false}, Case{1.0 + 1e-15, 255, true}, Case{1e30, 255, true},
+        Case{inf, 255, true}}) {
+    bool clamped = false;
+    const std::uint8_t k = code.encode(c.v, clamped);
+    EXPECT_EQ(k, c.expected) << c.v;
+    EXPECT_EQ(clamped, c.clamped) << c.v;
+    EXPECT_TRUE(std::isfinite(code.decode(k)));
+  }
+  // Below lo: the nearest of 0 and the first centre.
+  bool clamped = false;
+  EXPECT_EQ(code.encode(0.49 * code.decode(1), clamped), 0);
+  EXPECT_EQ(code.encode(0.51 * code.decode(1), clamped), 1);
+  EXPECT_FALSE(clamped);
 }
 
 }  // namespace

@@ -86,7 +86,7 @@ void addScalesCommand(CLI::App& app) {
   cmd->add_option("--estimator", args->estimator, "w3 | w2 | w1 | plane | mean | quadric | jet")
       ->capture_default_str();
   cmd->add_option("--encoding", args->encoding,
-                  "compact (quantised, ~23 bytes per point per scale) | float32 (83 bytes)")
+                  "compact (quantised, ~19 bytes per point per scale) | float32 (83 bytes)")
       ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "worker threads (0 = all cores)")
       ->capture_default_str();
@@ -241,7 +241,7 @@ bool printStackInfo(const std::string& path, std::ostream& out) {
                 stackEncodingName(info.encoding), info.bytesPerPointPerScale);
   out << encoding;
   if (info.encoding == StackEncoding::Compact)
-    out << ", " << info.clampedValues << " values clamped to +-65504";
+    out << ", " << info.clampedValues << " values clamped (out of range when written)";
   out << "\n";
   out << "  points: " << info.pointCount << "\n  scales: " << info.scales.size()
       << " (t = " << info.scales.front() << " .. " << info.scales.back() << ")\n";

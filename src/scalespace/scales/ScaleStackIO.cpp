@@ -39,30 +39,34 @@ struct Quantity {
   const char* description;
   std::vector<float> ScaleLayer::*floats;  // float32 encoding; nullptr for integers and compact
   const char* scaling;                     // compact: how the stored value relates to t_j
+  const char* codec;                       // compact version 3: how the number is stored
 };
 
 // The float32 encoding (format version 1): the ScaleLayer fields as they are.
 const Quantity kFloat32Quantities[] = {
     {"projection", "<f4", 4, 3, "projected position relative to manifest origin",
-     &ScaleLayer::projection, "none"},
-    {"normal", "<f4", 4, 3, "unit normal", &ScaleLayer::normal, "none"},
-    {"dir_max", "<f4", 4, 3, "principal direction of k_max", &ScaleLayer::dirMax, "none"},
-    {"dir_min", "<f4", 4, 3, "principal direction of k_min", &ScaleLayer::dirMin, "none"},
-    {"curv_mean", "<f4", 4, 1, "mean curvature H", &ScaleLayer::meanCurvature, "none"},
-    {"curv_max", "<f4", 4, 1, "principal curvature k_max", &ScaleLayer::kMax, "none"},
-    {"curv_min", "<f4", 4, 1, "principal curvature k_min", &ScaleLayer::kMin, "none"},
-    {"gls_tau", "<f4", 4, 1, "GLS tau", &ScaleLayer::tau, "none"},
-    {"gls_kappa", "<f4", 4, 1, "GLS kappa", &ScaleLayer::kappa, "none"},
-    {"gls_fitness", "<f4", 4, 1, "GLS fitness (Pratt norm)", &ScaleLayer::fitness, "none"},
-    {"anisotropy", "<f4", 4, 1, "1 - |u_l| (Eq. 1.20)", &ScaleLayer::anisotropy, "none"},
+     &ScaleLayer::projection, "none", nullptr},
+    {"normal", "<f4", 4, 3, "unit normal", &ScaleLayer::normal, "none", nullptr},
+    {"dir_max", "<f4", 4, 3, "principal direction of k_max", &ScaleLayer::dirMax, "none", nullptr},
+    {"dir_min", "<f4", 4, 3, "principal direction of k_min", &ScaleLayer::dirMin, "none", nullptr},
+    {"curv_mean", "<f4", 4, 1, "mean curvature H", &ScaleLayer::meanCurvature, "none", nullptr},
+    {"curv_max", "<f4", 4, 1, "principal curvature k_max", &ScaleLayer::kMax, "none", nullptr},
+    {"curv_min", "<f4", 4, 1, "principal curvature k_min", &ScaleLayer::kMin, "none", nullptr},
+    {"gls_tau", "<f4", 4, 1, "GLS tau", &ScaleLayer::tau, "none", nullptr},
+    {"gls_kappa", "<f4", 4, 1, "GLS kappa", &ScaleLayer::kappa, "none", nullptr},
+    {"gls_fitness", "<f4", 4, 1, "GLS fitness (Pratt norm)", &ScaleLayer::fitness, "none", nullptr},
+    {"anisotropy", "<f4", 4, 1, "1 - |u_l| (Eq. 1.20)", &ScaleLayer::anisotropy, "none", nullptr},
     {"geometric_variation", "<f4", 4, 1, "GLS geometric variation nu",
-     &ScaleLayer::geometricVariation, "none"},
-    {"neighbors", "<u2", 2, 1, "samples in the last fit (saturated at 65535)", nullptr, "none"},
-    {"fit_valid", "|u1", 1, 1, "1 if the fit is valid", nullptr, "none"},
+     &ScaleLayer::geometricVariation, "none", nullptr},
+    {"neighbors", "<u2", 2, 1, "samples in the last fit (saturated at 65535)", nullptr, "none",
+     nullptr},
+    {"fit_valid", "|u1", 1, 1, "1 if the fit is valid", nullptr, "none", nullptr},
 };
 
-// The compact encoding (format version 2, docs/STACK_FORMAT.md): 23.125 bytes per point and
-// scale. The order is the order of the buffers of encodeCompact / decodeCompact.
+// The compact encodings (docs/STACK_FORMAT.md): format version 3 (written, 19.125 bytes per point
+// and scale) and version 2 (read, and written only on request: 23.125 bytes). Both have the same
+// files in the same order, the order of the buffers of encodeCompact / decodeCompact; version 3
+// stores the offset with a shared exponent and the anisotropy and nu as 8-bit log codes.
 enum CompactFile {
   kOffset,
   kFrame,
@@ -76,22 +80,48 @@ enum CompactFile {
   kValidBits,
   kCompactFiles
 };
-const Quantity kCompactQuantities[] = {
-    {"projection_offset", "<f2", 2, 3, "(projection - input position) / t_j", nullptr, "over_t"},
+const Quantity kCompactV2Quantities[] = {
+    {"projection_offset", "<f2", 2, 3, "(projection - input position) / t_j", nullptr, "over_t",
+     nullptr},
     {"frame", "<u4", 4, 1,
      "bits 0-10, 11-21: octahedral normal (excess 1023); bits 22-31: dir_max angle q pi/1024",
-     nullptr, "none"},
-    {"curv_max_t", "<f2", 2, 1, "k_max * t_j", nullptr, "times_t"},
-    {"curv_min_t", "<f2", 2, 1, "k_min * t_j", nullptr, "times_t"},
-    {"gls_tau_t", "<f2", 2, 1, "GLS tau / t_j", nullptr, "over_t"},
-    {"gls_kappa_t", "<f2", 2, 1, "GLS kappa * t_j", nullptr, "times_t"},
-    {"anisotropy", "<f2", 2, 1, "1 - |u_l| (Eq. 1.20)", nullptr, "none"},
-    {"geometric_variation", "<f2", 2, 1, "GLS geometric variation nu", nullptr, "none"},
-    {"neighbors", "|u1", 1, 1, "samples in the last fit (saturated at 255)", nullptr, "none"},
+     nullptr, "none", nullptr},
+    {"curv_max_t", "<f2", 2, 1, "k_max * t_j", nullptr, "times_t", nullptr},
+    {"curv_min_t", "<f2", 2, 1, "k_min * t_j", nullptr, "times_t", nullptr},
+    {"gls_tau_t", "<f2", 2, 1, "GLS tau / t_j", nullptr, "over_t", nullptr},
+    {"gls_kappa_t", "<f2", 2, 1, "GLS kappa * t_j", nullptr, "times_t", nullptr},
+    {"anisotropy", "<f2", 2, 1, "1 - |u_l| (Eq. 1.20)", nullptr, "none", nullptr},
+    {"geometric_variation", "<f2", 2, 1, "GLS geometric variation nu", nullptr, "none", nullptr},
+    {"neighbors", "|u1", 1, 1, "samples in the last fit (saturated at 255)", nullptr, "none",
+     nullptr},
     {"fit_valid_bits", "|u1", 1, 0, "1 if the fit is valid, bit-packed (bitorder little)", nullptr,
-     "none"},
+     "none", nullptr},
 };
-static_assert(sizeof kCompactQuantities / sizeof kCompactQuantities[0] == kCompactFiles);
+const Quantity kCompactV3Quantities[] = {
+    {"projection_offset", "<u4", 4, 1,
+     "(projection - input position) / t_j, shared exponent: bits 0-8, 9-17, 18-26: x, y, z (bit 8 "
+     "sign, bits 0-7 magnitude m); bits 27-31: e; component = +-m 2^(e - bias)",
+     nullptr, "over_t", "shared_exponent"},
+    {"frame", "<u4", 4, 1,
+     "bits 0-10, 11-21: octahedral normal (excess 1023); bits 22-31: dir_max angle q pi/1024",
+     nullptr, "none", "octahedral_frame"},
+    {"curv_max_t", "<f2", 2, 1, "k_max * t_j", nullptr, "times_t", "float16"},
+    {"curv_min_t", "<f2", 2, 1, "k_min * t_j", nullptr, "times_t", "float16"},
+    {"gls_tau_t", "<f2", 2, 1, "GLS tau / t_j", nullptr, "over_t", "float16"},
+    {"gls_kappa_t", "<f2", 2, 1, "GLS kappa * t_j", nullptr, "times_t", "float16"},
+    {"anisotropy", "|u1", 1, 1,
+     "1 - |u_l| (Eq. 1.20); code 0: 0, code k: log_min (log_max / log_min)^((k - 0.5) / 255)",
+     nullptr, "none", "log8"},
+    {"geometric_variation", "|u1", 1, 1,
+     "GLS geometric variation nu; code 0: 0, code k: log_min (log_max / log_min)^((k - 0.5) / 255)",
+     nullptr, "none", "log8"},
+    {"neighbors", "|u1", 1, 1, "samples in the last fit (saturated at 255)", nullptr, "none",
+     "uint8"},
+    {"fit_valid_bits", "|u1", 1, 0, "1 if the fit is valid, bit-packed (bitorder little)", nullptr,
+     "none", "packbits_little"},
+};
+static_assert(sizeof kCompactV2Quantities / sizeof kCompactV2Quantities[0] == kCompactFiles);
+static_assert(sizeof kCompactV3Quantities / sizeof kCompactV3Quantities[0] == kCompactFiles);
 
 struct QuantityTable {
   const Quantity* begin_;
@@ -99,10 +129,13 @@ struct QuantityTable {
   const Quantity* begin() const { return begin_; }
   const Quantity* end() const { return end_; }
 };
-QuantityTable quantities(StackEncoding e) {
-  if (e == StackEncoding::Compact)
-    return {std::begin(kCompactQuantities), std::end(kCompactQuantities)};
-  return {std::begin(kFloat32Quantities), std::end(kFloat32Quantities)};
+// The files of an encoding; compact stacks by format version (2 or 3).
+QuantityTable quantities(StackEncoding e, int compactVersion) {
+  if (e == StackEncoding::Float32)
+    return {std::begin(kFloat32Quantities), std::end(kFloat32Quantities)};
+  if (compactVersion == 2)
+    return {std::begin(kCompactV2Quantities), std::end(kCompactV2Quantities)};
+  return {std::begin(kCompactV3Quantities), std::end(kCompactV3Quantities)};
 }
 
 // Bytes of one scale of a quantity, and of one point of it (bit-packed: the byte holding it).
@@ -146,23 +179,47 @@ float readHalf(const unsigned char* p) {
   return quant::halfToFloat(h);
 }
 
+// The codecs of a compact stack: its format version and, for version 3, the offset exponent bias
+// and the ranges of the log codes (the writer's constants; the reader's come from the manifest).
+struct CompactCodecs {
+  int version = kStackFormatVersion;
+  int offsetBias = quant::kOffsetBias;
+  quant::Log8Code anisotropy{quant::kAnisotropyLogMin, quant::kAnisotropyLogMax};
+  quant::Log8Code variation{quant::kVariationLogMin, quant::kVariationLogMax};
+};
+
 // Encodes one scale (t: its scale value; rel: input positions relative to the origin, 3 N).
 void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel,
-                   std::vector<std::vector<unsigned char>>& buf,
+                   const CompactCodecs& codecs, std::vector<std::vector<unsigned char>>& buf,
                    std::vector<std::size_t>& clamped) {
   const std::size_t n = L.size();
-  for (int k = 0; k < kCompactFiles; ++k) buf[k].assign(sliceBytes(kCompactQuantities[k], n), 0);
+  const bool version3 = codecs.version >= 3;
+  const Quantity* table = quantities(StackEncoding::Compact, codecs.version).begin();
+  for (int k = 0; k < kCompactFiles; ++k) buf[k].assign(sliceBytes(table[k], n), 0);
   // Points are independent: encoded in parallel blocks (a tenth of a 1M x 50 stack's time when
   // sequential), each block counting its clamped values; the sums do not depend on the blocks.
   std::mutex countLock;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& range) {
     std::vector<std::size_t> local(clamped.size(), 0);
     auto half = [&](int k) { return HalfWriter{&local[std::size_t(k)]}; };
+    auto log8 = [&](int k, const quant::Log8Code& code, float v, std::size_t i) {
+      bool c = false;
+      buf[std::size_t(k)][i] = code.encode(double(v), c);
+      if (c) ++local[std::size_t(k)];
+    };
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       // The projection is meaningful for invalid fits too (the last valid one): always stored.
+      Vec3 offset;
       for (int c = 0; c < 3; ++c)
-        half(kOffset)((double(L.projection[3 * i + c]) - rel[3 * i + c]) / t,
-                      &buf[kOffset][6 * i + 2 * c]);
+        offset[c] = (double(L.projection[3 * i + c]) - rel[3 * i + c]) / t;
+      if (version3) {
+        bool c = false;
+        const std::uint32_t code = quant::encodeSharedExponent(offset, c);
+        if (c) ++local[kOffset];
+        std::memcpy(&buf[kOffset][4 * i], &code, 4);
+      } else {
+        for (int c = 0; c < 3; ++c) half(kOffset)(offset[c], &buf[kOffset][6 * i + 2 * c]);
+      }
       buf[kNeighbors][i] = std::uint8_t(std::min<unsigned>(L.neighbors[i], 255u));
       if (!L.valid[i]) continue;  // zeros: decoded as zeros
       const auto v3 = [&](const std::vector<float>& a) {
@@ -174,8 +231,13 @@ void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel
       half(kCurvMin)(double(L.kMin[i]) * t, &buf[kCurvMin][2 * i]);
       half(kTau)(double(L.tau[i]) / t, &buf[kTau][2 * i]);
       half(kKappa)(double(L.kappa[i]) * t, &buf[kKappa][2 * i]);
-      half(kAnisotropy)(double(L.anisotropy[i]), &buf[kAnisotropy][2 * i]);
-      half(kVariation)(double(L.geometricVariation[i]), &buf[kVariation][2 * i]);
+      if (version3) {
+        log8(kAnisotropy, codecs.anisotropy, L.anisotropy[i], i);
+        log8(kVariation, codecs.variation, L.geometricVariation[i], i);
+      } else {
+        half(kAnisotropy)(double(L.anisotropy[i]), &buf[kAnisotropy][2 * i]);
+        half(kVariation)(double(L.geometricVariation[i]), &buf[kVariation][2 * i]);
+      }
     }
     const std::lock_guard<std::mutex> hold(countLock);
     for (std::size_t k = 0; k < clamped.size(); ++k) clamped[k] += local[k];
@@ -186,14 +248,22 @@ void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel
 // Decodes `count` consecutive points of one scale: data[k] points at the first point's bytes of
 // file k (for the bit-packed flags: the byte holding it, whose bit is firstBit); rel are the
 // points' input positions relative to the origin. Point p goes to entry out0 + p of `out`.
-void decodeCompact(const std::vector<const unsigned char*>& data, std::size_t firstBit,
-                   std::size_t count, double t, const double* rel, ScaleLayer& out,
-                   std::size_t out0) {
+void decodeCompact(const CompactCodecs& codecs, const std::vector<const unsigned char*>& data,
+                   std::size_t firstBit, std::size_t count, double t, const double* rel,
+                   ScaleLayer& out, std::size_t out0) {
+  const bool version3 = codecs.version >= 3;
   for (std::size_t p = 0; p < count; ++p) {
     const std::size_t o = out0 + p;
-    for (int c = 0; c < 3; ++c)
-      out.projection[3 * o + c] =
-          float(rel[3 * p + c] + double(readHalf(data[kOffset] + 6 * p + 2 * c)) * t);
+    Vec3 offset;
+    if (version3) {
+      std::uint32_t code;
+      std::memcpy(&code, data[kOffset] + 4 * p, 4);
+      offset = quant::decodeSharedExponent(code, codecs.offsetBias);
+    } else {
+      for (int c = 0; c < 3; ++c) offset[c] = double(readHalf(data[kOffset] + 6 * p + 2 * c));
+    }
+    // In double, then rounded once: what read_stack.py computes in float64.
+    for (int c = 0; c < 3; ++c) out.projection[3 * o + c] = float(rel[3 * p + c] + offset[c] * t);
     out.neighbors[o] = data[kNeighbors][p];
     const std::uint8_t valid = quant::unpackBit(data[kValidBits], firstBit + p);
     out.valid[o] = valid;
@@ -215,8 +285,13 @@ void decodeCompact(const std::vector<const unsigned char*>& data, std::size_t fi
     out.tau[o] = float(double(readHalf(data[kTau] + 2 * p)) * t);
     out.kappa[o] = float(double(readHalf(data[kKappa] + 2 * p)) / t);
     out.fitness[o] = 0;  // not stored in the compact encoding
-    out.anisotropy[o] = readHalf(data[kAnisotropy] + 2 * p);
-    out.geometricVariation[o] = readHalf(data[kVariation] + 2 * p);
+    if (version3) {
+      out.anisotropy[o] = float(codecs.anisotropy.decode(data[kAnisotropy][p]));
+      out.geometricVariation[o] = float(codecs.variation.decode(data[kVariation][p]));
+    } else {
+      out.anisotropy[o] = readHalf(data[kAnisotropy] + 2 * p);
+      out.geometricVariation[o] = readHalf(data[kVariation] + 2 * p);
+    }
   }
 }
 
@@ -380,6 +455,7 @@ struct ScaleStackWriter::Impl {
   std::vector<double> inputRel;                  // compact: input positions - origin, 3 N
   std::vector<std::vector<unsigned char>> bufs;  // compact: one scale, encoded
   std::vector<std::size_t> clamped;              // compact: clamped values per file
+  CompactCodecs codecs;                          // compact: format version and codecs
   nlohmann::json parameters;
   bool finished = false;
 
@@ -406,6 +482,10 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
   d.origin = cloud.origin();
   d.parameters = optionsJson(options);
   d.encoding = write.encoding;
+  if (write.compactVersion != 2 && write.compactVersion != 3)
+    throw OptionError("StackWriteOptions::compactVersion must be 2 or 3, not " +
+                      std::to_string(write.compactVersion));
+  d.codecs.version = write.compactVersion;
   d.clamped.assign(kCompactFiles, 0);
   d.bufs.resize(kCompactFiles);
   std::error_code ec;
@@ -415,7 +495,7 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
                     "cannot create the temporary stack directory: " + ec.message(),
                     "check that the parent directory exists and is writable");
   try {
-    for (const Quantity& q : quantities(d.encoding)) {
+    for (const Quantity& q : quantities(d.encoding, d.codecs.version)) {
       const std::string file = (d.tmpPath / (std::string(q.name) + ".npy")).string();
       const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       if (fd < 0)
@@ -476,9 +556,9 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
   if (!(t > 0) || !std::isfinite(t))
     throw Error("ScaleStackWriter: scale " + std::to_string(j) + " has t = " + std::to_string(t));
   const bool compact = d.encoding == StackEncoding::Compact;
-  if (compact) encodeCompact(layer, t, d.inputRel, d.bufs, d.clamped);
+  if (compact) encodeCompact(layer, t, d.inputRel, d.codecs, d.bufs, d.clamped);
   std::size_t k = 0;
-  for (const Quantity& q : quantities(d.encoding)) {
+  for (const Quantity& q : quantities(d.encoding, d.codecs.version)) {
     const std::size_t bytes = sliceBytes(q, d.n);
     const unsigned char* p = compact ? d.bufs[k].data() : layerBytes(q, layer);
     writeAll(d.fds[k], p, bytes, (d.tmpPath / q.name).string() + ".npy");
@@ -517,8 +597,9 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
   nlohmann::json manifest;
   manifest["format"] = "scalespace-stack";
   const bool compact = d.encoding == StackEncoding::Compact;
-  // Float32 stacks stay version 1 (readable by older programs); compact stacks are version 2.
-  manifest["format_version"] = compact ? 2 : 1;
+  // Float32 stacks stay version 1 (readable by older programs); compact stacks are version 3
+  // (version 2 on request).
+  manifest["format_version"] = compact ? d.codecs.version : 1;
   manifest["encoding"] = stackEncodingName(d.encoding);
   manifest["program"] = "scalespace";
   manifest["program_version"] = SCALESPACE_VERSION;
@@ -539,7 +620,7 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
   nlohmann::json entries = nlohmann::json::object();
   std::size_t k = 0;
   std::size_t clampedTotal = 0;
-  for (const Quantity& q : quantities(d.encoding)) {
+  for (const Quantity& q : quantities(d.encoding, d.codecs.version)) {
     entries[q.name] = {
         {"file", std::string(q.name) + ".npy"}, {"dtype", q.dtype},
         {"shape", quantityShape(q, d.m, d.n)},  {"scale_factor", 1.0},
@@ -548,6 +629,15 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
       entries[q.name]["scaling"] = q.scaling;
       entries[q.name]["clamped"] = d.clamped[k];
       clampedTotal += d.clamped[k];
+    }
+    // Version 3: how each file is stored, with the parameters a decoder needs (numpy included).
+    if (q.codec) entries[q.name]["codec"] = q.codec;
+    if (q.codec && std::strcmp(q.codec, "shared_exponent") == 0)
+      entries[q.name]["bias"] = d.codecs.offsetBias;
+    if (q.codec && std::strcmp(q.codec, "log8") == 0) {
+      const quant::Log8Code& code = k == kAnisotropy ? d.codecs.anisotropy : d.codecs.variation;
+      entries[q.name]["log_min"] = code.lo();
+      entries[q.name]["log_max"] = code.hi();
     }
     ++k;
   }
@@ -622,11 +712,48 @@ void writeScaleStack(const std::string& path, const PointCloud& cloud,
 
 // ---------------------------------------------------------------------------------------- reader
 
+namespace {
+
+// Checks the codec of a version-3 compact quantity in the manifest and reads its parameters into
+// `codecs` (the decoders use the manifest's values, so that numpy and we decode alike).
+void readCodec(const std::string& manifestPath, const Quantity& q, const nlohmann::json& entry,
+               CompactCodecs& codecs) {
+  const std::string fix = "recompute the stack with 'scalespace scales'";
+  const std::string what = std::string("quantity '") + q.name + "': ";
+  if (entry.at("codec").get<std::string>() != q.codec ||
+      entry.at("scaling").get<std::string>() != q.scaling)
+    throw FileError(manifestPath, "",
+                    what + "codec '" + entry.at("codec").get<std::string>() + "', scaling '" +
+                        entry.at("scaling").get<std::string>() + "' (expected '" + q.codec +
+                        "', '" + q.scaling + "')",
+                    fix);
+  if (std::strcmp(q.codec, "shared_exponent") == 0) {
+    // Any bias decodes exactly; beyond 0..64 the values would be absurd (2^-64 t and finer).
+    const int bias = entry.at("bias").get<int>();
+    if (bias < 0 || bias > 64)
+      throw FileError(manifestPath, "", what + "bias " + std::to_string(bias) + " is not in 0..64",
+                      fix);
+    codecs.offsetBias = bias;
+  } else if (std::strcmp(q.codec, "log8") == 0) {
+    const double lo = entry.at("log_min").get<double>(), hi = entry.at("log_max").get<double>();
+    if (!(lo > 0) || !(hi > lo) || !std::isfinite(hi))
+      throw FileError(manifestPath, "",
+                      what + "log_min " + std::to_string(lo) + " and log_max " +
+                          std::to_string(hi) + " must satisfy 0 < log_min < log_max < inf",
+                      fix);
+    (std::strcmp(q.name, "anisotropy") == 0 ? codecs.anisotropy : codecs.variation) =
+        quant::Log8Code(lo, hi);
+  }
+}
+
+}  // namespace
+
 struct ScaleStackReader::Impl {
   fs::path dir;
   StackInfo info;
   std::vector<int> fds;  // one per quantity of the encoding
-  QuantityTable table = quantities(StackEncoding::Float32);
+  QuantityTable table = quantities(StackEncoding::Float32, 1);
+  CompactCodecs codecs;  // compact: the manifest's version, bias and log ranges
   std::vector<std::uint64_t> dataOffset;
   std::vector<std::string> files;
   std::vector<std::string> sums;
@@ -765,7 +892,8 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     if (quantisation != (info.encoding == StackEncoding::Compact ? "compact" : "none"))
       throw FileError(manifestPath, "", "unknown quantisation '" + quantisation + "'", fix);
     info.clampedValues = manifest.value("clamped_values", std::size_t(0));
-    d.table = quantities(info.encoding);
+    d.codecs.version = info.formatVersion;
+    d.table = quantities(info.encoding, info.formatVersion);
     for (std::size_t j = 0; j < info.scales.size(); ++j)
       if (!(info.scales[j] > 0) || !std::isfinite(info.scales[j]))
         throw FileError(manifestPath, "", "scale " + std::to_string(j) + " is not positive", fix);
@@ -781,6 +909,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
         throw FileError(manifestPath, "",
                         std::string("quantity '") + q.name + "' has an unexpected dtype or shape",
                         fix);
+      if (q.codec) readCodec(manifestPath, q, entry, d.codecs);
       const std::string file = (d.dir / entry.at("file").get<std::string>()).string();
       d.fds.push_back(-1);
       d.dataOffset.push_back(
@@ -830,7 +959,7 @@ ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
     preadAll(d.fds[k], out, bytes, d.dataOffset[k] + std::uint64_t(j) * bytes, d.files[k]);
     ++k;
   }
-  if (compact) decodeCompact(rows, 0, n, info().scales[j], d.inputRel().data(), layer, 0);
+  if (compact) decodeCompact(d.codecs, rows, 0, n, info().scales[j], d.inputRel().data(), layer, 0);
   return layer;
 }
 
@@ -856,7 +985,7 @@ ScaleLayer ScaleStackReader::readPointSeries(std::size_t i) const {
         ptrs[k] = item[k];
         ++k;
       }
-      decodeCompact(ptrs, i % 8, 1, info().scales[j], rel, series, j);
+      decodeCompact(d.codecs, ptrs, i % 8, 1, info().scales[j], rel, series, j);
     }
     return series;
   }

@@ -2,8 +2,10 @@
 // The scale stack on disk (docs/STACK_FORMAT.md): a directory NAME.stack/ holding manifest.json
 // and one NumPy .npy file per quantity, shaped (M, N), (M, N, 3) or (M, ceil(N / 8)) for
 // bit-packed flags, so that numpy.load(f, mmap_mode='r')[j] is scale j and [:, i] is point i
-// without our code. Two encodings: float32 (format version 1) and compact (version 2: float16 in
-// units of t, octahedral frames, bit-packed flags; the pure codecs are in StackQuantization.hpp).
+// without our code. Two encodings: float32 (format version 1) and compact (version 3: float16 in
+// units of t, octahedral frames, bit-packed flags, shared-exponent offsets and 8-bit log codes;
+// version 2, with float16 offsets, anisotropy and nu, is still read; the pure codecs are in
+// StackQuantization.hpp).
 //
 // Writing is atomic: everything goes to NAME.stack.tmp-<pid>/, each file is fsync'ed, the
 // manifest is written last, and only then is the directory renamed to NAME.stack (an older stack
@@ -21,13 +23,15 @@
 namespace scalespace {
 
 /// The newest format version this program writes and reads. Version 1: float32 only; version 2
-/// adds the "encoding" key and the compact encoding. Float32 stacks are still written as version 1
-/// (identical to what older programs wrote and read); compact stacks are version 2.
-constexpr int kStackFormatVersion = 2;
+/// adds the "encoding" key and the compact encoding; version 3 changes three compact files
+/// (projection_offset, anisotropy, geometric_variation: 4 bytes less per point per scale, so that
+/// 1M points x 50 scales fit in 1 GB). Float32 stacks are still written as version 1 (identical to
+/// what older programs wrote and read); compact stacks are version 3. All three are read.
+constexpr int kStackFormatVersion = 3;
 
 /// How the per-scale quantities are stored (docs/STACK_FORMAT.md).
 enum class StackEncoding {
-  Compact,  // quantised, 23.125 bytes per point per scale (float16, octahedral frame, bit flags)
+  Compact,  // quantised, 19.125 bytes per point per scale (version 3; version 2: 23.125)
   Float32,  // every ScaleLayer field as float32 / uint16 / uint8, 83 bytes per point per scale
 };
 const char* stackEncodingName(StackEncoding encoding);
@@ -37,6 +41,9 @@ StackEncoding parseStackEncoding(const std::string& name);
 /// How a stack is written (kept apart from ScaleSpaceOptions: it does not change the results).
 struct StackWriteOptions {
   StackEncoding encoding = StackEncoding::Compact;
+  /// Format version of a compact stack: 3, or 2 for the previous layout (for programs that read
+  /// only versions 1 and 2, and for the tests of the version-2 reader). OptionError otherwise.
+  int compactVersion = kStackFormatVersion;
 };
 
 /// Streams a stack to disk scale by scale (peak memory: one ScaleLayer).
@@ -54,7 +61,9 @@ class ScaleStackWriter {
   /// Appends scale j of scale value t (the compact encoding stores lengths in units of t); scales
   /// must come in order 0, 1, ..., scaleCount-1.
   void writeScale(std::size_t j, const ScaleLayer& layer, double t);
-  /// Values clamped to +-65504 (or non-finite values zeroed) by the compact encoding so far.
+  /// Values clamped by the compact encoding so far (out of range or non-finite: float16 beyond
+  /// +-65504, offsets beyond 4088 t, log codes above their range or negative;
+  /// docs/STACK_FORMAT.md).
   std::size_t clampedValues() const;
   /// Writes the manifest (scales, stats, checksums), syncs and renames into place. Throws Error if
   /// the summary's scale values differ from those given to writeScale.
@@ -80,7 +89,7 @@ struct StackInfo {
   int formatVersion = 0;
   StackEncoding encoding = StackEncoding::Float32;
   double bytesPerPointPerScale = 0;  // the per-scale files' data, divided by N
-  std::size_t clampedValues = 0;     // compact: values clamped to +-65504 when written
+  std::size_t clampedValues = 0;     // compact: values clamped when written
   std::string programVersion;
   std::size_t pointCount = 0;
   std::vector<double> scales;

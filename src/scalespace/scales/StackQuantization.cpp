@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
+
+#include "scalespace/core/Error.hpp"
 
 namespace scalespace::quant {
 
@@ -164,6 +167,94 @@ void decodeFrame(std::uint32_t code, Vec3& normal, Vec3& dirMax, Vec3& dirMin) {
 double axisAngle(const Vec3& a, const Vec3& b) {
   // atan2 of |a x b| and |a . b| is accurate for small angles, unlike acos.
   return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
+}
+
+// ------------------------------------------------------- shared-exponent offsets (version 3)
+
+std::uint32_t encodeSharedExponent(const Vec3& offset, bool& clamped) {
+  double v[3];
+  double largest = 0;
+  for (int c = 0; c < 3; ++c) {
+    v[c] = offset[c];
+    if (std::isnan(v[c])) {  // never expected: the fits report finite values
+      v[c] = 0;
+      clamped = true;
+    }
+    largest = std::max(largest, std::abs(v[c]));
+  }
+  if (!(largest > 0)) return 0;  // a zero offset is the code 0
+  int e = kOffsetExponentMax;
+  if (largest >= kOffsetMaxMagnitude) {  // inf included
+    clamped = true;
+  } else {
+    // largest = f 2^k with f in [0.5, 1): largest 2^(8 - k) is in [128, 256), so e - bias = k - 8
+    // puts the largest magnitude in the top half of 0..255, unless it rounds to 256 (then one
+    // more). Exact: scaling by a power of two does not round.
+    int k;
+    std::frexp(largest, &k);
+    e = k - 8 + kOffsetBias;
+    if (std::ldexp(largest, kOffsetBias - e) >= kOffsetMagnitudeMax + 0.5) ++e;
+    e = std::max(e, 0);  // tiny offsets: the absolute floor (kOffsetAbsoluteFloor)
+  }
+  std::uint32_t code = std::uint32_t(e) << 27;
+  for (int c = 0; c < 3; ++c) {
+    const double scaled = std::round(std::ldexp(std::abs(v[c]), kOffsetBias - e));
+    const std::uint32_t m =
+        scaled >= kOffsetMagnitudeMax ? std::uint32_t(kOffsetMagnitudeMax) : std::uint32_t(scaled);
+    const std::uint32_t sign = (m != 0 && v[c] < 0) ? 0x100u : 0u;  // no negative zero
+    code |= (sign | m) << (9 * c);
+  }
+  return code;
+}
+
+Vec3 decodeSharedExponent(std::uint32_t code, int bias) {
+  const int e = int(code >> 27) - bias;
+  Vec3 o;
+  for (int c = 0; c < 3; ++c) {
+    const std::uint32_t field = (code >> (9 * c)) & 0x1ffu;
+    const double m = double(field & 0xffu);
+    o[c] = std::ldexp((field & 0x100u) ? -m : m, e);
+  }
+  return o;
+}
+
+// ---------------------------------------------------- 8-bit logarithmic codes (version 3)
+
+Log8Code::Log8Code(double lo, double hi) : lo_(lo), hi_(hi) {
+  if (!(lo > 0) || !(hi > lo) || !std::isfinite(hi))
+    throw Error("Log8Code: the range must satisfy 0 < lo < hi < inf, not [" + std::to_string(lo) +
+                ", " + std::to_string(hi) + "]");
+  ratio_ = std::pow(hi / lo, 1.0 / kCodes);
+  // The same expression as the NumPy decoder (docs/STACK_FORMAT.md), so both give the same doubles.
+  for (int k = 1; k <= kCodes; ++k) {
+    centre_[std::size_t(k)] = lo * std::pow(hi / lo, (k - 0.5) / kCodes);
+    logCentre_[std::size_t(k)] = std::log(centre_[std::size_t(k)]);
+  }
+}
+
+std::uint8_t Log8Code::encode(double value, bool& clamped) const {
+  if (std::isnan(value)) {
+    clamped = true;
+    return 0;
+  }
+  if (value <= 0) {
+    if (value < -kLogNegativeTolerance) clamped = true;
+    return 0;
+  }
+  if (value > hi_) {  // inf included
+    clamped = true;
+    return kCodes;
+  }
+  if (value < lo_) return value >= 0.5 * centre_[1] ? 1 : 0;
+  // The bin from the logarithm, then the nearest centre in log among its neighbours: the rounding
+  // of log() near a bin edge cannot then break the half-step bound.
+  const double lv = std::log(value);
+  const int guess = std::clamp(int((lv - logCentre_[1]) / std::log(ratio_) + 1.5), 1, kCodes);
+  int best = guess;
+  for (int k = std::max(1, guess - 1); k <= std::min(kCodes, guess + 1); ++k)
+    if (std::abs(lv - logCentre_[std::size_t(k)]) < std::abs(lv - logCentre_[std::size_t(best)]))
+      best = k;
+  return std::uint8_t(best);
 }
 
 // ------------------------------------------------------------------------------- bit packing

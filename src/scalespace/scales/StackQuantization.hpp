@@ -1,11 +1,15 @@
 #pragma once
 // The pure encode/decode functions of the compact stack encoding (docs/STACK_FORMAT.md,
-// "Compact encoding"). They are kept apart from the file handling so that they can be tested
-// exhaustively, and so that scripts/read_stack.py can mirror them line by line.
+// "Compact encoding": float16 and the octahedral frame since format version 2, the shared-exponent
+// offsets and the 8-bit logarithmic codes of version 3). They are kept apart from the file handling
+// so that they can be tested exhaustively, and so that scripts/read_stack.py can mirror them line
+// by line.
 //
 // Everything here is deterministic and uses only integer arithmetic wherever a decision is taken
 // (octahedral fold, sign of the tangent basis), so that a decoder written in another language
 // (NumPy) takes the same branches as ours.
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -75,6 +79,90 @@ void decodeFrame(std::uint32_t code, Vec3& normal, Vec3& dirMax, Vec3& dirMin);
 
 /// Angle (radians, in [0, pi/2]) between the lines spanned by a and b.
 double axisAngle(const Vec3& a, const Vec3& b);
+
+// ------------------------------------------------------- shared-exponent offsets (version 3)
+
+/// The projection offset o = (projection - input) / t in 32 bits: one 5-bit exponent e shared by
+/// three 9-bit sign-magnitude components (the idea of OpenGL's RGB9_E5 and of block floating
+/// point; EXT_texture_shared_exponent, 2008), component c = (-1)^s_c m_c 2^(e - bias):
+///
+///   bits 0..8: x (bit 8 sign, bits 0..7 magnitude m), 9..17: y, 18..26: z, 27..31: e.
+///
+/// The three components of one offset have similar magnitudes where it matters (the error is
+/// bounded by the largest one, which sets the length of the offset), so one exponent serves all
+/// three and leaves 8 bits of magnitude each, 12 bits less than three float16.
+/// The encoder takes the smallest e whose rounding keeps every |m_c| <= 255, so the largest
+/// component uses the full magnitude range (128..255) unless e = 0; rounding is to nearest, ties
+/// away from zero; a component that rounds to 0 (in particular an exact 0) is stored as +0.
+constexpr int kOffsetBias = 27;
+constexpr int kOffsetExponentMax = 31;
+constexpr int kOffsetMagnitudeMax = 255;
+/// Offsets whose largest component reaches 255.5 * 2^(31 - 27) = 4088 (in units of t) do not fit
+/// (m would round to 256 at the largest exponent): every component is clamped to 255 * 16, with
+/// its sign, and the offset is counted as clamped. Measured offsets stay below 1.5 t.
+constexpr double kOffsetMaxMagnitude = 255.5 * (1 << (kOffsetExponentMax - kOffsetBias));
+/// Worst error per component, |decoded_c - o_c| <= max(kOffsetRelativeError * max_c |o_c|,
+/// kOffsetAbsoluteFloor). Derivation: rounding m_c errs by at most half a step 2^(e - bias - 1).
+/// If e > 0, e - 1 was rejected, i.e. max |o_c| 2^(bias - e + 1) >= 255.5, so half a step is at
+/// most max |o_c| / 255.5 (3.91e-3, between 2^-9 and 2^-8); if e = 0, half a step is 2^-(bias + 1)
+/// = 2^-28 = 3.7e-9. Offsets from 2^-20 (where m reaches 128 at e = 0) to 4088 keep the full
+/// relative precision.
+constexpr double kOffsetRelativeError = 1.0 / 255.5;
+constexpr double kOffsetAbsoluteFloor = 1.0 / double(1u << (kOffsetBias + 1));
+
+/// Encodes an offset (units of t). NaN components are written as 0 and set `clamped`; offsets
+/// beyond kOffsetMaxMagnitude (inf included) are clamped as above and set `clamped`.
+std::uint32_t encodeSharedExponent(const Vec3& offset, bool& clamped);
+/// Decodes a code written with exponent bias `bias` (exact: an integer times a power of two).
+Vec3 decodeSharedExponent(std::uint32_t code, int bias = kOffsetBias);
+
+// ---------------------------------------------------- 8-bit logarithmic codes (version 3)
+
+/// Non-negative quantities spanning many decades (anisotropy, geometric variation) in one byte:
+/// code 0 is exactly 0; codes k = 1..255 split [lo, hi] into 255 bins of equal ratio
+/// r = (hi / lo)^(1/255), bin k = [lo r^(k-1), lo r^k], decoded to its geometric centre
+/// lo r^(k - 1/2) = lo * (hi / lo)^((k - 0.5) / 255). The encoder picks the code whose centre is
+/// nearest in log, so for lo <= v <= hi the relative error is at most half a step:
+/// |decoded / v - 1| <= sqrt(r) - 1. Below lo the nearest of 0 and the first centre c1 is taken
+/// (absolute error <= c1 / 2 = lo sqrt(r) / 2). Hence, for 0 <= v <= hi,
+/// |decoded - v| <= (sqrt(r) - 1) v + lo sqrt(r) / 2.
+/// Clamping (counted through `clamped`): v > hi (inf included) -> 255; NaN -> 0; v < 0 -> 0,
+/// counted only when v < -kLogNegativeTolerance (a negative float rounding of 0 is not a clamp).
+class Log8Code {
+ public:
+  static constexpr int kCodes = 255;
+  /// Requires 0 < lo < hi, both finite (Error otherwise: callers validate what they read).
+  Log8Code(double lo, double hi);
+  std::uint8_t encode(double value, bool& clamped) const;
+  double decode(std::uint8_t code) const { return centre_[code]; }
+  double lo() const { return lo_; }
+  double hi() const { return hi_; }
+  /// r = (hi / lo)^(1/255).
+  double stepRatio() const { return ratio_; }
+  /// sqrt(r) - 1: the relative error bound within [lo, hi].
+  double maxRelativeError() const { return std::sqrt(ratio_) - 1; }
+  /// lo sqrt(r) / 2: the absolute error bound below lo.
+  double absoluteFloor() const { return 0.5 * centre_[1]; }
+
+ private:
+  double lo_, hi_, ratio_;
+  std::array<double, 256> centre_{};     // decoded values, centre_[0] = 0
+  std::array<double, 256> logCentre_{};  // log(centre_[k]), k >= 1
+};
+
+/// Negative inputs of a log code down to -2^-23 (one float32 ulp at 1: what 1 - |u_l| rounds to
+/// when |u_l| is 1 in exact arithmetic) are written as 0 without being counted as clamped.
+constexpr double kLogNegativeTolerance = 1.0 / double(1u << 23);
+
+/// The ranges of the version-3 stack (measured, docs/STACK_FORMAT.md): anisotropy 1 - |u_l| lies
+/// in [0, 1] and is typically 1e-6..1e-1 (the fits give a few 1e-16 from rounding, coded 0);
+/// the geometric variation nu >= 0 ranged 1.5e-17..7.8e3 on a torus, a stairs scene and a real
+/// scan (0.1 percentile >= 1e-10). Step ratios: anisotropy 10^(7/255) = 1.0652 (relative error
+/// <= 3.21 %), nu 10^(16/255) = 1.1554 (<= 7.49 %).
+constexpr double kAnisotropyLogMin = 1e-7;
+constexpr double kAnisotropyLogMax = 1.0;
+constexpr double kVariationLogMin = 1e-10;
+constexpr double kVariationLogMax = 1e6;
 
 // ------------------------------------------------------------------------------- bit packing
 
