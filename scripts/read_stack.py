@@ -56,11 +56,13 @@ def check_codecs(path, manifest):
     bias = off.get("bias")
     if off.get("codec") != "shared_exponent" or not isinstance(bias, int) or not 0 <= bias <= 64:
         raise ValueError(f"{path}: projection_offset: expected codec shared_exponent, bias 0..64")
-    for name in ("anisotropy", "geometric_variation"):
+    # The anisotropy is signed (slog8); the first version-3 stacks stored it unsigned (log8).
+    for name, codecs in (("anisotropy", ("slog8", "log8")), ("geometric_variation", ("log8",))):
         lo, hi = q[name].get("log_min"), q[name].get("log_max")
-        if (q[name].get("codec") != "log8" or not isinstance(lo, (int, float))
+        if (q[name].get("codec") not in codecs or not isinstance(lo, (int, float))
                 or not isinstance(hi, (int, float)) or not 0 < lo < hi < np.inf):
-            raise ValueError(f"{path}: {name}: expected codec log8, 0 < log_min < log_max < inf")
+            raise ValueError(f"{path}: {name}: expected codec {' or '.join(codecs)}, "
+                             "0 < log_min < log_max < inf")
 
 
 def encoding(manifest):
@@ -121,6 +123,15 @@ def decode_log8(code, log_min, log_max):
     return np.where(code == 0, 0.0, log_min * np.power(log_max / log_min, (k - 0.5) / 255))
 
 
+def decode_slog8(code, log_min, log_max):
+    """Signed uint8 log codes -> float64: bit 7 is the sign, k = bits 0-6 the magnitude's code:
+    0 if k = 0, else log_min * (log_max / log_min) ** ((k - 0.5) / 127)."""
+    code = np.asarray(code, dtype=np.uint8)
+    k = (code & 0x7F).astype(np.float64)
+    magnitude = np.where(k == 0, 0.0, log_min * np.power(log_max / log_min, (k - 0.5) / 127))
+    return np.where((code & 0x80) != 0, -magnitude, magnitude)
+
+
 def _decode(manifest, arrays, rel, t, index, valid):
     """Decodes compact arrays at `index` (scale j: (j,); point i: (slice(None), i)).
     rel: input positions relative to the origin, broadcastable to the result; t: the scale
@@ -148,7 +159,8 @@ def _decode(manifest, arrays, rel, t, index, valid):
     out["gls_kappa"] = np.where(v, half("gls_kappa_t") / t, 0.0)
     for name in ("anisotropy", "geometric_variation"):
         if v3:
-            value = decode_log8(arrays[name][index], q[name]["log_min"], q[name]["log_max"])
+            decode = decode_slog8 if q[name]["codec"] == "slog8" else decode_log8
+            value = decode(arrays[name][index], q[name]["log_min"], q[name]["log_max"])
         else:
             value = half(name)
         out[name] = np.where(v, value, 0.0)
@@ -224,9 +236,11 @@ def compare(compact_path, float32_path):
         for name, (key, lo, hi) in ranges.items():
             fv = f[name][v].astype(np.float64)
             d = np.abs(c[name][v] - fv)
-            inside = (fv >= lo) & (fv <= hi)
-            errors[f"|d {key}| / {key} ({key} in [log_min, log_max])"].append(d[inside] / fv[inside])
-            errors[f"|d {key}| ({key} < log_min, negative included)"].append(d[fv < lo])
+            signed = mc["quantities"][name].get("codec") == "slog8"
+            mag = np.abs(fv) if signed else fv
+            inside = (mag >= lo) & (mag <= hi)
+            errors[f"|d {key}| / {key} ({key} in [log_min, log_max])"].append(d[inside] / mag[inside])
+            errors[f"|d {key}| ({key} < log_min, negative included)"].append(d[mag < lo])
             negative[name] += int(np.count_nonzero(fv < 0))
     per_file = ", ".join(f"{k} {q['clamped']}" for k, q in mc["quantities"].items() if q.get("clamped"))
     print(f"{compact_path} vs {float32_path}: {mc['point_count']} points x {mc['scale_count']} scales, "

@@ -218,8 +218,8 @@ struct CompactFixture : StackFixture {
         edited.layers[j].anisotropy[i] = float(std::pow(10.0, -8 + 8 * u));
         edited.layers[j].geometricVariation[i] = float(std::pow(10.0, -11 + 15 * u));
       }
-    // Beyond the version-3 ranges: a negative anisotropy, a huge nu, an offset of 5000 t.
-    L0.anisotropy[9] = -0.25f;
+    // Beyond the version-3 ranges: an anisotropy below -1, a huge nu, an offset of 5000 t.
+    L0.anisotropy[9] = -2.5f;
     edited.layers[1].geometricVariation[11] = 1e9f;
     for (std::size_t i = 0; i < cloud.size(); ++i)
       rel.push_back(cloud.absolutePosition(i) - cloud.origin());
@@ -298,15 +298,16 @@ void expectDecodedClose(const ScaleLayer& D, const ScaleLayer& F, std::size_t i,
   close(D.kappa[k], F.kappa[i], t, "kappa");
   if (version >= 3) {
     // 8-bit log codes: relative error <= sqrt(r) - 1 in [lo, hi], absolute lo sqrt(r) / 2 below;
-    // negative values (the fits give a few) decode as 0.
-    static const quant::Log8Code aniso(quant::kAnisotropyLogMin, quant::kAnisotropyLogMax);
+    // the anisotropy is signed (the fits give a few negative values), negative nu decodes as 0.
+    static const quant::Log8Code aniso(quant::kAnisotropyLogMin, quant::kAnisotropyLogMax, true);
     static const quant::Log8Code nu(quant::kVariationLogMin, quant::kVariationLogMax);
     auto logClose = [&](double d, double f, const quant::Log8Code& code, const char* what) {
-      if (f < 0) {
+      if (f < 0 && !code.isSigned()) {
         EXPECT_EQ(d, 0.0) << what << " point " << i;
         return;
       }
-      const double tol = code.maxRelativeError() * f + code.absoluteFloor() + f32 * f;
+      const double tol =
+          code.maxRelativeError() * std::abs(f) + code.absoluteFloor() + f32 * std::abs(f);
       EXPECT_LE(std::abs(d - f), tol) << what << " point " << i << ": " << d << " vs " << f;
     };
     logClose(D.anisotropy[k], F.anisotropy[i], aniso, "anisotropy");
@@ -344,18 +345,19 @@ void CompactFixture::checkDecoded(const std::string& stackPath, int version) con
   EXPECT_FLOAT_EQ(reader.readScale(1).kMax[7], float(65504.0 / scale(1)));
   EXPECT_EQ(reader.readScale(2).neighbors[3], 255);
   if (version >= 3) {
-    // The offset to 255 2^(31 - 27) = 4080 t, the negative anisotropy to 0, nu to the top code.
+    // The offset to 255 2^(31 - 27) = 4080 t, the anisotropy -2.5 to the top negative code, nu
+    // to the top code.
     EXPECT_FLOAT_EQ(reader.readScale(2).projection[3 * 13], float(rel[13].x() + 4080 * scale(2)));
-    EXPECT_EQ(reader.readScale(0).anisotropy[9], 0.0f);
+    const quant::Log8Code aniso(quant::kAnisotropyLogMin, quant::kAnisotropyLogMax, true);
+    EXPECT_FLOAT_EQ(reader.readScale(0).anisotropy[9], float(aniso.decode(0x80 | 127)));
     const quant::Log8Code nu(quant::kVariationLogMin, quant::kVariationLogMax);
     EXPECT_FLOAT_EQ(reader.readScale(1).geometricVariation[11], float(nu.decode(255)));
-    // Every clamp is counted: kMax, the offset, and the negative anisotropies (the fits give a few
-    // besides the edit) and huge nu of the valid fits.
+    // Every clamp is counted: kMax, the offset, the anisotropy beyond +-1 and the huge nu.
     std::size_t logClamps = 0;
     for (const ScaleLayer& L : edited.layers)
       for (std::size_t i = 0; i < L.size(); ++i)
         if (L.valid[i])
-          logClamps += (L.anisotropy[i] < -quant::kLogNegativeTolerance) +
+          logClamps += (std::abs(L.anisotropy[i]) > quant::kAnisotropyLogMax) +
                        (L.geometricVariation[i] > quant::kVariationLogMax);
     EXPECT_GE(logClamps, 2u);
     EXPECT_EQ(reader.info().clampedValues, 2 + logClamps);
@@ -367,7 +369,7 @@ void CompactFixture::checkDecoded(const std::string& stackPath, int version) con
   } else {
     EXPECT_NEAR(reader.readScale(2).projection[3 * 13], rel[13].x() + 5000 * scale(2),
                 5000 * scale(2) * std::ldexp(1.0, -11) + 1e-5);
-    EXPECT_FLOAT_EQ(reader.readScale(0).anisotropy[9], -0.25f);
+    EXPECT_FLOAT_EQ(reader.readScale(0).anisotropy[9], -2.5f);
     EXPECT_EQ(reader.info().clampedValues, 2u);  // kMax = 1e12, nu = 1e9
   }
   // By point: the same values as by scale.
@@ -397,7 +399,8 @@ TEST_F(CompactFixture, Version3DecodesWithinTheDocumentedTolerances) {
   EXPECT_EQ(q["projection_offset"]["dtype"], "<u4");
   EXPECT_EQ(q["projection_offset"]["codec"], "shared_exponent");
   EXPECT_EQ(q["projection_offset"]["bias"], quant::kOffsetBias);
-  EXPECT_EQ(q["anisotropy"]["codec"], "log8");
+  EXPECT_EQ(q["anisotropy"]["codec"], "slog8");
+  EXPECT_EQ(q["geometric_variation"]["codec"], "log8");
   EXPECT_EQ(q["anisotropy"]["log_min"], quant::kAnisotropyLogMin);
   EXPECT_EQ(q["geometric_variation"]["log_max"], quant::kVariationLogMax);
   EXPECT_EQ(q["curv_max_t"]["codec"], "float16");
@@ -448,7 +451,7 @@ TEST_F(CompactFixture, Version3ManifestCodecsAreValidated) {
   m["quantities"]["anisotropy"]["log_max"] = 10.0;
   writeManifest(compactPath, m);
   const ScaleLayer D = ScaleStackReader(compactPath).readScale(0);
-  EXPECT_FLOAT_EQ(D.anisotropy[9], 0.0f);
+  EXPECT_LT(D.anisotropy[9], -1.0f);  // the top negative code of a range up to 10
   writeManifest(compactPath, good);
   const ScaleLayer G = ScaleStackReader(compactPath).readScale(0);
   std::size_t differ = 0;

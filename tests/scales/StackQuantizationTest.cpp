@@ -332,13 +332,43 @@ TEST(StackQuantization, Log8EveryCodeRoundTrips) {
   EXPECT_THROW(Log8Code(std::numeric_limits<double>::quiet_NaN(), 1), Error);
 }
 
+TEST(StackQuantization, SignedLog8RoundTripsBothSigns) {
+  const Log8Code code(kAnisotropyLogMin, kAnisotropyLogMax, true);
+  EXPECT_EQ(code.magnitudeCodes(), 127);
+  for (int k = 0; k <= 255; ++k) {
+    bool clamped = false;
+    const double v = code.decode(std::uint8_t(k));
+    ASSERT_TRUE(std::isfinite(v));
+    const int m = k & 0x7F;
+    ASSERT_EQ(v, k >= 128 ? -code.decode(std::uint8_t(m)) : v);
+    ASSERT_EQ(code.encode(v, clamped), m == 0 ? 0 : k) << v;  // 128 (-0) is written as 0
+    ASSERT_FALSE(clamped);
+  }
+  struct Case {
+    double v;
+    int expected;
+    bool clamped;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  bool ignored = false;
+  const int quarter = code.encode(0.25, ignored);
+  for (const Case& c :
+       {Case{-1e-16, 0, false}, Case{-0.25, 0x80 | quarter, false}, Case{-1.0, 0x80 | 127, false},
+        Case{-1.5, 0x80 | 127, true}, Case{-inf, 0x80 | 127, true}, Case{1.5, 127, true},
+        Case{std::numeric_limits<double>::quiet_NaN(), 0, true}}) {
+    bool clamped = false;
+    EXPECT_EQ(code.encode(c.v, clamped), c.expected) << c.v;
+    EXPECT_EQ(clamped, c.clamped) << c.v;
+  }
+}
+
 TEST(StackQuantization, Log8MeetsTheDocumentedBound) {
   // Documented figures (docs/STACK_FORMAT.md).
-  const Log8Code aniso(kAnisotropyLogMin, kAnisotropyLogMax);
+  const Log8Code aniso(kAnisotropyLogMin, kAnisotropyLogMax, true);
   const Log8Code nu(kVariationLogMin, kVariationLogMax);
-  EXPECT_NEAR(aniso.stepRatio(), 1.06525, 1e-5);
-  EXPECT_NEAR(aniso.maxRelativeError(), 0.03211, 1e-5);
-  EXPECT_NEAR(aniso.absoluteFloor(), 5.161e-8, 1e-11);
+  EXPECT_NEAR(aniso.stepRatio(), 1.13532, 1e-5);
+  EXPECT_NEAR(aniso.maxRelativeError(), 0.06551, 1e-5);
+  EXPECT_NEAR(aniso.absoluteFloor(), 5.3276e-8, 1e-11);
   EXPECT_NEAR(nu.stepRatio(), 1.15543, 1e-5);
   EXPECT_NEAR(nu.maxRelativeError(), 0.07491, 1e-5);
   EXPECT_NEAR(nu.absoluteFloor(), 5.375e-11, 1e-14);
@@ -348,6 +378,10 @@ TEST(StackQuantization, Log8MeetsTheDocumentedBound) {
     double worst = 0;
     for (int k = 0; k < 200000; ++k) {
       const double v = std::exp(logV(rng));
+      if (code->isSigned()) {  // the negative half mirrors the positive one
+        bool c = false;
+        ASSERT_EQ(code->decode(code->encode(-v, c)), -code->decode(code->encode(v, c))) << v;
+      }
       bool clamped = false;
       const double d = code->decode(code->encode(v, clamped));
       ASSERT_FALSE(clamped) << v;
@@ -365,7 +399,7 @@ TEST(StackQuantization, Log8MeetsTheDocumentedBound) {
 }
 
 TEST(StackQuantization, Log8ClampsAndNeverReturnsNaN) {
-  const Log8Code code(kAnisotropyLogMin, kAnisotropyLogMax);
+  const Log8Code code(1e-7, 1.0);  // unsigned
   const double inf = std::numeric_limits<double>::infinity();
   struct Case {
     double v;

@@ -110,8 +110,9 @@ const Quantity kCompactV3Quantities[] = {
     {"gls_tau_t", "<f2", 2, 1, "GLS tau / t_j", nullptr, "over_t", "float16"},
     {"gls_kappa_t", "<f2", 2, 1, "GLS kappa * t_j", nullptr, "times_t", "float16"},
     {"anisotropy", "|u1", 1, 1,
-     "1 - |u_l| (Eq. 1.20); code 0: 0, code k: log_min (log_max / log_min)^((k - 0.5) / 255)",
-     nullptr, "none", "log8"},
+     "1 - |u_l| (Eq. 1.20); bit 7: sign, k = bits 0-6: 0 if k = 0, else "
+     "log_min (log_max / log_min)^((k - 0.5) / 127)",
+     nullptr, "none", "slog8"},
     {"geometric_variation", "|u1", 1, 1,
      "GLS geometric variation nu; code 0: 0, code k: log_min (log_max / log_min)^((k - 0.5) / 255)",
      nullptr, "none", "log8"},
@@ -184,7 +185,7 @@ float readHalf(const unsigned char* p) {
 struct CompactCodecs {
   int version = kStackFormatVersion;
   int offsetBias = quant::kOffsetBias;
-  quant::Log8Code anisotropy{quant::kAnisotropyLogMin, quant::kAnisotropyLogMax};
+  quant::Log8Code anisotropy{quant::kAnisotropyLogMin, quant::kAnisotropyLogMax, true};
   quant::Log8Code variation{quant::kVariationLogMin, quant::kVariationLogMax};
 };
 
@@ -634,7 +635,7 @@ void ScaleStackWriter::finish(const ScaleSpaceSummary& summary) {
     if (q.codec) entries[q.name]["codec"] = q.codec;
     if (q.codec && std::strcmp(q.codec, "shared_exponent") == 0)
       entries[q.name]["bias"] = d.codecs.offsetBias;
-    if (q.codec && std::strcmp(q.codec, "log8") == 0) {
+    if (q.codec && (std::strcmp(q.codec, "log8") == 0 || std::strcmp(q.codec, "slog8") == 0)) {
       const quant::Log8Code& code = k == kAnisotropy ? d.codecs.anisotropy : d.codecs.variation;
       entries[q.name]["log_min"] = code.lo();
       entries[q.name]["log_max"] = code.hi();
@@ -720,8 +721,12 @@ void readCodec(const std::string& manifestPath, const Quantity& q, const nlohman
                CompactCodecs& codecs) {
   const std::string fix = "recompute the stack with 'scalespace scales'";
   const std::string what = std::string("quantity '") + q.name + "': ";
-  if (entry.at("codec").get<std::string>() != q.codec ||
-      entry.at("scaling").get<std::string>() != q.scaling)
+  // The anisotropy of the first version-3 stacks used the unsigned code: the manifest says which.
+  const std::string codec = entry.at("codec").get<std::string>();
+  const bool anisotropyLog = std::strcmp(q.name, "anisotropy") == 0 &&
+                             (codec == "log8" || codec == "slog8") &&
+                             std::strcmp(q.codec, "slog8") == 0;
+  if ((codec != q.codec && !anisotropyLog) || entry.at("scaling").get<std::string>() != q.scaling)
     throw FileError(manifestPath, "",
                     what + "codec '" + entry.at("codec").get<std::string>() + "', scaling '" +
                         entry.at("scaling").get<std::string>() + "' (expected '" + q.codec +
@@ -734,7 +739,7 @@ void readCodec(const std::string& manifestPath, const Quantity& q, const nlohman
       throw FileError(manifestPath, "", what + "bias " + std::to_string(bias) + " is not in 0..64",
                       fix);
     codecs.offsetBias = bias;
-  } else if (std::strcmp(q.codec, "log8") == 0) {
+  } else if (codec == "log8" || codec == "slog8") {
     const double lo = entry.at("log_min").get<double>(), hi = entry.at("log_max").get<double>();
     if (!(lo > 0) || !(hi > lo) || !std::isfinite(hi))
       throw FileError(manifestPath, "",
@@ -742,7 +747,7 @@ void readCodec(const std::string& manifestPath, const Quantity& q, const nlohman
                           std::to_string(hi) + " must satisfy 0 < log_min < log_max < inf",
                       fix);
     (std::strcmp(q.name, "anisotropy") == 0 ? codecs.anisotropy : codecs.variation) =
-        quant::Log8Code(lo, hi);
+        quant::Log8Code(lo, hi, codec == "slog8");
   }
 }
 

@@ -220,15 +220,17 @@ Vec3 decodeSharedExponent(std::uint32_t code, int bias) {
 
 // ---------------------------------------------------- 8-bit logarithmic codes (version 3)
 
-Log8Code::Log8Code(double lo, double hi) : lo_(lo), hi_(hi) {
+Log8Code::Log8Code(double lo, double hi, bool isSigned) : lo_(lo), hi_(hi), signed_(isSigned) {
   if (!(lo > 0) || !(hi > lo) || !std::isfinite(hi))
     throw Error("Log8Code: the range must satisfy 0 < lo < hi < inf, not [" + std::to_string(lo) +
                 ", " + std::to_string(hi) + "]");
-  ratio_ = std::pow(hi / lo, 1.0 / kCodes);
+  const int codes = magnitudeCodes();
+  ratio_ = std::pow(hi / lo, 1.0 / codes);
   // The same expression as the NumPy decoder (docs/STACK_FORMAT.md), so both give the same doubles.
-  for (int k = 1; k <= kCodes; ++k) {
-    centre_[std::size_t(k)] = lo * std::pow(hi / lo, (k - 0.5) / kCodes);
+  for (int k = 1; k <= codes; ++k) {
+    centre_[std::size_t(k)] = lo * std::pow(hi / lo, (k - 0.5) / codes);
     logCentre_[std::size_t(k)] = std::log(centre_[std::size_t(k)]);
+    if (signed_) centre_[std::size_t(128 + k)] = -centre_[std::size_t(k)];
   }
 }
 
@@ -237,21 +239,31 @@ std::uint8_t Log8Code::encode(double value, bool& clamped) const {
     clamped = true;
     return 0;
   }
-  if (value <= 0) {
-    if (value < -kLogNegativeTolerance) clamped = true;
-    return 0;
+  if (value == 0) return 0;
+  if (value < 0) {
+    if (!signed_) {
+      if (value < -kLogNegativeTolerance) clamped = true;
+      return 0;
+    }
+    const std::uint8_t m = encodeMagnitude(-value, clamped);
+    return m == 0 ? 0 : std::uint8_t(0x80 | m);
   }
+  return encodeMagnitude(value, clamped);
+}
+
+std::uint8_t Log8Code::encodeMagnitude(double value, bool& clamped) const {
+  const int codes = magnitudeCodes();
   if (value > hi_) {  // inf included
     clamped = true;
-    return kCodes;
+    return std::uint8_t(codes);
   }
   if (value < lo_) return value >= 0.5 * centre_[1] ? 1 : 0;
   // The bin from the logarithm, then the nearest centre in log among its neighbours: the rounding
   // of log() near a bin edge cannot then break the half-step bound.
   const double lv = std::log(value);
-  const int guess = std::clamp(int((lv - logCentre_[1]) / std::log(ratio_) + 1.5), 1, kCodes);
+  const int guess = std::clamp(int((lv - logCentre_[1]) / std::log(ratio_) + 1.5), 1, codes);
   int best = guess;
-  for (int k = std::max(1, guess - 1); k <= std::min(kCodes, guess + 1); ++k)
+  for (int k = std::max(1, guess - 1); k <= std::min(codes, guess + 1); ++k)
     if (std::abs(lv - logCentre_[std::size_t(k)]) < std::abs(lv - logCentre_[std::size_t(best)]))
       best = k;
   return std::uint8_t(best);

@@ -118,26 +118,32 @@ Vec3 decodeSharedExponent(std::uint32_t code, int bias = kOffsetBias);
 
 // ---------------------------------------------------- 8-bit logarithmic codes (version 3)
 
-/// Non-negative quantities spanning many decades (anisotropy, geometric variation) in one byte:
-/// code 0 is exactly 0; codes k = 1..255 split [lo, hi] into 255 bins of equal ratio
-/// r = (hi / lo)^(1/255), bin k = [lo r^(k-1), lo r^k], decoded to its geometric centre
-/// lo r^(k - 1/2) = lo * (hi / lo)^((k - 0.5) / 255). The encoder picks the code whose centre is
-/// nearest in log, so for lo <= v <= hi the relative error is at most half a step:
-/// |decoded / v - 1| <= sqrt(r) - 1. Below lo the nearest of 0 and the first centre c1 is taken
-/// (absolute error <= c1 / 2 = lo sqrt(r) / 2). Hence, for 0 <= v <= hi,
-/// |decoded - v| <= (sqrt(r) - 1) v + lo sqrt(r) / 2.
-/// Clamping (counted through `clamped`): v > hi (inf included) -> 255; NaN -> 0; v < 0 -> 0,
-/// counted only when v < -kLogNegativeTolerance (a negative float rounding of 0 is not a clamp).
+/// Quantities spanning many decades (anisotropy, geometric variation) in one byte.
+/// Unsigned ("log8", for nu >= 0): code 0 is exactly 0; codes k = 1..C (C = 255) split [lo, hi]
+/// into C bins of equal ratio r = (hi / lo)^(1/C), bin k = [lo r^(k-1), lo r^k], decoded to its
+/// geometric centre lo r^(k - 1/2) = lo * (hi / lo)^((k - 0.5) / C).
+/// Signed ("slog8", for the anisotropy 1 - |u_l|, negative for a few percent of the fits): bit 7
+/// is the sign and bits 0..6 the code of the magnitude with C = 127 (0 and 128 decode to 0; the
+/// encoder writes 0).
+/// The encoder picks the code whose centre is nearest in log, so for lo <= |v| <= hi the relative
+/// error is at most half a step: |decoded / v - 1| <= sqrt(r) - 1. Below lo the nearest of 0 and
+/// the first centre c1 is taken (absolute error <= c1 / 2 = lo sqrt(r) / 2). Hence, for
+/// |v| <= hi, |decoded - v| <= (sqrt(r) - 1) |v| + lo sqrt(r) / 2.
+/// Clamping (counted through `clamped`): |v| > hi (inf included) -> the largest code of its sign;
+/// NaN -> 0; unsigned only: v < 0 -> 0, counted only when v < -kLogNegativeTolerance (a negative
+/// float rounding of 0 is not a clamp).
 class Log8Code {
  public:
-  static constexpr int kCodes = 255;
   /// Requires 0 < lo < hi, both finite (Error otherwise: callers validate what they read).
-  Log8Code(double lo, double hi);
+  Log8Code(double lo, double hi, bool isSigned = false);
   std::uint8_t encode(double value, bool& clamped) const;
   double decode(std::uint8_t code) const { return centre_[code]; }
   double lo() const { return lo_; }
   double hi() const { return hi_; }
-  /// r = (hi / lo)^(1/255).
+  bool isSigned() const { return signed_; }
+  /// Codes per sign: C = 255 unsigned, 127 signed.
+  int magnitudeCodes() const { return signed_ ? 127 : 255; }
+  /// r = (hi / lo)^(1/C).
   double stepRatio() const { return ratio_; }
   /// sqrt(r) - 1: the relative error bound within [lo, hi].
   double maxRelativeError() const { return std::sqrt(ratio_) - 1; }
@@ -145,20 +151,24 @@ class Log8Code {
   double absoluteFloor() const { return 0.5 * centre_[1]; }
 
  private:
+  std::uint8_t encodeMagnitude(double magnitude, bool& clamped) const;  // magnitude > 0
   double lo_, hi_, ratio_;
+  bool signed_;
   std::array<double, 256> centre_{};     // decoded values, centre_[0] = 0
-  std::array<double, 256> logCentre_{};  // log(centre_[k]), k >= 1
+  std::array<double, 256> logCentre_{};  // log(centre_[k]), 1 <= k <= C
 };
 
 /// Negative inputs of a log code down to -2^-23 (one float32 ulp at 1: what 1 - |u_l| rounds to
 /// when |u_l| is 1 in exact arithmetic) are written as 0 without being counted as clamped.
 constexpr double kLogNegativeTolerance = 1.0 / double(1u << 23);
 
-/// The ranges of the version-3 stack (measured, docs/STACK_FORMAT.md): anisotropy 1 - |u_l| lies
-/// in [0, 1] and is typically 1e-6..1e-1 (the fits give a few 1e-16 from rounding, coded 0);
-/// the geometric variation nu >= 0 ranged 1.5e-17..7.8e3 on a torus, a stairs scene and a real
-/// scan (0.1 percentile >= 1e-10). Step ratios: anisotropy 10^(7/255) = 1.0652 (relative error
-/// <= 3.21 %), nu 10^(16/255) = 1.1554 (<= 7.49 %).
+/// The ranges of the version-3 stack (measured, docs/STACK_FORMAT.md): the anisotropy 1 - |u_l|
+/// is at most 1 and typically 1e-6..1e-1 in magnitude; it is negative for 2.8 % of the fits of a
+/// noisy 200k torus (24 % at the smallest scale, down to -0.415 at coarse ones), hence signed;
+/// the fits give a few 1e-16 from rounding, coded 0. The geometric variation nu >= 0 ranged
+/// 1.5e-17..7.8e3 on a torus, a stairs scene and a real scan (0.1 percentile >= 1e-10). Step
+/// ratios: anisotropy 10^(7/127) = 1.1354 (relative error <= 6.56 %), nu 10^(16/255) = 1.1554
+/// (<= 7.49 %).
 constexpr double kAnisotropyLogMin = 1e-7;
 constexpr double kAnisotropyLogMax = 1.0;
 constexpr double kVariationLogMin = 1e-10;
