@@ -2,6 +2,7 @@
 #include <tbb/global_control.h>
 
 #include <map>
+#include <random>
 #include <set>
 
 #include "PlanesTestScenes.hpp"
@@ -74,6 +75,36 @@ TEST(RegionGrowing, SeedNormalCriterionAndDeterminism) {
   std::size_t assigned = 0;
   for (const auto& r : seg.regions) assigned += r.size();
   EXPECT_EQ(assigned, 5u);
+}
+
+TEST(RegionGrowing, MortonOrderedWalkGivesTheSameRegions) {
+  // buildKnnGraph adds a Morton-ordered copy of the graph that growRegions walks; without it the
+  // walk runs in input order. Same regions, same labels, in the same order.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Vec3> pts;
+  ScaleFeatures f;
+  f.t = 0.1;
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3 p(u(rng), u(rng), 0.3 * std::round(2 * u(rng)));  // three terraces, shuffled
+    pts.push_back(p);
+    f.normals.push_back(Vec3(0.05 * u(rng), 0.05 * u(rng), 1).normalized());
+    f.kMax.push_back(float(std::abs(u(rng))));
+    f.kMin.push_back(float(i % 7 == 0 ? 0.0 : 0.1 * u(rng)));  // ties in the planarity key
+    f.valid.push_back(i % 11 != 0);
+  }
+  const KnnGraph local = buildKnnGraph(pts, 10);
+  ASSERT_EQ(local.order.size(), pts.size());
+  KnnGraph plain = local;
+  plain.order.clear();
+  plain.rank.clear();
+  plain.localNeighbors.clear();
+  RegionGrowingOptions options;
+  options.maxAngleDegrees = 3;
+  const Segmentation a = growRegions(local, f, options), b = growRegions(plain, f, options);
+  EXPECT_EQ(a.labels, b.labels);
+  EXPECT_EQ(a.regions, b.regions);
+  EXPECT_GT(a.regions.size(), 3u);
 }
 
 TEST(RegionGraph, ChainsJaccardAndPersistence) {

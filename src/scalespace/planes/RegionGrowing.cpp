@@ -22,10 +22,9 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
     throw OptionError("region growing angle must be in (0, 180) degrees");
   const double cosTheta = std::cos(options.maxAngleDegrees * M_PI / 180.0);
 
-  // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2; a stable sort of
-  // indices keeps the lower index first on ties, so the result does not depend on anything else.
-  // Sorted as (key, index) pairs: the same order as a stable sort of the indices, with the key
-  // next to its index (no indirection) and both cores at work.
+  // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2, ties by increasing
+  // point index, so the result does not depend on anything else. Sorted as (key, index) pairs:
+  // the key next to its index (no indirection) and both cores at work.
   std::vector<std::pair<double, Index>> order;
   order.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -34,35 +33,50 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
       order.emplace_back(c, Index(i));
   }
   tbb::parallel_sort(order.begin(), order.end());
-  std::vector<Index> seeds(order.size());
-  for (std::size_t k = 0; k < order.size(); ++k) seeds[k] = order[k].second;
+
+  // The walk runs over the graph's vertices: the Morton-ordered copy when there is one (see
+  // KnnGraph), so that the per-vertex arrays below are read near where they were last read.
+  // The regions (which points, which seed first) are the same in either numbering.
+  const bool local =
+      graph.order.size() == n && graph.localNeighbors.size() == graph.neighbors.size();
+  const std::vector<Index>& adjacency = local ? graph.localNeighbors : graph.neighbors;
+  auto pointOf = [&](Index v) { return local ? graph.order[v] : v; };
+  std::vector<Vec3> normal(n);
+  std::vector<int> label(n);  // -1 free, -2 invalid (joins no region), else the region
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t v) {
+    const Index i = pointOf(Index(v));
+    normal[v] = scale.normals[i];
+    label[v] = scale.valid[i] ? -1 : -2;
+  });
 
   Segmentation seg;
-  seg.labels.assign(n, -1);
   std::vector<Index> frontier;
-  for (Index seed : seeds) {
-    if (seg.labels[seed] >= 0) continue;
-    const int label = int(seg.regions.size());
-    const Vec3 seedNormal = scale.normals[seed];
-    std::vector<Index> region{seed};
-    seg.labels[seed] = label;
+  for (const auto& [key, seedPoint] : order) {
+    const Index seed = local ? graph.rank[seedPoint] : seedPoint;
+    if (label[seed] != -1) continue;
+    const int id = int(seg.regions.size());
+    const Vec3 seedNormal = normal[seed];
+    std::vector<Index> region{seedPoint};
+    label[seed] = id;
     frontier.assign(1, seed);
     while (!frontier.empty()) {
       const Index p = frontier.back();
       frontier.pop_back();
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
-        const Index q = graph.neighbors[e];
-        if (seg.labels[q] >= 0 || !scale.valid[q]) continue;
+        const Index q = adjacency[e];
+        if (label[q] != -1) continue;
         // Against the seed's normal, not the neighbour's: the region stays planar (Sec. 2.3.1).
-        if (!(scale.normals[q].dot(seedNormal) >= cosTheta)) continue;
-        seg.labels[q] = label;
-        region.push_back(q);
+        if (!(normal[q].dot(seedNormal) >= cosTheta)) continue;
+        label[q] = id;
+        region.push_back(pointOf(q));
         frontier.push_back(q);
       }
     }
     std::sort(region.begin(), region.end());
     seg.regions.push_back(std::move(region));
   }
+  seg.labels.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v) seg.labels[pointOf(Index(v))] = std::max(label[v], -1);
   return seg;
 }
 

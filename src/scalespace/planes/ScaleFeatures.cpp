@@ -4,6 +4,7 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/core/SpatialOrder.hpp"
 
 namespace scalespace {
 
@@ -34,6 +35,15 @@ KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k,
     tracker.advance(range.size());
   });
   tracker.finish();
+  graph.order = spatialOrder(positions);
+  graph.rank.resize(n);
+  for (std::size_t v = 0; v < n; ++v) graph.rank[graph.order[v]] = Index(v);
+  graph.localNeighbors.resize(graph.neighbors.size());
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t v) {
+    const std::size_t from = graph.offsets[graph.order[v]];
+    for (std::size_t e = 0; e < perPoint; ++e)
+      graph.localNeighbors[graph.offsets[v] + e] = graph.rank[graph.neighbors[from + e]];
+  });
   return graph;
 }
 
