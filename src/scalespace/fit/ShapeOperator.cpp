@@ -29,7 +29,8 @@ PrincipalCurvatures shapeOperatorCurvatures(const Vec3& gradient, const Mat3& he
   // solver took a third of this function): lambda = (a + d) / 2 +- hypot((a - d) / 2, b).
   const double a = W(0, 0), d = W(1, 1), b = 0.5 * (W(0, 1) + W(1, 0));
   const double half = 0.5 * (a - d);
-  const double radius = std::hypot(half, b);
+  // sqrt, not std::hypot (1.3% of the stack's time): curvatures squared are far from overflow.
+  const double radius = std::sqrt(half * half + b * b);
   pc.kMax = 0.5 * (a + d) + radius;
   pc.kMin = 0.5 * (a + d) - radius;
   pc.mean = 0.5 * (a + d);

@@ -227,9 +227,10 @@ Log8Code::Log8Code(double lo, double hi, bool isSigned) : lo_(lo), hi_(hi), sign
   const int codes = magnitudeCodes();
   ratio_ = std::pow(hi / lo, 1.0 / codes);
   // The same expression as the NumPy decoder (docs/STACK_FORMAT.md), so both give the same doubles.
+  edge_[0] = lo;
   for (int k = 1; k <= codes; ++k) {
     centre_[std::size_t(k)] = lo * std::pow(hi / lo, (k - 0.5) / codes);
-    logCentre_[std::size_t(k)] = std::log(centre_[std::size_t(k)]);
+    edge_[std::size_t(k)] = lo * std::pow(hi / lo, double(k) / codes);  // upper edge of bin k
     if (signed_) centre_[std::size_t(128 + k)] = -centre_[std::size_t(k)];
   }
 }
@@ -258,14 +259,12 @@ std::uint8_t Log8Code::encodeMagnitude(double value, bool& clamped) const {
     return std::uint8_t(codes);
   }
   if (value < lo_) return value >= 0.5 * centre_[1] ? 1 : 0;
-  // The bin from the logarithm, then the nearest centre in log among its neighbours: the rounding
-  // of log() near a bin edge cannot then break the half-step bound.
-  const double lv = std::log(value);
-  const int guess = std::clamp(int((lv - logCentre_[1]) / std::log(ratio_) + 1.5), 1, codes);
-  int best = guess;
-  for (int k = std::max(1, guess - 1); k <= std::min(codes, guess + 1); ++k)
-    if (std::abs(lv - logCentre_[std::size_t(k)]) < std::abs(lv - logCentre_[std::size_t(best)]))
-      best = k;
+  // The bin k with edge_[k - 1] <= value < edge_[k], found by bisection on the edges (no log: the
+  // encoder runs twice per point and scale); the edges are the geometric means of neighbouring
+  // centres, so the bin is the centre nearest in log. The edges are rounded doubles: a value
+  // within an ulp of an edge may go to either neighbour, still within half a step (+ 1 ulp).
+  const auto first = edge_.begin(), last = edge_.begin() + codes;
+  const int best = int(std::upper_bound(first, last, value) - first);  // edge_[0] = lo <= value
   return std::uint8_t(best);
 }
 

@@ -154,8 +154,8 @@ class Log8Code {
   std::uint8_t encodeMagnitude(double magnitude, bool& clamped) const;  // magnitude > 0
   double lo_, hi_, ratio_;
   bool signed_;
-  std::array<double, 256> centre_{};     // decoded values, centre_[0] = 0
-  std::array<double, 256> logCentre_{};  // log(centre_[k]), 1 <= k <= C
+  std::array<double, 256> centre_{};  // decoded values, centre_[0] = 0
+  std::array<double, 256> edge_{};    // edge_[k] = lo r^k: the edges of bin k are k-1, k
 };
 
 /// Negative inputs of a log code down to -2^-23 (one float32 ulp at 1: what 1 - |u_l| rounds to
