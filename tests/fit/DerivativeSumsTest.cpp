@@ -20,7 +20,7 @@ void fillRandom(DerivativeChunk& c, unsigned seed) {
   }
 }
 
-void expectMatchesReference(SumsKernel kernel) {
+void expectMatchesReference(SimdKernel kernel) {
   DerivativeChunk c;
   fillRandom(c, 11);
   for (int m = 0; m <= DerivativeChunk::kSize; ++m) {
@@ -44,22 +44,22 @@ void expectMatchesReference(SumsKernel kernel) {
 }  // namespace
 
 TEST(DerivativeSums, PortableKernelMatchesReference) {
-  expectMatchesReference(SumsKernel::Portable);
+  expectMatchesReference(SimdKernel::Portable);
 }
 
 TEST(DerivativeSums, Avx2KernelMatchesReference) {
   // Where the CPU has no AVX2, asking for it runs the portable kernel (still checked).
-  expectMatchesReference(SumsKernel::Avx2Fma);
-  if (!avx2FmaKernelAvailable()) GTEST_SKIP() << "no AVX2 + FMA on this CPU: portable kernel ran";
+  expectMatchesReference(SimdKernel::Avx2Fma);
+  if (!avx2FmaAvailable()) GTEST_SKIP() << "no AVX2 + FMA on this CPU: portable kernel ran";
 }
 
 TEST(DerivativeSums, AutoIsOneOfTheTwoBitForBit) {
   DerivativeChunk c;
   fillRandom(c, 5);
   DerivativeSums a = {}, b = {};
-  accumulateDerivativeSums(c, 29, a, SumsKernel::Auto);
+  accumulateDerivativeSums(c, 29, a, SimdKernel::Auto);
   accumulateDerivativeSums(c, 29, b,
-                           avx2FmaKernelAvailable() ? SumsKernel::Avx2Fma : SumsKernel::Portable);
+                           avx2FmaAvailable() ? SimdKernel::Avx2Fma : SimdKernel::Portable);
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 12; ++j) EXPECT_EQ(a[i][j], b[i][j]);
 }

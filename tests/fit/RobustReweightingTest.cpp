@@ -51,8 +51,7 @@ NeighborColumns randomNeighbors(std::size_t n, std::mt19937& rng) {
   return c;
 }
 
-void checkAgainstDirect(bool portable) {
-  setPortableReweightingForTesting(portable);
+void checkAgainstDirect(SimdKernel kernel) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
   const double invSr2 = 1 / (0.2 * 0.2), invSn2 = 1 / (0.5 * 0.5);
@@ -65,7 +64,7 @@ void checkAgainstDirect(bool portable) {
     std::vector<double> previous(n), rho;
     for (double& p : previous) p = 0.5 + 0.5 * u(rng);
     SphereSums sums;
-    const double change = reweight(s, invSr2, invSn2, c, previous, rho, sums);
+    const double change = reweight(s, invSr2, invSn2, c, previous, rho, sums, kernel);
     const Reference ref = direct(s, invSr2, invSn2, c, previous);
     ASSERT_EQ(rho.size(), n);
     for (std::size_t k = 0; k < n; ++k) EXPECT_NEAR(rho[k], ref.rho[k], 1e-8 * ref.rho[k] + 1e-300);
@@ -74,34 +73,31 @@ void checkAgainstDirect(bool portable) {
       EXPECT_NEAR(sums.s[i], ref.sums[i], 1e-8 * (1 + std::abs(ref.sums[i])));
     EXPECT_EQ(sums.used, ref.used);
   }
-  setPortableReweightingForTesting(false);
 }
 
 }  // namespace
 
-TEST(RobustReweighting, PortableMatchesTheFormula) { checkAgainstDirect(true); }
+TEST(RobustReweighting, PortableMatchesTheFormula) { checkAgainstDirect(SimdKernel::Portable); }
 
-TEST(RobustReweighting, DefaultPathMatchesTheFormula) { checkAgainstDirect(false); }
+TEST(RobustReweighting, DefaultPathMatchesTheFormula) { checkAgainstDirect(SimdKernel::Auto); }
 
 // A vanishing gradient gives rho = 0 (never NaN); far samples get an exactly zero factor.
 TEST(RobustReweighting, DegenerateSphereAndFarSamplesGiveZeroFactors) {
-  for (bool portable : {true, false}) {
-    setPortableReweightingForTesting(portable);
+  for (SimdKernel kernel : {SimdKernel::Portable, SimdKernel::Auto}) {
     NeighborColumns c;
     for (int k = 0; k < 9; ++k) c.push(Vec3(0.1 * k, 0, 0), Vec3(0, 0, 1), 0.5);
     AlgebraicSphere flat;  // all zero: gradient 0 everywhere
     std::vector<double> previous(9, 1.0), rho;
     SphereSums sums;
-    EXPECT_EQ(reweight(flat, 25, 4, c, previous, rho, sums), 1.0);
+    EXPECT_EQ(reweight(flat, 25, 4, c, previous, rho, sums, kernel), 1.0);
     for (double r : rho) EXPECT_EQ(r, 0.0);
     EXPECT_EQ(sums.used, 0);
     EXPECT_EQ(sums.s[0], 0.0);
     AlgebraicSphere far;  // plane z = 1e3: r / sigma_r huge
     far.uc = -1e3;
     far.ul = Vec3(0, 0, 1);
-    reweight(far, 25, 4, c, previous, rho, sums);
+    reweight(far, 25, 4, c, previous, rho, sums, kernel);
     for (double r : rho) EXPECT_EQ(r, 0.0);
     for (double v : sums.s) EXPECT_TRUE(std::isfinite(v));
   }
-  setPortableReweightingForTesting(false);
 }

@@ -1,7 +1,6 @@
 #include "scalespace/fit/DerivativeSums.hpp"
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define SCALESPACE_HAVE_AVX2_KERNEL 1
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
 #include <immintrin.h>
 #endif
 
@@ -14,11 +13,9 @@ void accumulatePortable(const DerivativeChunk& c, int m, DerivativeSums& sums) {
       for (int j = 0; j < 12; ++j) sums[i][j] += c.items[k][i] * c.factors[k][j];
 }
 
-#ifdef SCALESPACE_HAVE_AVX2_KERNEL
-// 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by. The
-// project builds for baseline x86-64 (SSE2: 2-wide, no FMA; -march=native was measured no faster
-// overall), so only this function is compiled for AVX2 + FMA and chosen at run time. Measured
-// with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+// 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by.
+// Measured with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
 __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c, int m,
                                                         DerivativeSums& sums) {
   for (int jb = 0; jb < 12; jb += 4) {
@@ -40,19 +37,10 @@ __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c
 
 }  // namespace
 
-bool avx2FmaKernelAvailable() {
-#ifdef SCALESPACE_HAVE_AVX2_KERNEL
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-#else
-  return false;
-#endif
-}
-
 void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,
-                              SumsKernel kernel) {
-#ifdef SCALESPACE_HAVE_AVX2_KERNEL
-  if (kernel != SumsKernel::Portable && avx2FmaKernelAvailable()) {
+                              SimdKernel kernel) {
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx2Fma(kernel)) {
     accumulateAvx2(chunk, m, sums);
     return;
   }

@@ -123,8 +123,8 @@ void fillColumns(double t, FitWorkspace& ws) {
   const WeightKernel kernel(t);
   ws.columns.clear();
   for (std::size_t k = 0; k < ws.offsets.size(); ++k) {
-    const double r = kernel.ratio(ws.offsets[k].squaredNorm());
-    ws.columns.push(ws.offsets[k], ws.normals[k], r < 1 ? (r - 1) * (r - 1) : 0.0);  // Eq. 1.6
+    const double w = WeightKernel::value(kernel.ratio(ws.offsets[k].squaredNorm()));  // Eq. 1.6
+    ws.columns.push(ws.offsets[k], ws.normals[k], w);
   }
 }
 
@@ -158,11 +158,10 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
   const FitDerivatives order = derivativesOf(options.estimator);
   ws.weights.assign(ws.offsets.size(), 1.0);
   bool full = reported && passes == 0;
-  if (passes == 0)
-    return spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None, full,
-                      options.minNeighbors);
+  OrientedSphereFitResult res = spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None,
+                                           full, options.minNeighbors);
+  if (passes == 0) return res;
   fillColumns(t, ws);
-  OrientedSphereFitResult res = sumsPass(t, kernelSums(ws.columns), options.minNeighbors);
   const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
   const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
   SphereSums sums;

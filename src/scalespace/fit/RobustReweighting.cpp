@@ -1,13 +1,11 @@
 #include "scalespace/fit/RobustReweighting.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include "scalespace/fit/FastExp.hpp"
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define SCALESPACE_HAVE_AVX2_REWEIGHT 1
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
 #include <immintrin.h>
 #endif
 
@@ -26,8 +24,6 @@ void NeighborColumns::push(const Vec3& q, const Vec3& n, double kernelWeight) {
 
 namespace {
 
-std::atomic<bool> forcePortable{false};
-
 inline void addSample(SphereSums& out, const NeighborColumns& c, std::size_t k, double w) {
   out.s[0] += w;
   out.s[1] += w * c.qx[k], out.s[2] += w * c.qy[k], out.s[3] += w * c.qz[k];
@@ -41,10 +37,10 @@ inline void addSample(SphereSums& out, const NeighborColumns& c, std::size_t k, 
 inline double factorOf(const AlgebraicSphere& s, double invSr2, double invSn2,
                        const NeighborColumns& c, std::size_t k) {
   const Vec3 q(c.qx[k], c.qy[k], c.qz[k]);
-  const Vec3 g = s.ul + 2 * s.uq * q;
+  const Vec3 g = s.gradient(q);
   const double gn = g.norm();
   if (!(gn > 0)) return 0;
-  const double r = (s.uc + s.ul.dot(q) + s.uq * c.d2[k]) / gn;
+  const double r = s.value(q) / gn;
   const double dn = (Vec3(c.nx[k], c.ny[k], c.nz[k]) - g / gn).squaredNorm();
   return expNegative(r * r * invSr2 + dn * invSn2);
 }
@@ -61,36 +57,28 @@ double reweightPortable(const AlgebraicSphere& s, double invSr2, double invSn2,
   return change;
 }
 
-#ifdef SCALESPACE_HAVE_AVX2_REWEIGHT
-bool cpuHasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+__attribute__((target("avx2,fma"))) inline __m256d splat(double v) { return _mm256_set1_pd(v); }
 
 /// expNegative (fit/FastExp.hpp) on four lanes: the same reduction and polynomial; the scaling by
 /// 2^-n goes through the exponent bits for every lane (FastExp uses ldexp for n > 1000, where
 /// exp(-x) < 1e-301: a weight that small is 0 for any purpose). x >= 708 and NaN give 0.
 __attribute__((target("avx2,fma"))) inline __m256d expNegative4(__m256d x) {
-  const __m256d valid = _mm256_cmp_pd(x, _mm256_set1_pd(708.0), _CMP_LT_OQ);  // false for NaN
-  x = _mm256_max_pd(_mm256_min_pd(x, _mm256_set1_pd(708.0)), _mm256_setzero_pd());
-  const __m256d n =
-      _mm256_floor_pd(_mm256_fmadd_pd(x, _mm256_set1_pd(1.4426950408889634), _mm256_set1_pd(0.5)));
-  const __m256d y =
-      _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(n, _mm256_set1_pd(6.93147180369123816490e-01)), x),
-                    _mm256_mul_pd(n, _mm256_set1_pd(1.90821492927058770002e-10)));
-  const __m256d one = _mm256_set1_pd(1.0);
+  using namespace fastexp;
+  const __m256d valid = _mm256_cmp_pd(x, splat(kMaxArgument), _CMP_LT_OQ);  // false for NaN
+  x = _mm256_max_pd(_mm256_min_pd(x, splat(kMaxArgument)), _mm256_setzero_pd());
+  const __m256d n = _mm256_floor_pd(_mm256_fmadd_pd(x, splat(kInvLn2), splat(0.5)));
+  const __m256d y = _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(n, splat(kLn2Hi)), x),
+                                  _mm256_mul_pd(n, splat(kLn2Lo)));
   const __m256d y2 = _mm256_mul_pd(y, y);
-  const __m256d a = _mm256_add_pd(
-      _mm256_add_pd(one, y),
-      _mm256_mul_pd(y2, _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 6), _mm256_set1_pd(0.5))));
-  const __m256d b = _mm256_add_pd(
-      _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 120), _mm256_set1_pd(1.0 / 24)),
-      _mm256_mul_pd(y2, _mm256_fmadd_pd(y, _mm256_set1_pd(1.0 / 5040), _mm256_set1_pd(1.0 / 720))));
+  const __m256d a = _mm256_add_pd(_mm256_add_pd(splat(1.0), y),
+                                  _mm256_mul_pd(y2, _mm256_fmadd_pd(y, splat(kC3), splat(kC2))));
+  const __m256d b = _mm256_add_pd(_mm256_fmadd_pd(y, splat(kC5), splat(kC4)),
+                                  _mm256_mul_pd(y2, _mm256_fmadd_pd(y, splat(kC7), splat(kC6))));
   const __m256d p = _mm256_fmadd_pd(_mm256_mul_pd(y2, y2), b, a);
   // 2^-n: the biased exponent 1023 - n (an integer-valued double in [1, 1023]) read as an
   // integer by adding 2^52, then shifted into the exponent field.
-  const __m256d biased =
-      _mm256_add_pd(_mm256_sub_pd(_mm256_set1_pd(1023.0), n), _mm256_set1_pd(4503599627370496.0));
+  const __m256d biased = _mm256_add_pd(_mm256_sub_pd(splat(1023.0), n), splat(4503599627370496.0));
   const __m256i e = _mm256_slli_epi64(
       _mm256_sub_epi64(_mm256_castpd_si256(biased), _mm256_set1_epi64x(0x4330000000000000LL)), 52);
   return _mm256_and_pd(_mm256_mul_pd(p, _mm256_castsi256_pd(e)), valid);
@@ -164,24 +152,16 @@ __attribute__((target("avx2,fma"))) double reweightAvx2(const AlgebraicSphere& s
 
 }  // namespace
 
-SphereSums kernelSums(const NeighborColumns& c) {
-  SphereSums out;
-  for (std::size_t k = 0; k < c.size(); ++k) addSample(out, c, k, c.weight[k]);
-  return out;
-}
-
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
                 const NeighborColumns& c, const std::vector<double>& previous,
-                std::vector<double>& rho, SphereSums& next) {
+                std::vector<double>& rho, SphereSums& next, SimdKernel kernel) {
   rho.resize(c.size());
   next = SphereSums{};
-#ifdef SCALESPACE_HAVE_AVX2_REWEIGHT
-  if (!forcePortable.load(std::memory_order_relaxed) && cpuHasAvx2Fma())
-    return reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx2Fma(kernel)) return reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
 #endif
+  (void)kernel;
   return reweightPortable(sphere, invSr2, invSn2, c, previous, 0, rho, next);
 }
-
-void setPortableReweightingForTesting(bool portable) { forcePortable.store(portable); }
 
 }  // namespace scalespace

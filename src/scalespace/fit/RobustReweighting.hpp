@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "scalespace/fit/AlgebraicSphere.hpp"
+#include "scalespace/fit/SimdKernel.hpp"
 
 namespace scalespace {
 
@@ -31,17 +32,12 @@ struct SphereSums {
   int used = 0;
 };
 
-/// Sums with weights w_k (rho = 1): the first, unweighted pass.
-SphereSums kernelSums(const NeighborColumns& c);
-
 /// Re-weights against `sphere`: writes rho_k to rho (resized), accumulates the sums with weights
 /// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]|. invSr2 = 1 /
 /// sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets rho = 0.
+/// `kernel`: fit/SimdKernel.hpp.
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
                 const NeighborColumns& c, const std::vector<double>& previous,
-                std::vector<double>& rho, SphereSums& next);
-
-/// Forces the portable (scalar) implementation of reweight, for tests on CPUs with AVX2.
-void setPortableReweightingForTesting(bool portable);
+                std::vector<double>& rho, SphereSums& next, SimdKernel kernel = SimdKernel::Auto);
 
 }  // namespace scalespace
