@@ -56,13 +56,11 @@ def check_codecs(path, manifest):
     bias = off.get("bias")
     if off.get("codec") != "shared_exponent" or not isinstance(bias, int) or not 0 <= bias <= 64:
         raise ValueError(f"{path}: projection_offset: expected codec shared_exponent, bias 0..64")
-    # The anisotropy is signed (slog8); the first version-3 stacks stored it unsigned (log8).
-    for name, codecs in (("anisotropy", ("slog8", "log8")), ("geometric_variation", ("log8",))):
+    for name, codec in (("anisotropy", "slog8"), ("geometric_variation", "log8")):
         lo, hi = q[name].get("log_min"), q[name].get("log_max")
-        if (q[name].get("codec") not in codecs or not isinstance(lo, (int, float))
+        if (q[name].get("codec") != codec or not isinstance(lo, (int, float))
                 or not isinstance(hi, (int, float)) or not 0 < lo < hi < np.inf):
-            raise ValueError(f"{path}: {name}: expected codec {' or '.join(codecs)}, "
-                             "0 < log_min < log_max < inf")
+            raise ValueError(f"{path}: {name}: expected codec {codec}, 0 < log_min < log_max < inf")
 
 
 def encoding(manifest):
@@ -159,7 +157,7 @@ def _decode(manifest, arrays, rel, t, index, valid):
     out["gls_kappa"] = np.where(v, half("gls_kappa_t") / t, 0.0)
     for name in ("anisotropy", "geometric_variation"):
         if v3:
-            decode = decode_slog8 if q[name]["codec"] == "slog8" else decode_log8
+            decode = decode_slog8 if name == "anisotropy" else decode_log8
             value = decode(arrays[name][index], q[name]["log_min"], q[name]["log_max"])
         else:
             value = half(name)

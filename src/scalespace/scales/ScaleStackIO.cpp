@@ -721,14 +721,10 @@ void readCodec(const std::string& manifestPath, const Quantity& q, const nlohman
                CompactCodecs& codecs) {
   const std::string fix = "recompute the stack with 'scalespace scales'";
   const std::string what = std::string("quantity '") + q.name + "': ";
-  // The anisotropy of the first version-3 stacks used the unsigned code: the manifest says which.
   const std::string codec = entry.at("codec").get<std::string>();
-  const bool anisotropyLog = std::strcmp(q.name, "anisotropy") == 0 &&
-                             (codec == "log8" || codec == "slog8") &&
-                             std::strcmp(q.codec, "slog8") == 0;
-  if ((codec != q.codec && !anisotropyLog) || entry.at("scaling").get<std::string>() != q.scaling)
+  if (codec != q.codec || entry.at("scaling").get<std::string>() != q.scaling)
     throw FileError(manifestPath, "",
-                    what + "codec '" + entry.at("codec").get<std::string>() + "', scaling '" +
+                    what + "codec '" + codec + "', scaling '" +
                         entry.at("scaling").get<std::string>() + "' (expected '" + q.codec +
                         "', '" + q.scaling + "')",
                     fix);
