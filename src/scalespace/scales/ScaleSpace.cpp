@@ -28,6 +28,25 @@ void put3(std::vector<float>& v, std::size_t i, const Vec3& x) {
   v[3 * i + 2] = float(x.z());
 }
 
+/// Stores the fit of input point i in the layer, with `projection` (the fit's, or the last valid
+/// one when the fit is invalid).
+void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, ScaleLayer& layer) {
+  layer.neighbors[i] = std::uint16_t(std::clamp(f.neighbors, 0, 65535));
+  layer.valid[i] = f.valid ? 1 : 0;
+  put3(layer.projection, i, projection);
+  put3(layer.normal, i, f.normal);
+  put3(layer.dirMax, i, f.dirMax);
+  put3(layer.dirMin, i, f.dirMin);
+  layer.meanCurvature[i] = float(f.meanCurvature);
+  layer.kMax[i] = float(f.kMax);
+  layer.kMin[i] = float(f.kMin);
+  layer.tau[i] = float(f.tau);
+  layer.kappa[i] = float(f.kappa);
+  layer.fitness[i] = float(f.fitness);
+  layer.anisotropy[i] = float(f.anisotropy);
+  layer.geometricVariation[i] = float(f.geometricVariation);
+}
+
 // Neighbour-query reuse (fit/NeighborhoodCache). Consecutive points whose start positions span a
 // box of half-diagonal <= kBlockSpread t form a block; one query of radius
 // t (1 + kMlsSlack) + half-diagonal around the box centre then answers the radius-t queries of
@@ -171,41 +190,28 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     ProgressTracker tracker(scaleProgress, "projection", n);
     // Groups of kGroup consecutive (Morton-ordered) points, split into blocks independently of
     // the thread count, so that every point sees the same neighbour order for any --threads.
+    auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
+      const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
+      for (std::size_t k = g * kGroup; k < groupEnd;) {
+        const std::size_t blockEnd = prefetchBlock(current, k, groupEnd, samples, t, ws.cache);
+        for (; k < blockEnd; ++k) {
+          FitOptions pointFit = fit;
+          pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
+          const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
+          neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
+          mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
+          if (f.valid) current[k] = f.projection;  // else keep the last one
+          recordFit(f, current[k], order[k], layer);
+        }
+      }
+      return groupEnd - g * kGroup;
+    };
     const std::size_t groups = (n + kGroup - 1) / kGroup;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 8),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         FitWorkspace& ws = workspaces.local();
-                        for (std::size_t g = r.begin(); g != r.end(); ++g) {
-                          const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
-                          for (std::size_t k = g * kGroup; k < groupEnd;) {
-                            const std::size_t blockEnd =
-                                prefetchBlock(current, k, groupEnd, samples, t, ws.cache);
-                            for (; k < blockEnd; ++k) {
-                              FitOptions pointFit = fit;
-                              pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
-                              const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
-                              const std::size_t i = order[k];  // input index
-                              neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
-                              mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
-                              layer.neighbors[i] = std::uint16_t(std::min(f.neighbors, 65535));
-                              layer.valid[i] = f.valid ? 1 : 0;
-                              if (f.valid) current[k] = f.projection;  // else keep the last one
-                              put3(layer.projection, i, current[k]);
-                              put3(layer.normal, i, f.normal);
-                              put3(layer.dirMax, i, f.dirMax);
-                              put3(layer.dirMin, i, f.dirMin);
-                              layer.meanCurvature[i] = float(f.meanCurvature);
-                              layer.kMax[i] = float(f.kMax);
-                              layer.kMin[i] = float(f.kMin);
-                              layer.tau[i] = float(f.tau);
-                              layer.kappa[i] = float(f.kappa);
-                              layer.fitness[i] = float(f.fitness);
-                              layer.anisotropy[i] = float(f.anisotropy);
-                              layer.geometricVariation[i] = float(f.geometricVariation);
-                            }
-                          }
-                          tracker.advance(groupEnd - g * kGroup);
-                        }
+                        for (std::size_t g = r.begin(); g != r.end(); ++g)
+                          tracker.advance(projectGroup(g, ws));
                       });
     tracker.finish();
     stats.projectionSeconds = secondsSince(t0);
