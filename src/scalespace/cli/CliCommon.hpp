@@ -21,11 +21,11 @@ void addInputOptions(CLI::App& command, InputOptions& input);
 /// Reads the cloud; throws if it has no points (nothing to analyse).
 PointCloud loadCloud(const InputOptions& input, bool quiet);
 
-/// Throws OptionError when `output` names the same file as `input` (we never overwrite inputs).
 /// Estimates (PCA, 10 neighbours) and orients (MST) normals when the cloud has none; says so on
 /// stderr unless quiet. The APSS fits need oriented normals.
 void ensureNormals(PointCloud& cloud, bool quiet);
 
+/// Throws OptionError when `output` names the same file as `input` (we never overwrite inputs).
 void checkOutputPath(const std::string& input, const std::string& output);
 
 /// OUT.ply -> OUT.json

@@ -23,8 +23,7 @@ inline Jet1 operator/(const Jet1& a, const Jet1& b) { return a * inverse(b); }
 
 /// Value, gradient and Hessian. The Hessian is symmetric: only its 6 distinct entries are stored
 /// (xx, yy, zz, xy, xz, yz), which saves a third of the Hessian arithmetic of the W3 solve (about
-/// 20 products and 2 reciprocals per fit; perf put the solve at ~12% less time than with Eigen
-/// 3 x 3 Hessians).
+/// 20 products and 2 reciprocals per fit).
 struct Jet2 {
   double v = 0;
   Vec3 g = Vec3::Zero();

@@ -2,6 +2,7 @@
 
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_2.h>
 #include <CGAL/convex_hull_2.h>
@@ -18,21 +19,25 @@ using Vb = CGAL::Triangulation_vertex_base_2<Kernel>;
 using Fb = CGAL::Triangulation_face_base_with_info_2<bool, Kernel>;  // info: face is interior
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
-}  // namespace
+
+std::vector<Kernel::Point_2> toCgal(const std::vector<Vec2>& points) {
+  std::vector<Kernel::Point_2> out;
+  out.reserve(points.size());
+  for (const Vec2& p : points) out.emplace_back(p.x(), p.y());
+  return out;
+}
 
 // The regularized alpha shape read directly off the Delaunay triangulation: a finite triangle is
 // interior when its squared circumradius is <= alpha (what CGAL::Alpha_shape_2 classifies as
 // INTERIOR in REGULARIZED mode; tests/planes compare both), and the outline is made of the edges
 // between an interior triangle and a non-interior (or infinite) one. Alpha_shape_2 itself also
-// builds the whole alpha spectrum, which made the component outlines of a 1M-point scene take
-// most of their time in it.
-AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withOutlines) {
+// builds the whole alpha spectrum: with it, the components of a 1M-point Stairs scene took 25 s,
+// now 2 s.
+AlphaShape alphaShapeOf(const std::vector<Kernel::Point_2>& points, double alpha,
+                        bool withOutlines) {
   AlphaShape result;
   if (points.size() < 3 || !(alpha > 0)) return result;
-  std::vector<Kernel::Point_2> cgalPoints;
-  cgalPoints.reserve(points.size());
-  for (const Vec2& p : points) cgalPoints.emplace_back(p.x(), p.y());
-  Delaunay dt(cgalPoints.begin(), cgalPoints.end());
+  Delaunay dt(points.begin(), points.end());
   const auto squaredRadius = Kernel().compute_squared_radius_2_object();
   const auto area = Kernel().compute_area_2_object();
   for (auto f = dt.all_faces_begin(); f != dt.all_faces_end(); ++f) f->info() = false;
@@ -76,8 +81,6 @@ AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withO
   return result;
 }
 
-namespace {
-
 /// Sum of the areas of the triangles that are interior in the alpha shape of ALL `points`, found
 /// by triangulating only the points within `reach` of `centre`: a triangle of that local Delaunay
 /// triangulation whose circumcircle lies inside the disk (centre, reach) has no point of the
@@ -113,6 +116,10 @@ double certifiedArea(const std::vector<Vec2>& points, const Vec2& centre, double
 
 }  // namespace
 
+AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withOutlines) {
+  return alphaShapeOf(toCgal(points), alpha, withOutlines);
+}
+
 bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double minArea) {
   if (points.size() < 3 || !(alpha > 0)) return 0 >= minArea;
   // "No" from upper bounds: the interior triangles are Delaunay triangles, which tile a subset of
@@ -121,17 +128,10 @@ bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double
   Eigen::AlignedBox2d box;
   for (const Vec2& p : points) box.extend(p);
   if (box.volume() < minArea) return false;
-  std::vector<Kernel::Point_2> cgalPoints;
-  cgalPoints.reserve(points.size());
-  for (const Vec2& p : points) cgalPoints.emplace_back(p.x(), p.y());
+  const std::vector<Kernel::Point_2> cgalPoints = toCgal(points);
   std::vector<Kernel::Point_2> hull;
   CGAL::convex_hull_2(cgalPoints.begin(), cgalPoints.end(), std::back_inserter(hull));
-  double hullArea = 0;
-  for (std::size_t i = 0; i < hull.size(); ++i) {
-    const auto& a = hull[i];
-    const auto& b = hull[(i + 1) % hull.size()];
-    hullArea += 0.5 * (a.x() * b.y() - b.x() * a.y());
-  }
+  const double hullArea = CGAL::polygon_area_2(hull.begin(), hull.end(), Kernel());
   if (std::abs(hullArea) * (1 + 1e-9) < minArea) return false;
   // "Yes" from a patch around the middle (certifiedArea), when the patch is a small part of a
   // large set; otherwise the whole shape decides.
@@ -148,7 +148,7 @@ bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double
     if (2 * near < points.size() && certifiedArea(points, centre, reach, alpha) >= minArea)
       return true;
   }
-  return alphaShape2(points, alpha, false).area >= minArea;
+  return alphaShapeOf(cgalPoints, alpha, false).area >= minArea;
 }
 
 PlaneFit fitPlane(const std::vector<Vec3>& positions, const std::vector<Index>& indices) {
