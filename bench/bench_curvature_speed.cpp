@@ -2,7 +2,9 @@
 // neighbour query included), on a sphere and on a noisy scan-like surface, with CGAL's Monge jets
 // (degree 2) timed in the same run on the same neighbourhoods as the peer.
 //
-//   bench_curvature_speed [--points N] [--peer-points M]
+//   bench_curvature_speed [--points N] [--peer-points M] [--only-w3] [--no-sweep]
+//
+// --only-w3 times W3 alone and --no-sweep skips the neighbour sweep (quicker profiling runs).
 //
 // Prints one table per surface: estimator, threads, seconds, us per point per core, and the
 // ratio to the peer.
@@ -132,11 +134,20 @@ Run runFits(Surface& s, EstimatorKind kind, double t, int threads) {
 
 int main(int argc, char** argv) {
   std::size_t n = 1000000, peerPoints = 20000;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (!std::strcmp(argv[i], "--points"))
+  bool onlyW3 = false, sweep = true;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--points") && i + 1 < argc)
       n = std::strtoull(argv[++i], nullptr, 10);
-    else if (!std::strcmp(argv[i], "--peer-points"))
+    else if (!std::strcmp(argv[i], "--peer-points") && i + 1 < argc)
       peerPoints = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--only-w3"))
+      onlyW3 = true;
+    else if (!std::strcmp(argv[i], "--no-sweep"))
+      sweep = false;
+    else {
+      std::fprintf(stderr, "unknown argument '%s'\n", argv[i]);
+      return 2;
+    }
   }
   const int cores = tbb::info::default_concurrency();
   std::printf(
@@ -146,19 +157,22 @@ int main(int argc, char** argv) {
   for (Surface s : {sphere(n), scanLike(n)}) {
     const double t40 = scaleFor(s, 40);
     std::printf("\n== %s, t = %.5g (about 40 neighbours)\n", s.name.c_str(), t40);
-    std::printf("%-9s %7s %9s %12s %14s %10s\n", "estimator", "threads", "seconds", "neighbours",
-                "us/point/core", "vs peer");
+    std::printf("%-9s %7s %9s %12s %14s %10s %15s\n", "estimator", "threads", "seconds",
+                "neighbours", "us/point/core", "vs peer", "fits us/pt/core");
     const double peer = peerJets(s, t40, peerPoints);
     for (EstimatorKind kind : {EstimatorKind::W1, EstimatorKind::W2, EstimatorKind::W3}) {
+      if (onlyW3 && kind != EstimatorKind::W3) continue;
       for (int threads : {1, cores}) {
         const Run r = runFits(s, kind, t40, threads);
         const double us = r.seconds * threads / double(n) * 1e6;
-        std::printf("%-9s %7d %9.3f %12.1f %14.3f %9.1fx\n", estimatorName(kind), threads,
-                    r.seconds, r.summary.meanNeighbors, us, peer * 1e6 / us);
+        std::printf("%-9s %7d %9.3f %12.1f %14.3f %9.1fx %15.3f\n", estimatorName(kind), threads,
+                    r.seconds, r.summary.meanNeighbors, us, peer * 1e6 / us,
+                    r.summary.fitSeconds * threads / double(n) * 1e6);
         if (threads == cores && cores == 1) break;
       }
     }
     std::printf("%-9s %7d %9s %12s %14.3f %10s\n", "cgal-jet", 1, "-", "~40", peer * 1e6, "1.0x");
+    if (!sweep) continue;
 
     std::printf("\n   neighbour sweep (W3, %d threads; peer on %zu points)\n", cores,
                 peerPoints / 4);

@@ -12,9 +12,17 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
+#include "scalespace/fit/NeighborhoodCache.hpp"
 
 namespace scalespace {
 namespace {
+
+constexpr std::size_t kGroup = 64;  // points per run of blocks (see forEachFit)
+constexpr double kMlsSlack = 0.1;   // MLS steps may leave the block by 0.1 t (fit/NeighborhoodCache)
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 bool needsNormals(EstimatorKind kind) {
   return kind == EstimatorKind::W1 || kind == EstimatorKind::W2 || kind == EstimatorKind::W3;
@@ -55,6 +63,8 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   }
   const std::unique_ptr<SpatialIndex> index = makeSpatialIndex(positions);
   const SurfaceSamples samples{positions, normals, *index};
+  summary.setupSeconds = secondsSince(start);
+  const auto fitStart = std::chrono::steady_clock::now();
 
   std::vector<double> scales(n, options.scale);
   struct Counters {
@@ -63,30 +73,48 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
     FitWorkspace workspace;
   };
   tbb::enumerable_thread_specific<Counters> counters;
-  ProgressTracker tracker(progress, "fitting", n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& range) {
-    Counters& c = counters.local();
-    for (std::size_t k = range.begin(); k < range.end(); ++k) {
-      double t = options.scale;
-      if (options.scaleK > 0) {
-        // K + 1 because the point itself is its own nearest neighbour.
-        index->knnSearch(positions[k], std::size_t(options.scaleK) + 1, c.workspace.neighbors);
-        t = c.workspace.neighbors.empty() ? 0.0 : std::sqrt(c.workspace.neighbors.back().distSq);
-        // The support is open (|q| < t): widen by a hair so the K-th neighbour is inside it.
-        t *= 1.0 + 1e-9;
-        scales[k] = t;
-      }
-      LocalFit fit;
-      if (t > 0) fit = fitAt(positions[k], t, samples, options.fit, c.workspace);
-      if (fit.valid)
-        c.neighbors += fit.neighbors;
-      else
-        ++c.invalid;
-      visit(order[k], fit);
+  auto fitOne = [&](std::size_t k, Counters& c) {
+    double t = options.scale;
+    if (options.scaleK > 0) {
+      // K + 1 because the point itself is its own nearest neighbour.
+      index->knnSearch(positions[k], std::size_t(options.scaleK) + 1, c.workspace.neighbors);
+      t = c.workspace.neighbors.empty() ? 0.0 : std::sqrt(c.workspace.neighbors.back().distSq);
+      // The support is open (|q| < t): widen by a hair so the K-th neighbour is inside it.
+      t *= 1.0 + 1e-9;
+      scales[k] = t;
     }
-    tracker.advance(range.size());
+    LocalFit fit;
+    if (t > 0) fit = fitAt(positions[k], t, samples, options.fit, c.workspace);
+    if (fit.valid)
+      c.neighbors += fit.neighbors;
+    else
+      ++c.invalid;
+    visit(order[k], fit);
+  };
+  ProgressTracker tracker(progress, "fitting", n);
+  // At a fixed scale, consecutive (Morton-ordered) points share most neighbours: fixed groups of
+  // kGroup points are cut into blocks whose fits read one prefetched ball (fit/NeighborhoodCache).
+  // The groups do not depend on the thread count, so neither does the order of any sum.
+  const bool prefetch = options.scaleK == 0;
+  const double slack = options.fit.mls ? kMlsSlack : 0.0;
+  const std::size_t groups = (n + kGroup - 1) / kGroup;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4), [&](const auto& range) {
+    Counters& c = counters.local();
+    const std::size_t first = range.begin() * kGroup, last = std::min(n, range.end() * kGroup);
+    for (std::size_t g = range.begin(); g != range.end(); ++g) {
+      const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
+      for (std::size_t k = g * kGroup; k < groupEnd;) {
+        const std::size_t blockEnd =
+            prefetch ? prefetchBlock(positions, k, groupEnd, samples, options.scale, slack,
+                                     c.workspace.cache)
+                     : k + 1;
+        for (; k < blockEnd; ++k) fitOne(k, c);
+      }
+    }
+    tracker.advance(last - first);
   });
   tracker.finish();
+  summary.fitSeconds = secondsSince(fitStart);
 
   for (const Counters& c : counters) {
     summary.invalid += c.invalid;
@@ -96,7 +124,7 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   summary.meanNeighbors = valid ? summary.meanNeighbors / double(valid) : 0.0;
   std::nth_element(scales.begin(), scales.begin() + n / 2, scales.end());
   summary.medianScale = scales[n / 2];
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = secondsSince(start);
 }
 
 }  // namespace

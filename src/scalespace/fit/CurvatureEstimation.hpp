@@ -26,7 +26,9 @@ struct CurvatureSummary {
   std::size_t invalid = 0;
   double meanNeighbors = 0;  // over valid fits
   double medianScale = 0;    // t (the same for all points unless scaleK is used)
-  double seconds = 0;        // fits only (index build included)
+  double seconds = 0;        // everything below, and the output (index build included)
+  double setupSeconds = 0;   // spatial order and index build
+  double fitSeconds = 0;     // neighbour queries and fits of all points (results handed over)
 };
 
 /// Names of the columns written by computeCurvatureColumns, in order.

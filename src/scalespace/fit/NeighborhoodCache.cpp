@@ -1,5 +1,6 @@
 #include "scalespace/fit/NeighborhoodCache.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "scalespace/fit/LocalFit.hpp"
@@ -31,6 +32,25 @@ void NeighborhoodCache::prefetch(const SurfaceSamples& samples, const Vec3& cent
 bool NeighborhoodCache::covers(const SurfaceSamples& samples, const Vec3& q, double r) const {
   return source_ == &samples.index && r > 0 && q.allFinite() &&
          (q - center_).norm() + r <= radius_ * (1 - kContainmentMargin);
+}
+
+std::size_t prefetchBlock(const std::vector<Vec3>& points, std::size_t k, std::size_t last,
+                          const SurfaceSamples& samples, double t, double slack,
+                          NeighborhoodCache& cache) {
+  Eigen::AlignedBox3d box(points[k]);
+  std::size_t end = k + 1;
+  for (; end < last; ++end) {
+    Eigen::AlignedBox3d grown = box;
+    grown.extend(points[end]);
+    if (!(grown.diagonal().norm() <= 2 * kBlockSpread * t)) break;
+    box = grown;
+  }
+  if (end - k < 2) {
+    cache.clear();
+  } else {
+    cache.prefetch(samples, box.center(), t * (1 + slack) + box.diagonal().norm() / 2);
+  }
+  return end;
 }
 
 }  // namespace scalespace

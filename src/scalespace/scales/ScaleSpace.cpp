@@ -2,7 +2,6 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,36 +46,11 @@ void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, ScaleLa
   layer.geometricVariation[i] = float(f.geometricVariation);
 }
 
-// Neighbour-query reuse (fit/NeighborhoodCache). Consecutive points whose start positions span a
-// box of half-diagonal <= kBlockSpread t form a block; one query of radius
-// t (1 + kMlsSlack) + half-diagonal around the box centre then answers the radius-t queries of
-// all their MLS steps, unless a step moves a point more than kMlsSlack t out of the box. Larger
-// spreads make fewer tree queries but longer candidate lists to scan (on a surface the list grows
-// like (1 + spread + slack)^2). On 100k points x 50 scales (bench/fig_1_10, 1 thread) spreads
-// 0.12 / 0.25 / 0.5 / 1.0 took 9.5 / 9.1 / 8.9 / 9.05 s of projection against 10.0-10.9 s without.
+// Neighbour-query reuse (fit/NeighborhoodCache): Morton-ordered points are cut into groups of
+// kGroup, each group into blocks (prefetchBlock) whose radius-t queries of all MLS steps are
+// answered by one index query, unless a step moves a point more than kMlsSlack t out of the block.
 constexpr std::size_t kGroup = 64;
-constexpr double kBlockSpread = 0.5;
 constexpr double kMlsSlack = 0.1;
-
-/// Forms the block of points [k, end) starting at k within [k, groupEnd) and prefetches its
-/// neighbourhood into `cache` (emptied for a single point: a plain query is cheaper). Returns end.
-std::size_t prefetchBlock(const std::vector<Vec3>& start, std::size_t k, std::size_t groupEnd,
-                          const SurfaceSamples& samples, double t, NeighborhoodCache& cache) {
-  Eigen::AlignedBox3d box(start[k]);
-  std::size_t end = k + 1;
-  for (; end < groupEnd; ++end) {
-    Eigen::AlignedBox3d grown = box;
-    grown.extend(start[end]);
-    if (!(grown.diagonal().norm() <= 2 * kBlockSpread * t)) break;
-    box = grown;
-  }
-  if (end - k < 2) {
-    cache.clear();
-  } else {
-    cache.prefetch(samples, box.center(), t * (1 + kMlsSlack) + box.diagonal().norm() / 2);
-  }
-  return end;
-}
 
 }  // namespace
 
@@ -193,7 +167,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
       const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
       for (std::size_t k = g * kGroup; k < groupEnd;) {
-        const std::size_t blockEnd = prefetchBlock(current, k, groupEnd, samples, t, ws.cache);
+        const std::size_t blockEnd = prefetchBlock(current, k, groupEnd, samples, t, kMlsSlack, ws.cache);
         for (; k < blockEnd; ++k) {
           FitOptions pointFit = fit;
           pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
