@@ -18,7 +18,7 @@ namespace scalespace {
 namespace {
 
 constexpr std::size_t kGroup = 64;  // points per run of blocks (see forEachFit)
-constexpr double kMlsSlack = 0.1;   // MLS steps may leave the block by 0.1 t (fit/NeighborhoodCache)
+constexpr double kMlsSlack = 0.1;  // MLS steps may leave the block by 0.1 t (fit/NeighborhoodCache)
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -104,10 +104,10 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
     for (std::size_t g = range.begin(); g != range.end(); ++g) {
       const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
       for (std::size_t k = g * kGroup; k < groupEnd;) {
-        const std::size_t blockEnd =
-            prefetch ? prefetchBlock(positions, k, groupEnd, samples, options.scale, slack,
-                                     c.workspace.cache)
-                     : k + 1;
+        const std::size_t blockEnd = prefetch
+                                         ? prefetchBlock(positions, k, groupEnd, samples,
+                                                         options.scale, slack, c.workspace.cache)
+                                         : k + 1;
         for (; k < blockEnd; ++k) fitOne(k, c);
       }
     }

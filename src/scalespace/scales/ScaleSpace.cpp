@@ -167,7 +167,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
       const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
       for (std::size_t k = g * kGroup; k < groupEnd;) {
-        const std::size_t blockEnd = prefetchBlock(current, k, groupEnd, samples, t, kMlsSlack, ws.cache);
+        const std::size_t blockEnd =
+            prefetchBlock(current, k, groupEnd, samples, t, kMlsSlack, ws.cache);
         for (; k < blockEnd; ++k) {
           FitOptions pointFit = fit;
           pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
