@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -423,6 +424,143 @@ TEST(StackQuantization, Log8ClampsAndNeverReturnsNaN) {
   EXPECT_EQ(code.encode(0.49 * code.decode(1), clamped), 0);
   EXPECT_EQ(code.encode(0.51 * code.decode(1), clamped), 1);
   EXPECT_FALSE(clamped);
+}
+
+// ------------------------------------------------------------------------------------------
+// The encoders avoid library calls (atan2, log, frexp, ldexp, round) and unpredictable branches;
+// these tests hold them to the straightforward formulas, code for code.
+
+std::uint32_t referenceAxisAngle(double c, double s) {
+  if (!std::isfinite(c) || !std::isfinite(s) || (c == 0 && s == 0)) return 0;
+  double theta = std::atan2(s, c);
+  if (theta < 0) theta += kPi;
+  return std::uint32_t(std::lround(theta * (kAngleSteps / kPi))) % std::uint32_t(kAngleSteps);
+}
+
+TEST(StackQuantization, FastAxisAngleEqualsAtan2) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> g;
+  double worst = 0;
+  for (int k = 0; k < 400000; ++k) {
+    const double c = g(rng), s = g(rng);
+    double theta = std::atan2(s, c);
+    if (theta < 0) theta += kPi;
+    worst = std::max(worst, std::abs(fastAxisAngle(c, s) - theta));
+  }
+  EXPECT_LT(worst, 1e-11);
+  EXPECT_NEAR(fastAxisAngle(1, 0), 0, 1e-15);
+  EXPECT_NEAR(fastAxisAngle(0, 1), kPi / 2, 1e-15);
+  EXPECT_NEAR(fastAxisAngle(-1, 1e-300), kPi, 1e-15);
+  EXPECT_NEAR(fastAxisAngle(1, -1), 3 * kPi / 4, 1e-15);
+}
+
+TEST(StackQuantization, QuantizedAxisAngleIsTheAtan2Code) {
+  std::mt19937_64 rng(22);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> jitter(-1e-9, 1e-9);
+  for (int k = 0; k < 400000; ++k) {
+    const double c = g(rng), s = g(rng);
+    ASSERT_EQ(quantizeAxisAngle(c, s), referenceAxisAngle(c, s)) << c << " " << s;
+  }
+  // Directions on and next to every rounding tie, both half-planes, and the axes.
+  const double step = kPi / kAngleSteps;
+  for (int q = 0; q <= kAngleSteps; ++q)
+    for (const double sign : {1.0, -1.0}) {
+      const double theta = (q + 0.5) * step + jitter(rng);
+      const double c = sign * std::cos(theta), s = sign * std::sin(theta);
+      ASSERT_EQ(quantizeAxisAngle(c, s), referenceAxisAngle(c, s)) << q;
+      ASSERT_EQ(quantizeAxisAngle(sign * std::cos(q * step), sign * std::sin(q * step)),
+                referenceAxisAngle(sign * std::cos(q * step), sign * std::sin(q * step)));
+    }
+  for (const double c : {0.0, -0.0, 1.0, -1.0})
+    for (const double s : {0.0, -0.0, 1.0, -1.0})
+      EXPECT_EQ(quantizeAxisAngle(c, s), referenceAxisAngle(c, s)) << c << " " << s;
+  EXPECT_EQ(quantizeAxisAngle(std::nan(""), 1), 0u);
+}
+
+std::uint32_t referenceSharedExponent(const Vec3& offset) {
+  double largest = offset.cwiseAbs().maxCoeff();
+  if (!(largest > 0)) return 0;
+  int e = kOffsetExponentMax;
+  if (largest < kOffsetMaxMagnitude) {
+    int k;
+    std::frexp(largest, &k);
+    e = k - 8 + kOffsetBias;
+    if (std::ldexp(largest, kOffsetBias - e) >= kOffsetMagnitudeMax + 0.5) ++e;
+    e = std::max(e, 0);
+  }
+  std::uint32_t code = std::uint32_t(e) << 27;
+  for (int c = 0; c < 3; ++c) {
+    const double scaled = std::round(std::ldexp(std::abs(offset[c]), kOffsetBias - e));
+    const std::uint32_t m =
+        scaled >= kOffsetMagnitudeMax ? std::uint32_t(kOffsetMagnitudeMax) : std::uint32_t(scaled);
+    code |= ((m != 0 && offset[c] < 0 ? 0x100u : 0u) | m) << (9 * c);
+  }
+  return code;
+}
+
+TEST(StackQuantization, SharedExponentIsTheFrexpCode) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> mantissa(-1, 1);
+  std::uniform_int_distribution<int> exponent(-40, 12);
+  for (int k = 0; k < 300000; ++k) {
+    Vec3 v;
+    for (int c = 0; c < 3; ++c) v[c] = std::ldexp(mantissa(rng), exponent(rng));
+    if (k % 7 == 0) v[k % 3] = std::round(v[k % 3] * 512) / 512;  // exact halves of a step
+    bool clamped = false;
+    ASSERT_EQ(encodeSharedExponent(v, clamped), referenceSharedExponent(v)) << v.transpose();
+  }
+  for (const double tiny : {4.9e-324, 1e-310, 0x1p-1000, 0x1p-1001}) {
+    bool clamped = false;
+    const Vec3 v(tiny, -tiny / 2, 0);
+    EXPECT_EQ(encodeSharedExponent(v, clamped), referenceSharedExponent(v));
+  }
+}
+
+TEST(StackQuantization, Log8IsTheBisectionCode) {
+  for (const auto& code : {Log8Code(kAnisotropyLogMin, kAnisotropyLogMax, true),
+                           Log8Code(kVariationLogMin, kVariationLogMax)}) {
+    // The bin by bisection on the edges lo r^k (what the decoder's centres are the middles of).
+    const int codes = code.magnitudeCodes();
+    std::vector<double> edges(std::size_t(codes) + 1);
+    for (int k = 0; k <= codes; ++k)
+      edges[std::size_t(k)] = code.lo() * std::pow(code.hi() / code.lo(), double(k) / codes);
+    auto reference = [&](double v) {
+      return int(std::upper_bound(edges.begin(), edges.begin() + codes, v) - edges.begin());
+    };
+    std::vector<double> values;
+    std::mt19937_64 rng(24);
+    std::uniform_real_distribution<double> u(std::log(code.lo()), std::log(code.hi()));
+    for (int k = 0; k < 200000; ++k) values.push_back(std::exp(u(rng)));
+    for (const double e : edges)
+      for (const double v : {e, std::nextafter(e, 0.0), std::nextafter(e, 2 * e)})
+        values.push_back(v);
+    for (const double v : values) {
+      if (v < code.lo() || v > code.hi()) continue;
+      bool clamped = false;
+      ASSERT_EQ(int(code.encode(v, clamped)), reference(v)) << v;
+      ASSERT_FALSE(clamped);
+    }
+  }
+}
+
+TEST(StackQuantization, OctahedralPicksTheNearestOfTheFourCodes) {
+  std::mt19937_64 rng(25);
+  const int m = kOctMax;
+  for (int k = 0; k < 200000; ++k) {
+    const Vec3 n = randomUnit(rng);
+    const Vec3 chosen = decodeOctahedral(encodeOctahedral(n));
+    // No code of the 5 x 5 block around the chosen one decodes nearer to n.
+    const std::uint32_t code = encodeOctahedral(n);
+    const int qx = int(code & 0x7ffu) - m, qy = int((code >> kOctBits) & 0x7ffu) - m;
+    for (int dx = -2; dx <= 2; ++dx)
+      for (int dy = -2; dy <= 2; ++dy) {
+        const int x = std::clamp(qx + dx, -m, m), y = std::clamp(qy + dy, -m, m);
+        const Vec3 other =
+            decodeOctahedral(std::uint32_t(x + m) | (std::uint32_t(y + m) << kOctBits));
+        ASSERT_LE(other.dot(n), chosen.dot(n) + 1e-15) << n.transpose();
+      }
+  }
 }
 
 }  // namespace

@@ -67,6 +67,14 @@ constexpr double kAngleMaxError = 3.14159265358979323846 / (2 * kAngleSteps);
 /// integer z of the octahedral code (exact, so that every decoder takes the same branch).
 void tangentBasis(const Vec3& n, int zSign, Vec3& b1, Vec3& b2);
 
+/// The angle in [0, pi] of the axis through (c, s) (atan2(s, c), plus pi when negative), within
+/// 1e-11 rad, without a library call.
+double fastAxisAngle(double c, double s);
+/// q = round(theta K / pi) mod K for that axis angle theta (K = kAngleSteps), exactly as with
+/// std::atan2 and std::lround (values near a rounding tie are recomputed with them); 0 for a
+/// zero or non-finite (c, s).
+std::uint32_t quantizeAxisAngle(double c, double s);
+
 /// Packs a unit normal and a principal direction into 32 bits: bits 0..21 the octahedral normal,
 /// bits 22..31 the angle q of dir_max in the tangent basis of the *decoded* normal:
 /// dir_max = cos(theta) b1 + sin(theta) b2, theta = q pi / 1024.
@@ -154,8 +162,9 @@ class Log8Code {
   std::uint8_t encodeMagnitude(double magnitude, bool& clamped) const;  // magnitude > 0
   double lo_, hi_, ratio_;
   bool signed_;
-  std::array<double, 256> centre_{};  // decoded values, centre_[0] = 0
-  std::array<double, 256> edge_{};    // edge_[k] = lo r^k: the edges of bin k are k-1, k
+  std::array<double, 256> centre_{};     // decoded values, centre_[0] = 0
+  std::array<double, 256> edge_{};       // edge_[k] = lo r^k: the edges of bin k are k-1, k
+  double log2Lo_ = 0, binsPerLog2_ = 0;  // a first guess of the bin from the exponent bits
 };
 
 /// Negative inputs of a log code down to -2^-23 (one float32 ulp at 1: what 1 - |u_l| rounds to
