@@ -8,6 +8,9 @@
 // levels (M/5, 2M/5, 3M/5, 4M/5) and the time split of Table 2.1. The baselines get the exact
 // normals of the scene; ours uses them only as the stack's input normals.
 // Usage: bench_planes [points per scene, default 100000] [scales M, default 50]
+//                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
+// --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines, and
+// --robust-tolerance sets the stack's ScaleSpaceOptions::robustTolerance (default: the library's).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
@@ -18,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -151,9 +155,10 @@ Detection runRegionGrowing(const PointCloud& cloud) {
 // Our pipeline: recall over all levels, precision among persistent components, and per-level
 // coverage / RMS / number of planes at four levels.
 void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount, int scales,
-             const char* sceneName, double noise) {
+             const char* sceneName, double noise, double robustTolerance) {
   ScaleSpaceOptions stack;
   stack.series.count = scales;
+  if (robustTolerance >= 0) stack.robustTolerance = robustTolerance;
   stack.robust = true;  // as `scalespace planes` (Sec. 2.3)
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
@@ -220,11 +225,35 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::size_t points = argc > 1 ? std::size_t(std::atoll(argv[1])) : 100000;
-  const int scales = argc > 2 ? std::atoi(argv[2]) : 50;
+  std::size_t points = 100000;
+  int scales = 50, positional = 0;
+  double robustTolerance = -1, onlyNoise = -1;
+  std::string onlyScene;
+  bool peers = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--scene" && i + 1 < argc) {
+      onlyScene = argv[++i];
+    } else if (a == "--noise" && i + 1 < argc) {
+      onlyNoise = std::atof(argv[++i]);
+    } else if (a == "--robust-tolerance" && i + 1 < argc) {
+      robustTolerance = std::atof(argv[++i]);
+    } else if (a == "--no-peers") {
+      peers = false;
+    } else if (positional == 0 && !a.empty() && a[0] != '-') {
+      points = std::size_t(std::atoll(argv[i])), ++positional;
+    } else if (positional == 1 && !a.empty() && a[0] != '-') {
+      scales = std::atoi(argv[i]), ++positional;
+    } else {
+      std::fprintf(stderr, "bench_planes: unknown argument '%s'\n", argv[i]);
+      return 2;
+    }
+  }
   std::printf("scene,noise,method,recall,precision,coverage,rms,planes,seconds\n");
   for (SceneKind kind : {SceneKind::Tri, SceneKind::Stairs, SceneKind::Cubes}) {
+    if (!onlyScene.empty() && onlyScene != sceneKindName(kind)) continue;
     for (double noise : {1e-5, 5e-5, 10e-5, 25e-5}) {
+      if (onlyNoise >= 0 && std::abs(noise - onlyNoise) > 1e-3 * noise) continue;
       SceneOptions opt;
       opt.pointCount = points;
       opt.noise = noise;
@@ -232,7 +261,7 @@ int main(int argc, char** argv) {
       std::vector<int> gt;
       for (double v : cloud.findAttribute("gt_face")->values) gt.push_back(int(v));
       const int faces = int(sceneFaces(kind, opt).size());
-      for (int method = 0; method < 2; ++method) {
+      for (int method = 0; peers && method < 2; ++method) {
         const Detection d = method == 0 ? runRansac(cloud) : runRegionGrowing(cloud);
         const Scores s = evaluate(d, cloud, gt, faces);
         std::printf("%s,%g,%s,%.3f,%.3f,%.3f,%.2e,%zu,%.2f\n", sceneKindName(kind), noise,
@@ -240,7 +269,7 @@ int main(int argc, char** argv) {
                     s.coverage, s.rms, s.planes, d.seconds);
         std::fflush(stdout);
       }
-      runOurs(cloud, gt, faces, scales, sceneKindName(kind), noise);
+      runOurs(cloud, gt, faces, scales, sceneKindName(kind), noise, robustTolerance);
     }
   }
   return 0;
