@@ -41,12 +41,14 @@ void validate(const PointCloud& cloud, const CurvatureOptions& options) {
                 " estimator needs oriented normals: estimate them first (scalespace normals)");
 }
 
-/// Calls `visit(i, fit)` for every point, i in input order, in parallel. The cloud is traversed in
+/// Calls `visit(k, fit)` for every point, in parallel, k in the processing order that it returns
+/// in `order` (point k is the cloud's point order[k]). The cloud is traversed in
 /// spatial order (core/SpatialOrder) so that consecutive fits touch the same memory: this is
 /// where most of the time goes (neighbour queries and accumulation over ~40 samples).
 void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
                 const ProgressCallback& progress, CurvatureSummary& summary,
-                const std::function<void(std::size_t, const LocalFit&)>& visit) {
+                const std::function<void(std::size_t, const LocalFit&)>& visit,
+                std::vector<Index>& order) {
   validate(cloud, options);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t n = cloud.size();
@@ -54,7 +56,7 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   summary.points = n;
   if (n == 0) return;
 
-  const std::vector<Index> order = spatialOrder(cloud.positions());
+  order = spatialOrder(cloud.positions());
   std::vector<Vec3> positions(n), normals;
   for (std::size_t k = 0; k < n; ++k) positions[k] = cloud.positions()[order[k]];
   if (cloud.hasNormals()) {
@@ -89,7 +91,7 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
       c.neighbors += fit.neighbors;
     else
       ++c.invalid;
-    visit(order[k], fit);
+    visit(k, fit);
   };
   ProgressTracker tracker(progress, "fitting", n);
   // At a fixed scale, consecutive (Morton-ordered) points share most neighbours: fixed groups of
@@ -156,27 +158,41 @@ CurvatureSummary computeCurvatureColumns(PointCloud& cloud, const CurvatureOptio
     col[c] = cloud.findAttribute(names[c])->values.data();
 
   CurvatureSummary summary;
-  forEachFit(cloud, options, progress, summary, [&](std::size_t i, const LocalFit& f) {
-    const double v[] = {f.normal.x(),
-                        f.normal.y(),
-                        f.normal.z(),
-                        f.meanCurvature,
-                        f.kMax,
-                        f.kMin,
-                        f.dirMax.x(),
-                        f.dirMax.y(),
-                        f.dirMax.z(),
-                        f.dirMin.x(),
-                        f.dirMin.y(),
-                        f.dirMin.z(),
-                        f.tau,
-                        f.kappa,
-                        f.fitness,
-                        f.anisotropy,
-                        double(f.neighbors),
-                        f.valid ? 1.0 : 0.0};
-    for (std::size_t c = 0; c < names.size(); ++c) col[c][i] = v[c];
-  });
+  std::vector<Index> order;
+  forEachFit(
+      cloud, options, progress, summary,
+      [&](std::size_t k, const LocalFit& f) {
+        const double v[] = {f.normal.x(),
+                            f.normal.y(),
+                            f.normal.z(),
+                            f.meanCurvature,
+                            f.kMax,
+                            f.kMin,
+                            f.dirMax.x(),
+                            f.dirMax.y(),
+                            f.dirMax.z(),
+                            f.dirMin.x(),
+                            f.dirMin.y(),
+                            f.dirMin.z(),
+                            f.tau,
+                            f.kappa,
+                            f.fitness,
+                            f.anisotropy,
+                            double(f.neighbors),
+                            f.valid ? 1.0 : 0.0};
+        for (std::size_t c = 0; c < names.size(); ++c) col[c][k] = v[c];
+      },
+      order);
+  // The columns were filled in processing order (consecutive fits write consecutive entries:
+  // scattering 18 values per point over the whole cloud cost more than the neighbour queries);
+  // each is put in input order on its own, which keeps the scattered writes in a few MB.
+  std::vector<double> processed(cloud.size());
+  for (double* column : col) {
+    std::copy(column, column + cloud.size(), processed.begin());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cloud.size(), 4096), [&](const auto& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) column[order[k]] = processed[k];
+    });
+  }
   return summary;
 }
 
@@ -184,7 +200,10 @@ std::vector<LocalFit> fitAllPoints(const PointCloud& cloud, const CurvatureOptio
                                    const ProgressCallback& progress, CurvatureSummary* summary) {
   std::vector<LocalFit> fits(cloud.size());
   CurvatureSummary s;
-  forEachFit(cloud, options, progress, s, [&](std::size_t i, const LocalFit& f) { fits[i] = f; });
+  std::vector<Index> order;
+  forEachFit(
+      cloud, options, progress, s, [&](std::size_t k, const LocalFit& f) { fits[order[k]] = f; },
+      order);
   if (summary) *summary = s;
   return fits;
 }
