@@ -98,6 +98,26 @@ TEST(ScaleSpace, IdenticalForOneAndTwoThreads) {
   }
 }
 
+TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
+  const PointCloud cloud = test::noisyPlane(40, 1.0, 0.02, 9);
+  ScaleSpaceOptions o = smallOptions(3);
+  const ScaleStack all = computeScaleSpace(cloud, o);
+  o.layerContents = LayerContents::NormalAndCurvatures;
+  const ScaleStack some = computeScaleSpace(cloud, o);
+  ASSERT_EQ(all.layers.size(), some.layers.size());
+  for (std::size_t j = 0; j < all.layers.size(); ++j) {
+    const ScaleLayer &a = all.layers[j], &b = some.layers[j];
+    EXPECT_EQ(a.normal, b.normal);
+    EXPECT_EQ(a.meanCurvature, b.meanCurvature);
+    EXPECT_EQ(a.kMax, b.kMax);
+    EXPECT_EQ(a.kMin, b.kMin);
+    EXPECT_EQ(a.valid, b.valid);
+    EXPECT_EQ(b.size(), cloud.size());
+    EXPECT_TRUE(b.projection.empty() && b.dirMax.empty() && b.tau.empty() && b.neighbors.empty());
+    EXPECT_EQ(all.summary.stats[j].validPoints, some.summary.stats[j].validPoints);
+  }
+}
+
 TEST(ScaleSpace, SamplesShrinkAndStatsAreFilled) {
   const PointCloud cloud = test::sphereCloud(3000, 1.0);
   const ScaleStack s = computeScaleSpace(cloud, smallOptions(5));

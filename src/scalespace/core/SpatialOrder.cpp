@@ -1,10 +1,11 @@
 #include "scalespace/core/SpatialOrder.hpp"
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <limits>
 #include <string>
+
+#include "scalespace/core/RadixSort.hpp"
 
 namespace scalespace {
 namespace {
@@ -19,14 +20,6 @@ std::uint64_t spreadBits(std::uint64_t v) {
   v = (v | v << 2) & 0x1249249249249249ULL;
   return v;
 }
-
-struct Keyed {
-  std::uint64_t code;
-  Index index;
-  bool operator<(const Keyed& o) const {
-    return code < o.code || (code == o.code && index < o.index);
-  }
-};
 
 }  // namespace
 
@@ -49,7 +42,7 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
   const double extent = (hi - lo).maxCoeff();
   constexpr double kCells = double(1u << 21);
   const double scale = extent > 0.0 ? (kCells - 1.0) / extent : 0.0;
-  std::vector<Keyed> keyed(n);
+  std::vector<KeyedIndex> keyed(n);
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     const Vec3& p = points[i];
     if (!p.allFinite()) {
@@ -60,8 +53,8 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
     keyed[i] = {mortonCode(std::uint32_t(c.x()), std::uint32_t(c.y()), std::uint32_t(c.z())),
                 Index(i)};
   });
-  // (code, index) is a total order, so the parallel sort gives the same result on any schedule.
-  tbb::parallel_sort(keyed.begin(), keyed.end());
+  // Stable by code over increasing indices: ties are broken by index.
+  radixSortStable(keyed);
   std::vector<Index> order(n);
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { order[i] = keyed[i].index; });
   return order;

@@ -1,13 +1,13 @@
 #include "scalespace/planes/RegionGrowing.hpp"
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/RadixSort.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
 
 namespace scalespace {
@@ -23,16 +23,16 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
   const double cosTheta = std::cos(options.maxAngleDegrees * M_PI / 180.0);
 
   // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2, ties by increasing
-  // point index, so the result does not depend on anything else. Sorted as (key, index) pairs:
-  // the key next to its index (no indirection) and both cores at work.
-  std::vector<std::pair<double, Index>> order;
+  // point index, so the result does not depend on anything else: a stable radix sort of the
+  // keys' bits (monotone for doubles >= 0) over increasing indices.
+  std::vector<KeyedIndex> order;
   order.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double c = double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
     if (scale.valid[i] && std::isfinite(c) && scale.normals[i].allFinite())
-      order.emplace_back(c, Index(i));
+      order.push_back({orderedKey(c), Index(i)});
   }
-  tbb::parallel_sort(order.begin(), order.end());
+  radixSortStable(order);
 
   // The walk runs over the graph's vertices: the Morton-ordered copy when there is one (see
   // KnnGraph), so that the per-vertex arrays below are read near where they were last read.
@@ -49,14 +49,16 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
     label[v] = scale.valid[i] ? -1 : -2;
   });
 
-  Segmentation seg;
+  // The walk labels the regions; their point lists are then filled in one pass over the points
+  // in index order, which gives the increasing lists without sorting each region.
   std::vector<Index> frontier;
-  for (const auto& [key, seedPoint] : order) {
-    const Index seed = local ? graph.rank[seedPoint] : seedPoint;
+  std::vector<std::size_t> regionSize;
+  for (const KeyedIndex& item : order) {
+    const Index seed = local ? graph.rank[item.index] : item.index;
     if (label[seed] != -1) continue;
-    const int id = int(seg.regions.size());
+    const int id = int(regionSize.size());
     const Vec3 seedNormal = normal[seed];
-    std::vector<Index> region{seedPoint};
+    std::size_t size = 1;
     label[seed] = id;
     frontier.assign(1, seed);
     while (!frontier.empty()) {
@@ -68,15 +70,19 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
         // Against the seed's normal, not the neighbour's: the region stays planar (Sec. 2.3.1).
         if (!(normal[q].dot(seedNormal) >= cosTheta)) continue;
         label[q] = id;
-        region.push_back(pointOf(q));
+        ++size;
         frontier.push_back(q);
       }
     }
-    std::sort(region.begin(), region.end());
-    seg.regions.push_back(std::move(region));
+    regionSize.push_back(size);
   }
+  Segmentation seg;
   seg.labels.assign(n, -1);
   for (std::size_t v = 0; v < n; ++v) seg.labels[pointOf(Index(v))] = std::max(label[v], -1);
+  seg.regions.resize(regionSize.size());
+  for (std::size_t r = 0; r < regionSize.size(); ++r) seg.regions[r].reserve(regionSize[r]);
+  for (std::size_t i = 0; i < n; ++i)
+    if (seg.labels[i] >= 0) seg.regions[std::size_t(seg.labels[i])].push_back(Index(i));
   return seg;
 }
 

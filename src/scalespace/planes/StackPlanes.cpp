@@ -37,7 +37,9 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
         segmentScale(positions, knn, scaleFeaturesFromLayer(layer, stats.t), options, timings));
   };
   start = std::chrono::steady_clock::now();
-  out.stack = runScaleSpace(cloud, stackOptions, sink, progress);
+  ScaleSpaceOptions stack = stackOptions;
+  stack.layerContents = LayerContents::NormalAndCurvatures;  // what scaleFeaturesFromLayer reads
+  out.stack = runScaleSpace(cloud, stack, sink, progress);
   out.stackSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
       timings.segmentation - timings.filtering;

@@ -68,23 +68,27 @@ void gather(const std::vector<T>& in, const std::vector<Index>& rank, std::size_
 /// input order here, one array at a time: storing each fit straight at its input index scatters
 /// ~200 bytes per point over 14 arrays of the whole cloud, which took a quarter of the
 /// projection time of 1M points x 50 scales (bench/fig_1_10: projection 40.0 s against 29.3 s).
-void toInputOrder(const ScaleLayer& spatial, const std::vector<Index>& rank, ScaleLayer& layer) {
+void toInputOrder(const ScaleLayer& spatial, const std::vector<Index>& rank, LayerContents contents,
+                  ScaleLayer& layer) {
+  const bool all = contents == LayerContents::All;
+  gather(spatial.normal, rank, 3, layer.normal);
+  for (auto [in, out] : {std::pair{&spatial.meanCurvature, &layer.meanCurvature},
+                         {&spatial.kMax, &layer.kMax},
+                         {&spatial.kMin, &layer.kMin}})
+    gather(*in, rank, 1, *out);
+  gather(spatial.valid, rank, 1, layer.valid);
+  if (!all) return;
   for (auto [in, out] : {std::pair{&spatial.projection, &layer.projection},
-                         {&spatial.normal, &layer.normal},
                          {&spatial.dirMax, &layer.dirMax},
                          {&spatial.dirMin, &layer.dirMin}})
     gather(*in, rank, 3, *out);
-  for (auto [in, out] : {std::pair{&spatial.meanCurvature, &layer.meanCurvature},
-                         {&spatial.kMax, &layer.kMax},
-                         {&spatial.kMin, &layer.kMin},
-                         {&spatial.tau, &layer.tau},
+  for (auto [in, out] : {std::pair{&spatial.tau, &layer.tau},
                          {&spatial.kappa, &layer.kappa},
                          {&spatial.fitness, &layer.fitness},
                          {&spatial.anisotropy, &layer.anisotropy},
                          {&spatial.geometricVariation, &layer.geometricVariation}})
     gather(*in, rank, 1, *out);
   gather(spatial.neighbors, rank, 1, layer.neighbors);
-  gather(spatial.valid, rank, 1, layer.valid);
 }
 
 }  // namespace
@@ -163,6 +167,13 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   ScaleLayer spatial, layer;  // this scale in processing order, and in input order
   spatial.resize(n);
   layer.resize(n);
+  if (options.layerContents == LayerContents::NormalAndCurvatures) {
+    for (auto* v : {&layer.projection, &layer.dirMax, &layer.dirMin}) *v = {};
+    for (auto* v :
+         {&layer.tau, &layer.kappa, &layer.fitness, &layer.anisotropy, &layer.geometricVariation})
+      *v = {};
+    layer.neighbors = {};
+  }
   tbb::enumerable_thread_specific<FitWorkspace> workspaces;
   std::vector<std::uint32_t> neighborCount(n);
   std::vector<std::uint8_t> mlsSteps(n);
@@ -226,7 +237,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                           tracker.advance(projectGroup(g, ws));
                       });
     tracker.finish();
-    toInputOrder(spatial, rank, layer);
+    toInputOrder(spatial, rank, options.layerContents, layer);
     stats.projectionSeconds = secondsSince(t0);
     double sum = 0, steps = 0;
     for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k], steps += mlsSteps[k];

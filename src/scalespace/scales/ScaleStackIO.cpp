@@ -554,6 +554,13 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
   if (layer.size() != d.n)
     throw Error("ScaleStackWriter: layer has " + std::to_string(layer.size()) +
                 " points, expected " + std::to_string(d.n));
+  for (const auto* v : {&layer.projection, &layer.normal, &layer.dirMax, &layer.dirMin})
+    if (v->size() != 3 * d.n)
+      throw Error("ScaleStackWriter: the layer lacks arrays (computed with LayerContents::All?)");
+  for (const auto* v : {&layer.meanCurvature, &layer.kMax, &layer.kMin, &layer.tau, &layer.kappa,
+                        &layer.fitness, &layer.anisotropy, &layer.geometricVariation})
+    if (v->size() != d.n || layer.neighbors.size() != d.n)
+      throw Error("ScaleStackWriter: the layer lacks arrays (computed with LayerContents::All?)");
   if (!(t > 0) || !std::isfinite(t))
     throw Error("ScaleStackWriter: scale " + std::to_string(j) + " has t = " + std::to_string(t));
   const bool compact = d.encoding == StackEncoding::Compact;
@@ -687,8 +694,10 @@ ScaleSpaceSummary computeScaleStack(const PointCloud& cloud, const ScaleSpaceOpt
                                     const std::string& path, const ProgressCallback& progress,
                                     const StackWriteOptions& write) {
   std::unique_ptr<ScaleStackWriter> writer;
+  ScaleSpaceOptions all = options;
+  all.layerContents = LayerContents::All;  // the stack stores every quantity
   ScaleSpaceSummary summary = runScaleSpace(
-      cloud, options,
+      cloud, all,
       [&](std::size_t j, const ScaleLayer& layer, const ScaleStats& stats) {
         // The series is known only once runScaleSpace resolved t_min; M is the option count.
         if (!writer)
