@@ -191,13 +191,12 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
   const auto& t = result.detection.timings;
   std::printf("%s,%g,ours_persistence,%.3f,%.3f,,,%zu,%.2f\n", sceneName, noise,
               double(found) / faceCount, persistent ? double(matched) / double(persistent) : 0.0,
-              persistent,
-              result.stackSeconds + result.knnSeconds + t.segmentation + t.filtering + t.graph +
-                  t.components);
+              persistent, result.totalSeconds);
   std::printf(
-      "#   time split (s): stack %.2f, knn %.2f, segmentation %.2f, filtering %.2f, "
+      "#   time split (s): stack %.2f, knn %.2f, segmentation %.2f, filtering %.2f%s, "
       "graph %.3f, components %.2f\n",
-      result.stackSeconds, result.knnSeconds, t.segmentation, t.filtering, t.graph, t.components);
+      result.stackSeconds, result.knnSeconds, t.segmentation, t.filtering,
+      result.overlapped ? " (overlapping the stack)" : "", t.graph, t.components);
   for (int q = 1; q <= 4; ++q) {
     const int level = q * model.scaleCount() / 5;
     std::map<int, std::vector<Index>> planes;
