@@ -10,8 +10,8 @@
 //
 // Results must not depend on timing: jobs write to their own slots. Submitting blocks while
 // `capacity` jobs are waiting (this bounds the memory the jobs hold). If a job throws, the later
-// jobs are skipped and every later submit() and finish() rethrows its exception. The destructor drops waiting jobs
-// and joins (when the caller unwinds from an exception or a cancellation).
+// jobs are skipped and every later submit() and finish() rethrows its exception. The destructor
+// drops waiting jobs and joins (when the caller unwinds from an exception or a cancellation).
 #include <condition_variable>
 #include <cstddef>
 #include <deque>

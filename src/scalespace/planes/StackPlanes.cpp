@@ -54,7 +54,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
     } else {
       const auto jobStart = std::chrono::steady_clock::now();
       job();
-      inlineSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - jobStart).count();
+      inlineSeconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - jobStart).count();
     }
   };
   start = std::chrono::steady_clock::now();
@@ -63,7 +64,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   out.stack = runScaleSpace(cloud, stack, sink, progress);
   if (worker) worker->finish();
   out.stackSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - inlineSeconds;
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
+      inlineSeconds;
   out.detection = buildPlaneDetection(positions, std::move(levels), options, timings, progress);
   out.totalSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
