@@ -310,10 +310,9 @@ void addPlanesCommand(CLI::App& app) {
     if (!args->quiet) {
       const auto& t = result.detection.timings;
       std::fprintf(stderr,
-                   "%zu components; time (s): stack %.2f, segmentation %.2f, filtering %.2f%s, "
+                   "%zu components; time (s): stack %.2f, segmentation %.2f, filtering %.2f, "
                    "graph %.2f, components %.2f\n",
                    model.components.size(), result.stackSeconds, t.segmentation, t.filtering,
-                   result.overlapped ? " (both during the stack, on a background thread)" : "",
                    t.graph, t.components);
     }
     reportDone("planes", start, args->quiet);

@@ -1,12 +1,8 @@
 #include "scalespace/planes/StackPlanes.hpp"
 
 #include <chrono>
-#include <memory>
-#include <optional>
 
 #include "scalespace/core/Error.hpp"
-#include "scalespace/core/Parallel.hpp"
-#include "scalespace/core/SerialWorker.hpp"
 
 namespace scalespace {
 
@@ -37,35 +33,17 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   out.knnSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   PlaneDetectionTimings timings;
   std::vector<RegionLevel> levels;
-  // Region growing is sequential: with two or more threads each scale is segmented on a
-  // background thread while the next scales are projected (in order, at most two scales
-  // waiting), which fills the core that it would leave idle. The levels do not depend on it.
-  std::optional<SerialWorker> worker;
-  if (ThreadLimit::active() > 1) worker.emplace(2);
-  out.overlapped = worker.has_value();
-  double inlineSeconds = 0;  // segmentation time spent inside the stack's wall time (no worker)
   const ScaleSink sink = [&](std::size_t, const ScaleLayer& layer, const ScaleStats& stats) {
-    auto features = std::make_shared<const ScaleFeatures>(scaleFeaturesFromLayer(layer, stats.t));
-    auto job = [&, features] {
-      levels.push_back(segmentScale(positions, knn, *features, options, timings));
-    };
-    if (worker) {
-      worker->submit(job);
-    } else {
-      const auto jobStart = std::chrono::steady_clock::now();
-      job();
-      inlineSeconds +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - jobStart).count();
-    }
+    levels.push_back(
+        segmentScale(positions, knn, scaleFeaturesFromLayer(layer, stats.t), options, timings));
   };
   start = std::chrono::steady_clock::now();
   ScaleSpaceOptions stack = stackOptions;
   stack.layerContents = LayerContents::NormalAndCurvatures;  // what scaleFeaturesFromLayer reads
   out.stack = runScaleSpace(cloud, stack, sink, progress);
-  if (worker) worker->finish();
   out.stackSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
-      inlineSeconds;
+      timings.segmentation - timings.filtering;
   out.detection = buildPlaneDetection(positions, std::move(levels), options, timings, progress);
   out.totalSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();

@@ -15,12 +15,9 @@ ScaleFeatures scaleFeaturesFromLayer(const ScaleLayer& layer, double t);
 struct StackPlaneDetection {
   PlaneDetection detection;
   ScaleSpaceSummary stack;  // scales, per-scale statistics and time
-  /// Table 2.1 "Surf. Recon.": the stack's wall time. When `overlapped`, each scale's
-  /// segmentation and filtering (timed on their own in detection.timings) ran on a background
-  /// thread during the next scales' projection, so the times add up to more than the wall time.
-  double stackSeconds = 0;
+  double stackSeconds = 0;  // Table 2.1 "Surf. Recon." (includes the per-scale segmentation
+                            // hand-off, which is timed separately in detection.timings)
   double knnSeconds = 0;
-  bool overlapped = false;
   double totalSeconds = 0;  // wall time of the whole detection
 };
 
