@@ -20,6 +20,7 @@ inline Jet1 operator*(double s, const Jet1& a) { return {s * a.v, s * a.g}; }
 inline Jet1 operator*(const Jet1& a, const Jet1& b) { return {a.v * b.v, a.v * b.g + b.v * a.g}; }
 inline Jet1 inverse(const Jet1& b) { return {1 / b.v, -b.g / (b.v * b.v)}; }
 inline Jet1 operator/(const Jet1& a, const Jet1& b) { return a * inverse(b); }
+inline const Jet1& firstOrder(const Jet1& a) { return a; }
 
 /// Value, gradient and Hessian. The Hessian is symmetric: only its 6 distinct entries are stored
 /// (xx, yy, zz, xy, xz, yz), which saves a third of the Hessian arithmetic of the W3 solve (about
@@ -68,6 +69,9 @@ inline Jet2 inverse(const Jet2& b) {
   return r;
 }
 inline Jet2 operator/(const Jet2& a, const Jet2& b) { return a * inverse(b); }
+/// The value and gradient of a Jet2 (what a quantity needs when only its first derivatives are
+/// used further).
+inline Jet1 firstOrder(const Jet2& a) { return {a.v, a.g}; }
 
 struct Dual {
   double v = 0;

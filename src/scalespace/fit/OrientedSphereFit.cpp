@@ -8,10 +8,25 @@
 namespace scalespace {
 namespace {
 
+// u_l is only ever differentiated once (W3's Hessian, Eq. 1.36, needs its Jacobian), so for a
+// Jet2 it is carried as a Jet1; every other type keeps its own.
+template <class S>
+struct LowerOrder {
+  using type = S;
+};
+template <>
+struct LowerOrder<Jet2> {
+  using type = Jet1;
+};
+template <class S>
+const S& firstOrder(const S& s) {
+  return s;
+}
+
 template <class S>
 struct SphereTerms {
   S uc, uq;
-  S ul[3];
+  typename LowerOrder<S>::type ul[3];
   bool ok = false;
 };
 
@@ -34,15 +49,21 @@ SphereTerms<S> solveSphere(const S* item, double degenerate) {
   const S* sn = item + 4;
   const S& spn = item[7];
   const S& spp = item[8];
-  const S num = s0 * spn - (sp[0] * sn[0] + sp[1] * sn[1] + sp[2] * sn[2]);  // Eq. 1.7 numerator
-  const S den = s0 * spp - (sp[0] * sp[0] + sp[1] * sp[1] + sp[2] * sp[2]);
+  const S pn = sp[0] * sn[0] + sp[1] * sn[1] + sp[2] * sn[2];
+  const S pp = sp[0] * sp[0] + sp[1] * sp[1] + sp[2] * sp[2];
+  const S num = s0 * spn - pn;  // Eq. 1.7 numerator
+  const S den = s0 * spp - pp;
   if (!(valueOf(den) > degenerate)) return r;  // all samples (numerically) at one position
   r.uq = 0.5 * (num / den);                    // Eq. 1.7
-  // One reciprocal of s0 shared by the four divisions (a Jet2 reciprocal is ~30 flops).
   const S invS0 = inverse(s0);
-  for (int k = 0; k < 3; ++k) r.ul[k] = (sn[k] - 2.0 * (r.uq * sp[k])) * invS0;  // Eq. 1.8
-  const S dot = r.ul[0] * sp[0] + r.ul[1] * sp[1] + r.ul[2] * sp[2];
-  r.uc = -1.0 * ((dot + r.uq * spp) * invS0);  // Eq. 1.9
+  // Eq. 1.9 with u_l of Eq. 1.8 substituted: u_c = -(u_l.sp + u_q spp) / s0
+  // = -(sp.sn + u_q (den - |sp|^2)) / s0^2, from sums already formed, so that u_l itself needs
+  // no Hessian (for W3 that saves 9 of the solve's 23 Jet2 products).
+  r.uc = -1.0 * ((pn + r.uq * (den - pp)) * (invS0 * invS0));
+  using L = typename LowerOrder<S>::type;
+  const L uq = firstOrder(r.uq), inv = firstOrder(invS0);
+  for (int k = 0; k < 3; ++k)
+    r.ul[k] = (firstOrder(sn[k]) - 2.0 * (uq * firstOrder(sp[k]))) * inv;  // Eq. 1.8
   r.ok = true;
   return r;
 }
