@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
@@ -133,6 +134,7 @@ Run runFits(Surface& s, EstimatorKind kind, double t, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t n = 1000000, peerPoints = 20000;
   bool onlyW3 = false, sweep = true;
   for (int i = 1; i < argc; ++i) {

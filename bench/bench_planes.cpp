@@ -25,6 +25,7 @@
 #include <tuple>
 #include <vector>
 
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
@@ -223,6 +224,7 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
 }  // namespace
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 100000;
   int scales = 50, positional = 0;
   double robustTolerance = -1, onlyNoise = -1;

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "scalespace/core/KdTreeIndex.hpp"
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/Parallel.hpp"
@@ -245,6 +246,7 @@ void benchSurface(const std::string& name, const std::vector<Vec3>& input, std::
 }  // namespace
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 1000000, queries = 0;
   bool normals = true;
   for (int i = 1; i < argc; ++i) {

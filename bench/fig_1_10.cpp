@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
 #include "scalespace/scales/ScaleStackIO.hpp"
@@ -290,6 +291,7 @@ void fig10Bench(const PointCloud& cloud, ScaleSpaceOptions options, const fs::pa
 }  // namespace
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t n = 1000000, fig10Points = 100000;
   int scales = 50, threads = 0, mlsSteps = -1;
   std::string mode = "all", out = ".";

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "scalespace/core/AnalyticSurface.hpp"
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/fit/LocalFit.hpp"
 
@@ -136,6 +137,7 @@ void speed() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 800000;
   bool runSpeed = true, runTable = true;
   for (int i = 1; i < argc; ++i) {

@@ -6,8 +6,10 @@
 
 #include "scalespace/cli/CloudCommands.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/MemoryReuse.hpp"
 
 int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // per-scale arrays reuse memory (core/MemoryReuse.hpp)
   CLI::App app{"scalespace " SCALESPACE_VERSION
                ": multi-scale analysis of 3D point clouds (normals, curvatures, scale spaces)"};
   app.require_subcommand(1);
