@@ -21,16 +21,6 @@ PointCloud cloudOf(const TestCloud& c) {
   return cloud;
 }
 
-void expectSameFit(const LocalFit& a, const LocalFit& b) {
-  ASSERT_EQ(a.valid, b.valid);
-  EXPECT_EQ(a.neighbors, b.neighbors);
-  EXPECT_EQ(a.mlsSteps, b.mlsSteps);
-  EXPECT_LT((a.projection - b.projection).norm(), 1e-12);
-  EXPECT_LT((a.normal - b.normal).norm(), 1e-10);
-  EXPECT_NEAR(a.kMax, b.kMax, 1e-8 * (1 + std::abs(a.kMax)));
-  EXPECT_NEAR(a.kMin, b.kMin, 1e-8 * (1 + std::abs(a.kMin)));
-}
-
 }  // namespace
 
 TEST(CurvatureEstimation, EveryPointGetsTheFitOfItsOwnQuery) {

@@ -1,5 +1,8 @@
 #pragma once
 // Sampled analytic surfaces with an index, shared by the fit tests.
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -35,6 +38,19 @@ inline LocalFit fitWith(const TestCloud& c, const Vec3& x, double t, EstimatorKi
   o.robust = robust;
   FitWorkspace ws;
   return fitAt(x, t, c.samples(), o, ws);
+}
+
+/// The same neighbours summed in another order (prefetched blocks, other drivers): equal fits up
+/// to rounding.
+inline void expectSameFit(const LocalFit& a, const LocalFit& b) {
+  ASSERT_EQ(a.valid, b.valid);
+  EXPECT_EQ(a.neighbors, b.neighbors);
+  EXPECT_EQ(a.mlsSteps, b.mlsSteps);
+  EXPECT_LT((a.projection - b.projection).norm(), 1e-12);
+  EXPECT_LT((a.normal - b.normal).norm(), 1e-10);
+  EXPECT_NEAR(a.kMax, b.kMax, 1e-8 * (1 + std::abs(a.kMax)));
+  EXPECT_NEAR(a.kMin, b.kMin, 1e-8 * (1 + std::abs(a.kMin)));
+  EXPECT_NEAR(a.geometricVariation, b.geometricVariation, 1e-8);
 }
 
 }  // namespace scalespace::test

@@ -10,22 +10,6 @@
 using namespace scalespace;
 using namespace scalespace::test;
 
-namespace {
-
-// Same neighbours, summed in another order: equal up to rounding.
-void expectSameFit(const LocalFit& a, const LocalFit& b) {
-  ASSERT_EQ(a.valid, b.valid);
-  EXPECT_EQ(a.neighbors, b.neighbors);
-  EXPECT_EQ(a.mlsSteps, b.mlsSteps);
-  EXPECT_LT((a.projection - b.projection).norm(), 1e-12);
-  EXPECT_LT((a.normal - b.normal).norm(), 1e-10);
-  EXPECT_NEAR(a.kMax, b.kMax, 1e-8 * (1 + std::abs(a.kMax)));
-  EXPECT_NEAR(a.kMin, b.kMin, 1e-8 * (1 + std::abs(a.kMin)));
-  EXPECT_NEAR(a.geometricVariation, b.geometricVariation, 1e-8);
-}
-
-}  // namespace
-
 TEST(NeighborhoodCache, CachedFitsEqualIndexedFitsForPlainAndRobustMls) {
   const auto cloud = sampleCloud(SurfaceShape::Saddle, Vec3::Zero(), 1.0, 4000, 7);
   const SurfaceSamples samples = cloud->samples();
