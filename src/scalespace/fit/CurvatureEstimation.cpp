@@ -17,9 +17,6 @@
 namespace scalespace {
 namespace {
 
-constexpr std::size_t kGroup = 64;  // points per run of blocks (see forEachFit)
-constexpr double kMlsSlack = 0.1;  // MLS steps may leave the block by 0.1 t (fit/NeighborhoodCache)
-
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -94,26 +91,23 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
     visit(k, fit);
   };
   ProgressTracker tracker(progress, "fitting", n);
-  // At a fixed scale, consecutive (Morton-ordered) points share most neighbours: fixed groups of
-  // kGroup points are cut into blocks whose fits read one prefetched ball (fit/NeighborhoodCache).
-  // The groups do not depend on the thread count, so neither does the order of any sum.
-  const bool prefetch = options.scaleK == 0;
+  // At a fixed scale, consecutive (Morton-ordered) points share most neighbours: their fits read
+  // one prefetched ball per block (fit/NeighborhoodCache). Per-point scales (scaleK) query alone.
   const double slack = options.fit.mls ? kMlsSlack : 0.0;
-  const std::size_t groups = (n + kGroup - 1) / kGroup;
+  const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4), [&](const auto& range) {
     Counters& c = counters.local();
-    const std::size_t first = range.begin() * kGroup, last = std::min(n, range.end() * kGroup);
     for (std::size_t g = range.begin(); g != range.end(); ++g) {
-      const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
-      for (std::size_t k = g * kGroup; k < groupEnd;) {
-        const std::size_t blockEnd = prefetch
-                                         ? prefetchBlock(positions, k, groupEnd, samples,
-                                                         options.scale, slack, c.workspace.cache)
-                                         : k + 1;
-        for (; k < blockEnd; ++k) fitOne(k, c);
+      auto fit = [&](std::size_t k) { fitOne(k, c); };
+      if (options.scaleK == 0) {
+        tracker.advance(
+            fitGroupByBlocks(positions, g, samples, options.scale, slack, c.workspace.cache, fit));
+      } else {
+        const std::size_t end = std::min(n, (g + 1) * kPrefetchGroup);
+        for (std::size_t k = g * kPrefetchGroup; k < end; ++k) fit(k);
+        tracker.advance(end - g * kPrefetchGroup);
       }
     }
-    tracker.advance(last - first);
   });
   tracker.finish();
   summary.fitSeconds = secondsSince(fitStart);

@@ -9,6 +9,7 @@
 // (every sample within t of y is then within R of c, by the triangle inequality). The fit keeps
 // exactly the samples with |p - y|^2 < t^2, the index's contract, so the result is the same up to
 // the order in which the neighbours are summed.
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -54,15 +55,35 @@ class NeighborhoodCache {
 /// 9.5 / 9.1 / 8.9 / 9.05 s of projection against 10.0-10.9 s without the cache.
 constexpr double kBlockSpread = 0.5;
 
+/// Evaluation points are walked in fixed groups of kPrefetchGroup consecutive (Morton-ordered)
+/// points, each cut into blocks: the groups, hence the blocks and the order in which neighbours
+/// are summed, do not depend on the thread count.
+constexpr std::size_t kPrefetchGroup = 64;
+/// How far (a fraction of t) MLS steps may move a point out of its block and still read the
+/// prefetched samples.
+constexpr double kMlsSlack = 0.1;
+
 /// Forms the block of evaluation points points[k..end) that starts at k, ends at most at
 /// `last` and spans at most kBlockSpread t, and prefetches the samples that the radius-t fits of
 /// the whole block need: a ball of radius t (1 + slack) + half-diagonal around the block's
-/// centre. `slack` (a fraction of t) is how far MLS steps may move a point out of the block and
-/// still read the cache. A single-point block empties the cache instead (a plain query is
-/// cheaper). Returns end. Callers cut their points into fixed runs (`last`) so that the blocks,
-/// and hence the order in which neighbours are summed, do not depend on the thread count.
+/// centre. A single-point block empties the cache instead (a plain query is cheaper). Returns end.
 std::size_t prefetchBlock(const std::vector<Vec3>& points, std::size_t k, std::size_t last,
                           const SurfaceSamples& samples, double t, double slack,
                           NeighborhoodCache& cache);
+
+/// Calls fit(k) for every point of group g (points [g kPrefetchGroup, ...)), block by block, each
+/// block's samples prefetched into `cache` first. Returns the number of points of the group.
+template <class Fit>
+std::size_t fitGroupByBlocks(const std::vector<Vec3>& points, std::size_t g,
+                             const SurfaceSamples& samples, double t, double slack,
+                             NeighborhoodCache& cache, Fit&& fit) {
+  const std::size_t begin = g * kPrefetchGroup;
+  const std::size_t end = std::min(points.size(), begin + kPrefetchGroup);
+  for (std::size_t k = begin; k < end;) {
+    const std::size_t blockEnd = prefetchBlock(points, k, end, samples, t, slack, cache);
+    for (; k < blockEnd; ++k) fit(k);
+  }
+  return end - begin;
+}
 
 }  // namespace scalespace

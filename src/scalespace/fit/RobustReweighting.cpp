@@ -33,7 +33,7 @@ inline void addSample(SphereSums& out, const NeighborColumns& c, std::size_t k, 
   out.used += w > 0 ? 1 : 0;
 }
 
-/// The factor of neighbour k (scalar; also the tail of the vector loop).
+/// The factor of neighbour k (the portable pass).
 inline double factorOf(const AlgebraicSphere& s, double invSr2, double invSn2,
                        const NeighborColumns& c, std::size_t k) {
   const Vec3 q(c.qx[k], c.qy[k], c.qz[k]);
@@ -47,9 +47,9 @@ inline double factorOf(const AlgebraicSphere& s, double invSr2, double invSn2,
 
 double reweightPortable(const AlgebraicSphere& s, double invSr2, double invSn2,
                         const NeighborColumns& c, const std::vector<double>& previous,
-                        std::size_t from, std::vector<double>& rho, SphereSums& next) {
+                        std::vector<double>& rho, SphereSums& next) {
   double change = 0;
-  for (std::size_t k = from; k < c.size(); ++k) {
+  for (std::size_t k = 0; k < c.size(); ++k) {
     rho[k] = factorOf(s, invSr2, invSn2, c, k);
     change = std::max(change, std::abs(rho[k] - previous[k]));
     addSample(next, c, k, c.weight[k] * rho[k]);
@@ -167,7 +167,7 @@ double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
   if (useAvx2Fma(kernel)) return reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
 #endif
   (void)kernel;
-  return reweightPortable(sphere, invSr2, invSn2, c, previous, 0, rho, next);
+  return reweightPortable(sphere, invSr2, invSn2, c, previous, rho, next);
 }
 
 }  // namespace scalespace

@@ -47,12 +47,6 @@ void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, ScaleLa
   layer.geometricVariation[i] = float(f.geometricVariation);
 }
 
-// Neighbour-query reuse (fit/NeighborhoodCache): Morton-ordered points are cut into groups of
-// kGroup, each group into blocks (prefetchBlock) whose radius-t queries of all MLS steps are
-// answered by one index query, unless a step moves a point more than kMlsSlack t out of the block.
-constexpr std::size_t kGroup = 64;
-constexpr double kMlsSlack = 0.1;
-
 /// out[i] = in[rank[i]] for every array of the layer, items of `width` values (3 for vectors).
 template <typename T>
 void gather(const std::vector<T>& in, const std::vector<Index>& rank, std::size_t width,
@@ -66,8 +60,8 @@ void gather(const std::vector<T>& in, const std::vector<Index>& rank, std::size_
 /// The layer in input order from the layer in processing (Morton) order: point i of the cloud is
 /// point rank[i] of the processing order. The fits are recorded in processing order and put in
 /// input order here, one array at a time: storing each fit straight at its input index scatters
-/// ~200 bytes per point over 14 arrays of the whole cloud, which took a quarter of the
-/// projection time of 1M points x 50 scales (bench/fig_1_10: projection 40.0 s against 29.3 s).
+/// ~200 bytes per point over 14 arrays of the whole cloud: the projection of 1M points x 50
+/// scales (bench/fig_1_10) took 40.0 s that way and 31.9 s with this gather.
 void toInputOrder(const ScaleLayer& spatial, const std::vector<Index>& rank, LayerContents contents,
                   ScaleLayer& layer) {
   const bool all = contents == LayerContents::All;
@@ -100,6 +94,16 @@ void ScaleLayer::resize(std::size_t n) {
     v->assign(n, 0.0f);
   neighbors.assign(n, 0);
   valid.assign(n, 0);
+}
+
+bool ScaleLayer::complete() const {
+  const std::size_t n = size();
+  for (const auto* v : {&projection, &normal, &dirMax, &dirMin})
+    if (v->size() != 3 * n) return false;
+  for (const auto* v :
+       {&meanCurvature, &kMax, &kMin, &tau, &kappa, &fitness, &anisotropy, &geometricVariation})
+    if (v->size() != n) return false;
+  return neighbors.size() == n;
 }
 
 std::uint64_t cloudChecksum(const PointCloud& cloud) {
@@ -210,26 +214,21 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
         })
                  : ProgressCallback();
     ProgressTracker tracker(scaleProgress, "projection", n);
-    // Groups of kGroup consecutive (Morton-ordered) points, split into blocks independently of
-    // the thread count, so that every point sees the same neighbour order for any --threads.
+    // Neighbour-query reuse (fit/NeighborhoodCache): the radius-t queries of all MLS steps of a
+    // block of Morton-ordered points are answered by one index query, unless a step moves a
+    // point more than kMlsSlack t out of the block.
     auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
-      const std::size_t groupEnd = std::min(n, (g + 1) * kGroup);
-      for (std::size_t k = g * kGroup; k < groupEnd;) {
-        const std::size_t blockEnd =
-            prefetchBlock(current, k, groupEnd, samples, t, kMlsSlack, ws.cache);
-        for (; k < blockEnd; ++k) {
-          FitOptions pointFit = fit;
-          pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
-          const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
-          neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
-          mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
-          if (f.valid) current[k] = f.projection;  // else keep the last one
-          recordFit(f, current[k], k, spatial);
-        }
-      }
-      return groupEnd - g * kGroup;
+      FitOptions pointFit = fit;
+      return fitGroupByBlocks(current, g, samples, t, kMlsSlack, ws.cache, [&](std::size_t k) {
+        pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
+        const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
+        neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
+        mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
+        if (f.valid) current[k] = f.projection;  // else keep the last one
+        recordFit(f, current[k], k, spatial);
+      });
     };
-    const std::size_t groups = (n + kGroup - 1) / kGroup;
+    const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 8),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         FitWorkspace& ws = workspaces.local();

@@ -66,6 +66,8 @@ struct ScaleLayer {
   std::vector<std::uint8_t> valid;                                         // N, 1 = valid fit
   void resize(std::size_t n);
   std::size_t size() const { return valid.size(); }
+  /// Every array holds size() entries (LayerContents::All).
+  bool complete() const;
 };
 
 /// Receives each scale as soon as it is computed (j = 0..M-1), e.g. to stream it to disk.

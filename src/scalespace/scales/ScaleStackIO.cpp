@@ -554,13 +554,8 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
   if (layer.size() != d.n)
     throw Error("ScaleStackWriter: layer has " + std::to_string(layer.size()) +
                 " points, expected " + std::to_string(d.n));
-  for (const auto* v : {&layer.projection, &layer.normal, &layer.dirMax, &layer.dirMin})
-    if (v->size() != 3 * d.n)
-      throw Error("ScaleStackWriter: the layer lacks arrays (computed with LayerContents::All?)");
-  for (const auto* v : {&layer.meanCurvature, &layer.kMax, &layer.kMin, &layer.tau, &layer.kappa,
-                        &layer.fitness, &layer.anisotropy, &layer.geometricVariation})
-    if (v->size() != d.n || layer.neighbors.size() != d.n)
-      throw Error("ScaleStackWriter: the layer lacks arrays (computed with LayerContents::All?)");
+  if (!layer.complete())
+    throw Error("ScaleStackWriter: the layer lacks arrays (computed with LayerContents::All?)");
   if (!(t > 0) || !std::isfinite(t))
     throw Error("ScaleStackWriter: scale " + std::to_string(j) + " has t = " + std::to_string(t));
   const bool compact = d.encoding == StackEncoding::Compact;
