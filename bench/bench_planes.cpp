@@ -9,8 +9,10 @@
 // normals of the scene; ours uses them only as the stack's input normals.
 // Usage: bench_planes [points per scene, default 100000] [scales M, default 50]
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
-// --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines, and
-// --robust-tolerance sets the stack's ScaleSpaceOptions::robustTolerance (default: the library's).
+//                     [--robust-iterations N]
+// --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
+// --robust-tolerance / --robust-iterations set the stack's ScaleSpaceOptions::robustTolerance /
+// robustIterations (default: the library's; 0 iterations = the plain APSS stack).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
@@ -156,11 +158,12 @@ Detection runRegionGrowing(const PointCloud& cloud) {
 // Our pipeline: recall over all levels, precision among persistent components, and per-level
 // coverage / RMS / number of planes at four levels.
 void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount, int scales,
-             const char* sceneName, double noise, double robustTolerance) {
+             const char* sceneName, double noise, double robustTolerance, int robustIterations) {
   ScaleSpaceOptions stack;
   stack.series.count = scales;
   if (robustTolerance >= 0) stack.robustTolerance = robustTolerance;
-  stack.robust = true;  // as `scalespace planes` (Sec. 2.3)
+  stack.robust = robustIterations != 0;  // as `scalespace planes` (Sec. 2.3)
+  if (robustIterations > 0) stack.robustIterations = robustIterations;
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
   std::vector<std::size_t> faceSize(std::size_t(faceCount), 0);
@@ -228,6 +231,7 @@ int main(int argc, char** argv) {
   std::size_t points = 100000;
   int scales = 50, positional = 0;
   double robustTolerance = -1, onlyNoise = -1;
+  int robustIterations = -1;
   std::string onlyScene;
   bool peers = true;
   for (int i = 1; i < argc; ++i) {
@@ -238,6 +242,8 @@ int main(int argc, char** argv) {
       onlyNoise = std::atof(argv[++i]);
     } else if (a == "--robust-tolerance" && i + 1 < argc) {
       robustTolerance = std::atof(argv[++i]);
+    } else if (a == "--robust-iterations" && i + 1 < argc) {
+      robustIterations = std::atoi(argv[++i]);
     } else if (a == "--no-peers") {
       peers = false;
     } else if (positional == 0 && !a.empty() && a[0] != '-') {
@@ -269,7 +275,8 @@ int main(int argc, char** argv) {
                     s.coverage, s.rms, s.planes, d.seconds);
         std::fflush(stdout);
       }
-      runOurs(cloud, gt, faces, scales, sceneKindName(kind), noise, robustTolerance);
+      runOurs(cloud, gt, faces, scales, sceneKindName(kind), noise, robustTolerance,
+              robustIterations);
     }
   }
   return 0;

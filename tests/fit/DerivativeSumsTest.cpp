@@ -53,13 +53,20 @@ TEST(DerivativeSums, Avx2KernelMatchesReference) {
   if (!avx2FmaAvailable()) GTEST_SKIP() << "no AVX2 + FMA on this CPU: portable kernel ran";
 }
 
-TEST(DerivativeSums, AutoIsOneOfTheTwoBitForBit) {
+TEST(DerivativeSums, Avx512KernelMatchesReference) {
+  expectMatchesReference(SimdKernel::Avx512);
+  if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: another kernel ran";
+}
+
+TEST(DerivativeSums, AutoIsTheWidestAvailableBitForBit) {
   DerivativeChunk c;
   fillRandom(c, 5);
   DerivativeSums a = {}, b = {};
   accumulateDerivativeSums(c, 29, a, SimdKernel::Auto);
   accumulateDerivativeSums(c, 29, b,
-                           avx2FmaAvailable() ? SimdKernel::Avx2Fma : SimdKernel::Portable);
+                           avx512Available()    ? SimdKernel::Avx512
+                           : avx2FmaAvailable() ? SimdKernel::Avx2Fma
+                                                : SimdKernel::Portable);
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 12; ++j) EXPECT_EQ(a[i][j], b[i][j]);
 }

@@ -81,9 +81,20 @@ TEST(RobustReweighting, PortableMatchesTheFormula) { checkAgainstDirect(SimdKern
 
 TEST(RobustReweighting, DefaultPathMatchesTheFormula) { checkAgainstDirect(SimdKernel::Auto); }
 
+TEST(RobustReweighting, Avx2PathMatchesTheFormula) {
+  checkAgainstDirect(SimdKernel::Avx2Fma);
+  if (!avx2FmaAvailable()) GTEST_SKIP() << "no AVX2 + FMA on this CPU: portable kernel ran";
+}
+
+TEST(RobustReweighting, Avx512PathMatchesTheFormula) {
+  checkAgainstDirect(SimdKernel::Avx512);
+  if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: another kernel ran";
+}
+
 // A vanishing gradient gives rho = 0 (never NaN); far samples get an exactly zero factor.
 TEST(RobustReweighting, DegenerateSphereAndFarSamplesGiveZeroFactors) {
-  for (SimdKernel kernel : {SimdKernel::Portable, SimdKernel::Auto}) {
+  for (SimdKernel kernel :
+       {SimdKernel::Portable, SimdKernel::Avx2Fma, SimdKernel::Avx512, SimdKernel::Auto}) {
     NeighborColumns c;
     for (int k = 0; k < 9; ++k) c.push(Vec3(0.1 * k, 0, 0), Vec3(0, 0, 1), 0.5);
     AlgebraicSphere flat;  // all zero: gradient 0 everywhere

@@ -1,6 +1,12 @@
 #include "scalespace/fit/DerivativeSums.hpp"
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
+// GCC 12's AVX-512 intrinsics trip -Wuninitialized inside the header (GCC bug 105593; see
+// fit/RobustReweighting.cpp).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <immintrin.h>
 #endif
 
@@ -33,6 +39,30 @@ __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c
     }
   }
 }
+
+// The same block with 8 + 4 columns per pass over the samples instead of 4 + 4 + 4: 18
+// fused multiply-adds per sample instead of 27, all accumulators in the 32 registers.
+__attribute__((target("avx512f,avx512dq,avx512vl,fma"))) void accumulateAvx512(
+    const DerivativeChunk& c, int m, DerivativeSums& sums) {
+  __m512d lo[9];
+  __m256d hi[9];
+  for (int i = 0; i < 9; ++i) lo[i] = _mm512_setzero_pd(), hi[i] = _mm256_setzero_pd();
+  for (int k = 0; k < m; ++k) {
+    const __m512d f0 = _mm512_loadu_pd(&c.factors[k][0]);
+    const __m256d f1 = _mm256_load_pd(&c.factors[k][8]);
+    for (int i = 0; i < 9; ++i) {
+      const double item = c.items[k][i];
+      lo[i] = _mm512_fmadd_pd(_mm512_set1_pd(item), f0, lo[i]);
+      hi[i] = _mm256_fmadd_pd(_mm256_set1_pd(item), f1, hi[i]);
+    }
+  }
+  for (int i = 0; i < 9; ++i) {
+    alignas(64) double lane[12];
+    _mm512_store_pd(lane, lo[i]);
+    _mm256_store_pd(lane + 8, hi[i]);
+    for (int j = 0; j < 12; ++j) sums[i][j] += lane[j];
+  }
+}
 #endif
 
 }  // namespace
@@ -40,6 +70,10 @@ __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c
 void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,
                               SimdKernel kernel) {
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx512(kernel)) {
+    accumulateAvx512(chunk, m, sums);
+    return;
+  }
   if (useAvx2Fma(kernel)) {
     accumulateAvx2(chunk, m, sums);
     return;

@@ -110,21 +110,23 @@ OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::
   return acc.finish(minNeighbors);
 }
 
-/// The sphere of precomputed sums (no derivatives): the intermediate robust passes.
-OrientedSphereFitResult sumsPass(double t, const SphereSums& sums, int minNeighbors) {
-  OrientedSphereFit acc;
-  acc.begin(Vec3::Zero(), t, FitDerivatives::None, false);
-  acc.addSums(sums.s, sums.used);
-  return acc.finish(minNeighbors);
-}
-
 /// The gathered neighbours as columns with their kernel weights (what reweight() reads).
 void fillColumns(double t, FitWorkspace& ws) {
   const WeightKernel kernel(t);
-  ws.columns.clear();
-  for (std::size_t k = 0; k < ws.offsets.size(); ++k) {
-    const double w = WeightKernel::value(kernel.ratio(ws.offsets[k].squaredNorm()));  // Eq. 1.6
-    ws.columns.push(ws.offsets[k], ws.normals[k], w);
+  NeighborColumns& c = ws.columns;
+  const std::size_t n = ws.offsets.size();
+  for (auto* v : {&c.qx, &c.qy, &c.qz, &c.nx, &c.ny, &c.nz, &c.d2, &c.weight}) v->resize(n);
+  // Raw pointers, as in gatherNeighbors: no reloads of the vectors' data pointers per neighbour.
+  const Vec3* q = ws.offsets.data();
+  const Vec3* nIn = ws.normals.data();
+  double *qx = c.qx.data(), *qy = c.qy.data(), *qz = c.qz.data();
+  double *nx = c.nx.data(), *ny = c.ny.data(), *nz = c.nz.data();
+  double *d2 = c.d2.data(), *w = c.weight.data();
+  for (std::size_t k = 0; k < n; ++k) {
+    qx[k] = q[k].x(), qy[k] = q[k].y(), qz[k] = q[k].z();
+    nx[k] = nIn[k].x(), ny[k] = nIn[k].y(), nz[k] = nIn[k].z();
+    d2[k] = q[k].squaredNorm();
+    w[k] = WeightKernel::value(kernel.ratio(d2[k]));  // Eq. 1.6
   }
 }
 
@@ -170,15 +172,24 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
     const double change =
         reweight(res.sphere, invSr2, invSn2, ws.columns, ws.weights, ws.trialWeights, sums);
     if (change <= options.robustTolerance) break;
-    const bool last = reported && it + 1 == passes;
     // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
-    OrientedSphereFitResult next =
-        last ? spherePass(t, ws, ws.trialWeights, order, true, 1) : sumsPass(t, sums, 1);
-    if (!next.valid) break;
-    next.neighbors = res.neighbors;
-    res = next;
+    if (reported && it + 1 == passes) {
+      OrientedSphereFitResult next = spherePass(t, ws, ws.trialWeights, order, true, 1);
+      if (!next.valid) break;
+      next.neighbors = res.neighbors;
+      res = next;
+      full = true;
+    } else {
+      // An intermediate pass: only the sphere feeds the next re-weighting (what finish() would
+      // give for these sums without derivatives, at a fraction of its cost).
+      AlgebraicSphere next;
+      if (!sphereFromSums(sums.s, sums.used, t, 1, next)) break;
+      res.sphere = next;
+      res.gradient = next.ul;
+      res.weightSum = sums.s[0];
+      full = false;
+    }
     std::swap(ws.weights, ws.trialWeights);
-    full = last;
   }
   if (res.valid && reported && !full) res = reportedPass(t, options, ws, res.neighbors);
   return res;

@@ -68,7 +68,24 @@ SphereTerms<S> solveSphere(const S* item, double degenerate) {
   return r;
 }
 
+/// Eq. 1.7-1.9 on plain sums (no derivatives); false when degenerate.
+bool solvePlain(const double* sums, double t, AlgebraicSphere& sphere) {
+  const double degenerate = 1e-14 * sums[0] * sums[0] * (t * t);
+  const auto u = solveSphere<double>(sums, degenerate);
+  if (!u.ok) return false;
+  sphere.uc = u.uc;
+  sphere.uq = u.uq;
+  sphere.ul = Vec3(u.ul[0], u.ul[1], u.ul[2]);
+  return true;
+}
+
 }  // namespace
+
+bool sphereFromSums(const double* sums, int count, double t, int minNeighbors,
+                    AlgebraicSphere& sphere) {
+  if (count < minNeighbors || count < 1 || !(sums[0] > 0)) return false;
+  return solvePlain(sums, t, sphere) && sphere.isValid() && sphere.ul.squaredNorm() > 0;
+}
 
 void OrientedSphereFit::begin(const Vec3& x, double t, FitDerivatives order, bool scale) {
   x_ = x;
@@ -209,13 +226,7 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors) const {
   const double degenerate = 1e-14 * s_[0] * s_[0] * t2;
   AlgebraicSphere sphere;
   if (order_ == FitDerivatives::None) {
-    double items[9];
-    for (int k = 0; k < 9; ++k) items[k] = s_[k];
-    const auto u = solveSphere<double>(items, degenerate);
-    if (!u.ok) return res;
-    sphere.uc = u.uc;
-    sphere.uq = u.uq;
-    sphere.ul = Vec3(u.ul[0], u.ul[1], u.ul[2]);
+    if (!solvePlain(s_.data(), kernel_.t, sphere)) return res;
     res.gradient = sphere.ul;
   } else if (order_ == FitDerivatives::First) {
     Jet1 items[9];

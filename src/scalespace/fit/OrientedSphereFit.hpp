@@ -34,6 +34,12 @@ struct OrientedSphereFitResult {
   Vec3 dUlDt = Vec3::Zero();
 };
 
+/// The sphere of precomputed sums without derivatives: what finish() gives for
+/// FitDerivatives::None after addSums(sums, count), without a fit object (the robust passes'
+/// intermediate fits, fit/LocalFit). `sums` as in addSums; false where finish() is invalid.
+bool sphereFromSums(const double* sums, int count, double t, int minNeighbors,
+                    AlgebraicSphere& sphere);
+
 class OrientedSphereFit {
  public:
   /// Starts a fit at x with support t. `scaleDerivatives` adds the d/dt sums.

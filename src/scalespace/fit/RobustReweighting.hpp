@@ -5,8 +5,8 @@
 //   r_k = s(q_k) / |grad s(q_k)|,
 // fused with the accumulation of the next fit's sums (Eq. 1.7-1.9 inputs) with weights
 // w_k rho_k, w_k the kernel weight of Eq. 1.6. The robust stack spends most of its time here
-// (5 passes per fit), so the neighbours are read as columns and, on CPUs with AVX2 + FMA, four at
-// a time.
+// (5 passes per fit), so the neighbours are read as columns and, on CPUs with AVX-512 (AVX2 +
+// FMA), eight (four) at a time.
 #include <cstddef>
 #include <vector>
 

@@ -11,4 +11,14 @@ bool avx2FmaAvailable() {
 #endif
 }
 
+bool avx512Available() {
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                          __builtin_cpu_supports("avx512vl");
+  return has;
+#else
+  return false;
+#endif
+}
+
 }  // namespace scalespace
