@@ -1,5 +1,6 @@
-// The fused RIMLS re-weighting: both implementations (portable, AVX2) against a direct
-// evaluation of the formula with std::exp, for every tail length of the 4-wide loop.
+// The fused RIMLS re-weighting and the first (kernel-weighted) sums: every implementation
+// (portable, AVX2, AVX-512) against a direct evaluation of the formula with std::exp, for every
+// tail length of the 4- and 8-wide loops.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,6 +77,30 @@ void checkAgainstDirect(SimdKernel kernel) {
 }
 
 }  // namespace
+
+// The first fit's sums: a factor of 1 for every neighbour.
+TEST(RobustReweighting, KernelWeightedSumsMatchTheFormula) {
+  std::mt19937 rng(5);
+  for (SimdKernel kernel : {SimdKernel::Portable, SimdKernel::Avx512, SimdKernel::Auto}) {
+    for (std::size_t n = 0; n <= 37; ++n) {
+      const NeighborColumns c = randomNeighbors(n, rng);
+      double ref[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+      int used = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const Vec3 q(c.qx[k], c.qy[k], c.qz[k]), nk(c.nx[k], c.ny[k], c.nz[k]);
+        const double item[9] = {1,      q.x(),  q.y(),     q.z(),          nk.x(),
+                                nk.y(), nk.z(), q.dot(nk), q.squaredNorm()};
+        for (int i = 0; i < 9; ++i) ref[i] += c.weight[k] * item[i];
+        used += c.weight[k] > 0;
+      }
+      SphereSums sums;
+      sums.s[0] = 42;  // overwritten: the sums start from zero
+      kernelWeightedSums(c, sums, kernel);
+      for (int i = 0; i < 9; ++i) EXPECT_NEAR(sums.s[i], ref[i], 1e-12 * (1 + std::abs(ref[i])));
+      EXPECT_EQ(sums.used, used);
+    }
+  }
+}
 
 TEST(RobustReweighting, PortableMatchesTheFormula) { checkAgainstDirect(SimdKernel::Portable); }
 

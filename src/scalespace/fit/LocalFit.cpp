@@ -160,13 +160,20 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
   const FitDerivatives order = derivativesOf(options.estimator);
   ws.weights.assign(ws.offsets.size(), 1.0);
   bool full = reported && passes == 0;
-  OrientedSphereFitResult res = spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None,
-                                           full, options.minNeighbors);
-  if (passes == 0) return res;
+  if (passes == 0)
+    return spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None, full,
+                      options.minNeighbors);
+  // The robust passes read the neighbours as columns, the first (kernel weights only) too.
   fillColumns(t, ws);
+  SphereSums sums;
+  kernelWeightedSums(ws.columns, sums);
+  OrientedSphereFitResult res;
+  res.neighbors = sums.used;
+  res.weightSum = sums.s[0];
+  res.valid = sphereFromSums(sums.s, sums.used, t, options.minNeighbors, res.sphere);
+  res.gradient = res.sphere.ul;
   const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
   const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
-  SphereSums sums;
   for (int it = 0; it < passes && res.valid; ++it) {
     // Converged: the next fit would be (nearly) the current one.
     const double change =

@@ -40,6 +40,10 @@ inline void addSample(SphereSums& out, const NeighborColumns& c, std::size_t k, 
   out.used += w > 0 ? 1 : 0;
 }
 
+void kernelWeightedSumsPortable(const NeighborColumns& c, SphereSums& out) {
+  for (std::size_t k = 0; k < c.size(); ++k) addSample(out, c, k, c.weight[k]);
+}
+
 /// The factor of neighbour k (the portable pass).
 inline double factorOf(const AlgebraicSphere& s, double invSr2, double invSn2,
                        const NeighborColumns& c, std::size_t k) {
@@ -247,9 +251,49 @@ SCALESPACE_AVX512 double reweightAvx512(const AlgebraicSphere& s, double invSr2,
   next.used += used;
   return _mm512_reduce_max_pd(change);
 }
+
+SCALESPACE_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c, SphereSums& out) {
+  __m512d acc[9];
+  for (__m512d& v : acc) v = _mm512_setzero_pd();
+  int used = 0;
+  const std::size_t n = c.size();
+  const double *qxs = c.qx.data(), *qys = c.qy.data(), *qzs = c.qz.data();
+  const double *nxs = c.nx.data(), *nys = c.ny.data(), *nzs = c.nz.data();
+  const double *d2s = c.d2.data(), *ws = c.weight.data();
+  for (std::size_t k = 0; k < n; k += 8) {
+    const __mmask8 m = n - k >= 8 ? __mmask8(0xff) : __mmask8((1u << (n - k)) - 1);
+    const __m512d qx = _mm512_maskz_loadu_pd(m, qxs + k), qy = _mm512_maskz_loadu_pd(m, qys + k),
+                  qz = _mm512_maskz_loadu_pd(m, qzs + k);
+    const __m512d nx = _mm512_maskz_loadu_pd(m, nxs + k), ny = _mm512_maskz_loadu_pd(m, nys + k),
+                  nz = _mm512_maskz_loadu_pd(m, nzs + k);
+    const __m512d w = _mm512_maskz_loadu_pd(m, ws + k);
+    used += __builtin_popcount(_mm512_cmp_pd_mask(w, _mm512_setzero_pd(), _CMP_GT_OQ));
+    acc[0] = _mm512_add_pd(acc[0], w);
+    acc[1] = _mm512_fmadd_pd(w, qx, acc[1]);
+    acc[2] = _mm512_fmadd_pd(w, qy, acc[2]);
+    acc[3] = _mm512_fmadd_pd(w, qz, acc[3]);
+    acc[4] = _mm512_fmadd_pd(w, nx, acc[4]);
+    acc[5] = _mm512_fmadd_pd(w, ny, acc[5]);
+    acc[6] = _mm512_fmadd_pd(w, nz, acc[6]);
+    acc[7] = _mm512_fmadd_pd(
+        w, _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))), acc[7]);
+    acc[8] = _mm512_fmadd_pd(w, _mm512_maskz_loadu_pd(m, d2s + k), acc[8]);
+  }
+  for (int i = 0; i < 9; ++i) out.s[i] += _mm512_reduce_add_pd(acc[i]);
+  out.used += used;
+}
 #endif
 
 }  // namespace
+
+void kernelWeightedSums(const NeighborColumns& c, SphereSums& out, SimdKernel kernel) {
+  out = SphereSums{};
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx512(kernel)) return kernelWeightedSumsAvx512(c, out);
+#endif
+  (void)kernel;
+  kernelWeightedSumsPortable(c, out);
+}
 
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
                 const NeighborColumns& c, const std::vector<double>& previous,

@@ -32,6 +32,11 @@ struct SphereSums {
   int used = 0;
 };
 
+/// The sums with the kernel weights alone (the first, not yet re-weighted fit), into `out` (from
+/// zero). `kernel`: fit/SimdKernel.hpp.
+void kernelWeightedSums(const NeighborColumns& c, SphereSums& out,
+                        SimdKernel kernel = SimdKernel::Auto);
+
 /// Re-weights against `sphere`: writes rho_k to rho (resized), accumulates the sums with weights
 /// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]|. invSr2 = 1 /
 /// sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets rho = 0.
