@@ -161,3 +161,52 @@ TEST(AlphaShape, AreaAtLeastAgreesWithTheFullShape) {
   EXPECT_FALSE(alphaShapeAreaAtLeast({Vec2(0, 0), Vec2(1, 0)}, 1.0, 1e-9));
   EXPECT_TRUE(alphaShapeAreaAtLeast({Vec2(0, 0), Vec2(1, 0)}, 1.0, 0.0));
 }
+
+TEST(AlphaShape, SubsetLowerBoundNeverExceedsTheArea) {
+  // Sets with holes, concave corners, sparse and dense parts; cells from coarse to fine.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<std::vector<Vec2>> sets(4);
+  for (int i = 0; i < 6000; ++i) sets[0].emplace_back(u(rng), u(rng));  // dense square
+  for (int i = 0; i < 6000; ++i) {                                      // annulus
+    const double a = 6.283185307179586 * u(rng), r = 1 + 0.5 * u(rng);
+    sets[1].emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  for (int i = 0; i < 4000; ++i) {  // L shape
+    const Vec2 p(u(rng), 4 * u(rng));
+    sets[2].push_back(i % 2 ? p : Vec2(p.y(), p.x()));
+  }
+  for (int i = 0; i < 3000; ++i)  // clusters with gaps between them
+    sets[3].emplace_back(double(i % 5) + 0.6 * u(rng), 0.6 * u(rng));
+  for (const auto& pts : sets)
+    for (double radius : {0.05, 0.2, 0.7, 3.0}) {
+      const double alpha = radius * radius;
+      const double area = alphaShape2(pts, alpha).area;
+      for (double cell : {radius / 2, radius / 8, radius / 32, 1e-4}) {
+        const double bound = alphaShapeAreaLowerBound(pts, alpha, cell);
+        EXPECT_LE(bound, area * (1 + 1e-12))
+            << pts.size() << " radius " << radius << " cell " << cell;
+        EXPECT_GE(bound, 0);
+      }
+    }
+  // Dense points, cell << radius: the bound is nearly the area (what makes it useful).
+  const double alpha = 0.3 * 0.3;
+  EXPECT_GT(alphaShapeAreaLowerBound(sets[0], alpha, 0.3 / 32),
+            0.9 * alphaShape2(sets[0], alpha).area);
+  // A cell finer than the spacing keeps every point: only the segments are subtracted.
+  const double full = alphaShape2(sets[0], alpha).area;
+  EXPECT_GT(alphaShapeAreaLowerBound(sets[0], alpha, 1e-6), 0.95 * full);
+  EXPECT_EQ(alphaShapeAreaLowerBound({Vec2(0, 0), Vec2(1, 0)}, 1.0, 0.1), 0.0);
+}
+
+TEST(AlphaShape, SubsetLowerBoundSubtractsTheBoundarySegments) {
+  // The subset {a, b, c} (d shares c's cell of side 0.95) is one interior triangle of area 0.891
+  // (circumradius 0.994 <= 1). With d just inside the long edge ab, the flat triangle abd
+  // (circumradius 4.95) leaves the full shape, whose area is 0.792 < 0.891: only the circular
+  // segment on ab keeps the bound below it.
+  const std::vector<Vec2> pts = {Vec2(-0.99, 0), Vec2(0.99, 0), Vec2(0, -0.9), Vec2(0, -0.1)};
+  const double area = alphaShape2(pts, 1.0).area;
+  EXPECT_NEAR(area, 0.891 - 0.099, 1e-9);
+  EXPECT_NEAR(alphaShape2({pts[0], pts[1], pts[2]}, 1.0).area, 0.891, 1e-9);
+  EXPECT_LE(alphaShapeAreaLowerBound(pts, 1.0, 0.95), area);
+}

@@ -25,6 +25,12 @@ AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withO
 /// Sec. 2.3.1 only needs this answer; large regions pass it from a small patch).
 bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double minArea);
 
+/// A lower bound of alphaShape2(points, alpha).area from the alpha shape of a subset (one point
+/// per grid cell of side `cell`): the subset's area minus, for each of its boundary edges, the
+/// circular segment of radius sqrt(alpha) on that edge (AlphaShapeArea.cpp gives the proof).
+/// Nearly tight for dense points when cell << sqrt(alpha); 0 for fewer than 3 subset points.
+double alphaShapeAreaLowerBound(const std::vector<Vec2>& points, double alpha, double cell);
+
 struct PlaneFit {
   Vec3 normal = Vec3::UnitZ();  // unit; the plane is {x : normal . x = offset}
   double offset = 0.0;
