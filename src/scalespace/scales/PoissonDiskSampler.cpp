@@ -34,6 +34,71 @@ std::uint64_t packCell(std::int64_t x, std::int64_t y, std::int64_t z) {
   return (std::uint64_t(x) << (2 * kCellBits)) | (std::uint64_t(y) << kCellBits) | std::uint64_t(z);
 }
 
+/// The occupied cells among the 27 around a cell, as indices into the sorted keys of the occupied
+/// cells. For fixed (dx, dy) the keys of z - 1, z, z + 1 are consecutive, so 9 searches suffice,
+/// and their targets grow with the cell's own key: asked for cells of increasing key (one colour
+/// of a task's range), each search gallops forward from where it ended for the previous cell.
+/// Measured (bench/fig_1_10 --points 1000000 --mode timing): the sampling of the 50 levels took
+/// 2.68 s with 9 binary searches over all cells per cell, 1.69 s with these cursors (with the
+/// flag scan of increasingIndices); the first level, about one point per cell, 0.47 -> 0.32 s.
+class NeighbourCells {
+ public:
+  explicit NeighbourCells(const std::vector<std::uint64_t>& keys) : keys_(keys) {}
+
+  int find(std::int64_t x, std::int64_t y, std::int64_t z, std::size_t* near) {
+    int count = 0, s = 0;
+    const std::size_t n = keys_.size();
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy, ++s) {
+        const std::uint64_t first = packCell(x + dx, y + dy, z - 1);
+        const std::uint64_t last = packCell(x + dx, y + dy, z + 1);
+        std::size_t k = cursor_[s] = firstNotBelow(cursor_[s], first);
+        for (; k < n && keys_[k] <= last; ++k) near[count++] = k;
+      }
+    return count;
+  }
+
+ private:
+  /// The first k >= from with keys_[k] >= v (keys_.size() if none): exponential then binary search.
+  std::size_t firstNotBelow(std::size_t from, std::uint64_t v) const {
+    const std::size_t n = keys_.size();
+    if (from >= n || keys_[from] >= v) return from;
+    std::size_t below = from, step = 1;  // keys_[below] < v
+    while (below + step < n && keys_[below + step] < v) below += step, step *= 2;
+    const auto end = keys_.begin() + std::ptrdiff_t(std::min(n, below + step));
+    return std::size_t(std::lower_bound(keys_.begin() + std::ptrdiff_t(below) + 1, end, v) -
+                       keys_.begin());
+  }
+
+  const std::vector<std::uint64_t>& keys_;
+  std::size_t cursor_[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+};
+
+/// The accepted samples of every cell (accepted[cellBegin[q] .. + count[q])) in increasing index
+/// order. When they are a sizeable share of the cloud's `n` points a flag per point is scanned
+/// instead of sorting (the first levels keep ~90% of the points: a serial sort of 0.9M indices).
+std::vector<Index> increasingIndices(const std::vector<Index>& accepted,
+                                     const std::vector<std::size_t>& cellBegin,
+                                     const std::vector<std::uint32_t>& count, std::size_t n) {
+  std::size_t total = 0;
+  for (std::uint32_t k : count) total += k;
+  std::vector<Index> out;
+  out.reserve(total);
+  if (total < n / 16) {
+    for (std::size_t q = 0; q < count.size(); ++q)
+      out.insert(out.end(), accepted.begin() + std::ptrdiff_t(cellBegin[q]),
+                 accepted.begin() + std::ptrdiff_t(cellBegin[q] + count[q]));
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  std::vector<std::uint8_t> kept(n, 0);
+  for (std::size_t q = 0; q < count.size(); ++q)
+    for (std::size_t a = cellBegin[q]; a < cellBegin[q] + count[q]; ++a) kept[accepted[a]] = 1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (kept[i]) out.push_back(Index(i));
+  return out;
+}
+
 // r(i, k) of the rejection rule: the larger radius (homogeneous: the radius).
 template <class RadiusOf>
 std::vector<Index> gridSample(const std::vector<Vec3>& positions,
@@ -62,38 +127,22 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
            : a.order != b.order ? a.order < b.order
                                 : a.point < b.point;
   });
-  // Cells as runs of the sorted array, grouped by colour (parity of the three coordinates).
+  // Cells as runs of the sorted array (keys in cellKey, increasing), grouped by colour (parity
+  // of the three coordinates).
   std::vector<std::size_t> cellBegin;
+  std::vector<std::uint64_t> cellKey;
   for (std::size_t k = 0; k < c.size(); ++k)
-    if (k == 0 || c[k].cell != c[k - 1].cell) cellBegin.push_back(k);
+    if (k == 0 || c[k].cell != c[k - 1].cell) cellBegin.push_back(k), cellKey.push_back(c[k].cell);
   const std::size_t cellCount = cellBegin.size();
   cellBegin.push_back(c.size());
   std::vector<std::vector<std::size_t>> byColour(8);
   const std::uint64_t mask = (std::uint64_t(1) << kCellBits) - 1;
   for (std::size_t q = 0; q < cellCount; ++q) {
-    const std::uint64_t key = c[cellBegin[q]].cell;
+    const std::uint64_t key = cellKey[q];
     const int colour =
         int(((key >> (2 * kCellBits)) & 1) | (((key >> kCellBits) & 1) << 1) | ((key & 1) << 2));
     byColour[std::size_t(colour)].push_back(q);
   }
-  // The 27 neighbours of a cell, in 9 binary searches: for fixed (dx, dy) the keys of z - 1, z,
-  // z + 1 are consecutive, and keys grow with (dx, dy), so each search starts where the last one
-  // ended. (With 27 independent searches the t_min level of 1M points took 1.39 s, now 0.54 s.)
-  auto neighbourCells = [&](std::int64_t x, std::int64_t y, std::int64_t z, std::size_t* near) {
-    int count = 0;
-    auto from = cellBegin.begin();
-    const auto end = cellBegin.end() - 1;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) {
-        const std::uint64_t first = packCell(x + dx, y + dy, z - 1);
-        const std::uint64_t last = packCell(x + dx, y + dy, z + 1);
-        from = std::lower_bound(from, end, first,
-                                [&](std::size_t b, std::uint64_t v) { return c[b].cell < v; });
-        for (auto it = from; it != end && c[*it].cell <= last; ++it)
-          near[count++] = std::size_t(it - cellBegin.begin());
-      }
-    return count;
-  };
   // Accepted samples of cell q are kept compactly in accepted[cellBegin[q] .. + acceptedCount[q]):
   // a cell of size >= r holds a bounded number of samples, so checking a candidate costs O(1)
   // however many candidates the neighbouring cells hold. A cell is written only by its own task,
@@ -101,41 +150,37 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
   std::vector<Index> accepted(c.size());
   std::vector<std::uint32_t> acceptedCount(cellCount, 0);
   for (const auto& cells : byColour) {
-    parallelFor(
-        cells.size(),
-        [&](std::size_t ci) {
-          const std::size_t q = cells[ci];
-          const std::uint64_t key = c[cellBegin[q]].cell;
-          const std::int64_t x = std::int64_t((key >> (2 * kCellBits)) & mask),
-                             y = std::int64_t((key >> kCellBits) & mask),
-                             z = std::int64_t(key & mask);
-          std::size_t near[27];
-          const int nearCount = neighbourCells(x, y, z, near);
-          for (std::size_t k = cellBegin[q]; k < cellBegin[q + 1]; ++k) {
-            const Index candidate = c[k].point;
-            const Vec3& p = positions[candidate];
-            bool free = true;
-            for (int nb = 0; nb < nearCount && free; ++nb) {
-              const std::size_t f = near[nb];
-              for (std::size_t a = cellBegin[f]; a < cellBegin[f] + acceptedCount[f]; ++a) {
-                const double r = radiusOf(candidate, accepted[a]);
-                if ((positions[accepted[a]] - p).squaredNorm() < r * r) {
-                  free = false;
-                  break;
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, cells.size(), 16),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          NeighbourCells neighbours(cellKey);
+          for (std::size_t ci = range.begin(); ci != range.end(); ++ci) {
+            const std::size_t q = cells[ci];
+            const std::uint64_t key = cellKey[q];
+            std::size_t near[27];
+            const int nearCount = neighbours.find(std::int64_t((key >> (2 * kCellBits)) & mask),
+                                                  std::int64_t((key >> kCellBits) & mask),
+                                                  std::int64_t(key & mask), near);
+            for (std::size_t k = cellBegin[q]; k < cellBegin[q + 1]; ++k) {
+              const Index candidate = c[k].point;
+              const Vec3& p = positions[candidate];
+              bool free = true;
+              for (int nb = 0; nb < nearCount && free; ++nb) {
+                const std::size_t f = near[nb];
+                for (std::size_t a = cellBegin[f]; a < cellBegin[f] + acceptedCount[f]; ++a) {
+                  const double r = radiusOf(candidate, accepted[a]);
+                  if ((positions[accepted[a]] - p).squaredNorm() < r * r) {
+                    free = false;
+                    break;
+                  }
                 }
               }
+              if (free) accepted[cellBegin[q] + acceptedCount[q]++] = candidate;
             }
-            if (free) accepted[cellBegin[q] + acceptedCount[q]++] = candidate;
           }
-        },
-        16);
+        });
   }
-  std::vector<Index> out;
-  for (std::size_t q = 0; q < cellCount; ++q)
-    out.insert(out.end(), accepted.begin() + std::ptrdiff_t(cellBegin[q]),
-               accepted.begin() + std::ptrdiff_t(cellBegin[q] + acceptedCount[q]));
-  std::sort(out.begin(), out.end());
-  return out;
+  return increasingIndices(accepted, cellBegin, acceptedCount, positions.size());
 }
 
 }  // namespace
