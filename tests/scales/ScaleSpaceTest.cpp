@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "scales/ScalesTestClouds.hpp"
@@ -115,6 +117,55 @@ TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
     EXPECT_EQ(b.size(), cloud.size());
     EXPECT_TRUE(b.projection.empty() && b.dirMax.empty() && b.tau.empty() && b.neighbors.empty());
     EXPECT_EQ(all.summary.stats[j].validPoints, some.summary.stats[j].validPoints);
+  }
+}
+
+TEST(ScaleSpace, ProcessingOrderLayersAreTheInputOrderLayersPermuted) {
+  const PointCloud cloud = test::sphereCloud(800, 1.0);
+  ScaleSpaceOptions o = smallOptions(3);
+  const ScaleStack input = computeScaleSpace(cloud, o);
+  o.layerOrder = LayerOrder::Processing;
+  const ScaleStack processing = computeScaleSpace(cloud, o);
+  ASSERT_EQ(input.layers.size(), processing.layers.size());
+  for (std::size_t j = 0; j < input.layers.size(); ++j) {
+    const ScaleLayer &a = input.layers[j], &b = processing.layers[j];
+    EXPECT_TRUE(a.inputIndex.empty());
+    ASSERT_EQ(b.inputIndex.size(), cloud.size());
+    ASSERT_TRUE(b.complete());
+    // A permutation, and not the identity (a sphere sampled at random is not in Morton order).
+    std::vector<int> seen(cloud.size(), 0);
+    bool identity = true;
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      ++seen[b.inputIndex[k]];
+      identity = identity && b.inputIndex[k] == k;
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), std::ptrdiff_t(cloud.size()));
+    EXPECT_FALSE(identity);
+    for (std::size_t k = 0; k < b.size(); k += 37) {
+      const std::size_t i = b.inputIndex[k];
+      EXPECT_EQ(b.projection[3 * k + 1], a.projection[3 * i + 1]);
+      EXPECT_EQ(b.dirMin[3 * k + 2], a.dirMin[3 * i + 2]);
+      EXPECT_EQ(b.kMax[k], a.kMax[i]);
+      EXPECT_EQ(b.neighbors[k], a.neighbors[i]);
+    }
+    const ScaleLayer c = inInputOrder(b);
+    EXPECT_TRUE(c.inputIndex.empty());
+    for (auto [x, y] : {std::pair{&a.projection, &c.projection},
+                        {&a.normal, &c.normal},
+                        {&a.dirMax, &c.dirMax},
+                        {&a.dirMin, &c.dirMin},
+                        {&a.meanCurvature, &c.meanCurvature},
+                        {&a.kMax, &c.kMax},
+                        {&a.kMin, &c.kMin},
+                        {&a.tau, &c.tau},
+                        {&a.kappa, &c.kappa},
+                        {&a.fitness, &c.fitness},
+                        {&a.anisotropy, &c.anisotropy},
+                        {&a.geometricVariation, &c.geometricVariation}})
+      EXPECT_EQ(*x, *y);
+    EXPECT_EQ(a.neighbors, c.neighbors);
+    EXPECT_EQ(a.valid, c.valid);
+    EXPECT_EQ(input.summary.stats[j].validPoints, processing.summary.stats[j].validPoints);
   }
 }
 

@@ -98,12 +98,24 @@ void ScaleLayer::resize(std::size_t n) {
 
 bool ScaleLayer::complete() const {
   const std::size_t n = size();
+  if (!inputIndex.empty() && inputIndex.size() != n) return false;
   for (const auto* v : {&projection, &normal, &dirMax, &dirMin})
     if (v->size() != 3 * n) return false;
   for (const auto* v :
        {&meanCurvature, &kMax, &kMin, &tau, &kappa, &fitness, &anisotropy, &geometricVariation})
     if (v->size() != n) return false;
   return neighbors.size() == n;
+}
+
+ScaleLayer inInputOrder(const ScaleLayer& layer) {
+  if (layer.inputIndex.empty()) return layer;
+  const std::size_t n = layer.size();
+  std::vector<Index> rank(n);
+  for (std::size_t k = 0; k < n; ++k) rank[layer.inputIndex[k]] = Index(k);
+  ScaleLayer out;
+  out.resize(n);
+  toInputOrder(layer, rank, LayerContents::All, out);
+  return out;
 }
 
 std::uint64_t cloudChecksum(const PointCloud& cloud) {
@@ -167,11 +179,13 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   std::vector<Vec3> current = positions;  // projection at the previous scale (Fig. 1.9)
   std::vector<Index> level(n);
   for (std::size_t k = 0; k < n; ++k) level[k] = Index(k);
-  const std::vector<Index> rank = invertPermutation(order);
+  const bool inputOrder = options.layerOrder == LayerOrder::Input;
+  const std::vector<Index> rank = inputOrder ? invertPermutation(order) : std::vector<Index>{};
   ScaleLayer spatial, layer;  // this scale in processing order, and in input order
   spatial.resize(n);
-  layer.resize(n);
-  if (options.layerContents == LayerContents::NormalAndCurvatures) {
+  if (inputOrder) layer.resize(n);
+  if (!inputOrder) spatial.inputIndex = order;
+  if (inputOrder && options.layerContents == LayerContents::NormalAndCurvatures) {
     for (auto* v : {&layer.projection, &layer.dirMax, &layer.dirMin}) *v = {};
     for (auto* v :
          {&layer.tau, &layer.kappa, &layer.fitness, &layer.anisotropy, &layer.geometricVariation})
@@ -236,15 +250,16 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                           tracker.advance(projectGroup(g, ws));
                       });
     tracker.finish();
-    toInputOrder(spatial, rank, options.layerContents, layer);
+    if (inputOrder) toInputOrder(spatial, rank, options.layerContents, layer);
+    const ScaleLayer& result = inputOrder ? layer : spatial;
     stats.projectionSeconds = secondsSince(t0);
     double sum = 0, steps = 0;
     for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k], steps += mlsSteps[k];
     stats.meanNeighbors = sum / double(n);
     stats.meanMlsSteps = steps / double(n);
-    for (std::uint8_t v : layer.valid) stats.validPoints += v;
+    for (std::uint8_t v : result.valid) stats.validPoints += v;
     summary.stats.push_back(stats);
-    if (sink) sink(j, layer, stats);
+    if (sink) sink(j, result, stats);
   }
   summary.totalSeconds = secondsSince(start);
   return summary;

@@ -22,6 +22,14 @@ enum class LayerContents {
   NormalAndCurvatures  // normal, meanCurvature, kMax, kMin, valid; the other arrays are empty
 };
 
+/// In which order the layers handed to a ScaleSink list the points (ScaleLayer::inputIndex).
+enum class LayerOrder {
+  Input,      // entry i is input point i
+  Processing  // the order the points were processed in (spatial): entry k is input point
+              // inputIndex[k]; saves putting every array back in input order, for a consumer
+              // that reorders something smaller (the stack writer: the encoded bytes)
+};
+
 struct ScaleSpaceOptions {
   ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
   double alpha = 0.1;  // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2): samples >= 2 r_j apart
@@ -41,6 +49,7 @@ struct ScaleSpaceOptions {
   /// NormalAndCurvatures is what plane detection reads: putting only those arrays in input order
   /// saves ~1 s per 50 scales of 1M points (2 cores).
   LayerContents layerContents = LayerContents::All;
+  LayerOrder layerOrder = LayerOrder::Input;
 };
 
 /// Statistics of one scale (what Fig. 1.11 plots).
@@ -55,7 +64,8 @@ struct ScaleStats {
   double projectionSeconds = 0;  // projecting every input point
 };
 
-/// Everything computed at one scale, one entry per input point, in input order (with
+/// Everything computed at one scale, one entry per input point, in input order unless inputIndex
+/// is set (LayerOrder::Processing: entry k is input point inputIndex[k]) (with
 /// LayerContents::NormalAndCurvatures, only normal, meanCurvature, kMax, kMin and valid). Positions
 /// are relative to the cloud's origin() (PointCloud.hpp); vectors are packed x,y,z.
 struct ScaleLayer {
@@ -64,11 +74,15 @@ struct ScaleLayer {
   std::vector<float> tau, kappa, fitness, anisotropy, geometricVariation;  // N each
   std::vector<std::uint16_t> neighbors;                                    // N, saturated at 65535
   std::vector<std::uint8_t> valid;                                         // N, 1 = valid fit
+  std::vector<Index> inputIndex;  // empty (input order) or N: the input point of each entry
   void resize(std::size_t n);
   std::size_t size() const { return valid.size(); }
   /// Every array holds size() entries (LayerContents::All).
   bool complete() const;
 };
+
+/// The layer in input order (a copy of an input-order layer as it is).
+ScaleLayer inInputOrder(const ScaleLayer& layer);
 
 /// Receives each scale as soon as it is computed (j = 0..M-1), e.g. to stream it to disk.
 using ScaleSink = std::function<void(std::size_t j, const ScaleLayer& layer, const ScaleStats&)>;
