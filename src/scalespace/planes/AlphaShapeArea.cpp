@@ -53,6 +53,18 @@ double markInterior(Delaunay& dt, double alpha) {
   return sum;
 }
 
+/// Calls edge(a, b) for every boundary edge of the shape marked by markInterior, oriented
+/// counter-clockwise around its interior face (infinite faces are never interior).
+template <class Edge>
+void forEachBoundaryEdge(const Delaunay& dt, Edge&& edge) {
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    if (!f->info()) continue;
+    for (int i = 0; i < 3; ++i)
+      if (!f->neighbor(i)->info())
+        edge(f->vertex(Delaunay::ccw(i))->point(), f->vertex(Delaunay::cw(i))->point());
+  }
+}
+
 AlphaShape alphaShapeOf(const std::vector<Kernel::Point_2>& points, double alpha,
                         bool withOutlines) {
   AlphaShape result;
@@ -64,15 +76,9 @@ AlphaShape alphaShapeOf(const std::vector<Kernel::Point_2>& points, double alpha
   // Boundary edges oriented counter-clockwise around their interior face, chained into loops by
   // their start point (coordinates, not handles, so that the loop order is reproducible).
   std::multimap<std::pair<double, double>, std::pair<double, double>> next;
-  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
-    if (!f->info()) continue;
-    for (int i = 0; i < 3; ++i) {
-      if (f->neighbor(i)->info()) continue;  // infinite faces are never interior
-      const auto& a = f->vertex(Delaunay::ccw(i))->point();
-      const auto& b = f->vertex(Delaunay::cw(i))->point();
-      next.emplace(std::make_pair(a.x(), a.y()), std::make_pair(b.x(), b.y()));
-    }
-  }
+  forEachBoundaryEdge(dt, [&](const Kernel::Point_2& a, const Kernel::Point_2& b) {
+    next.emplace(std::make_pair(a.x(), a.y()), std::make_pair(b.x(), b.y()));
+  });
   while (!next.empty()) {
     std::vector<Vec2> loop;
     auto it = next.begin();
@@ -164,15 +170,9 @@ double alphaShapeAreaLowerBound(const std::vector<Vec2>& points, double alpha, d
   Delaunay dt(subset.begin(), subset.end());
   double bound = markInterior(dt, alpha);
   const double r = std::sqrt(alpha);
-  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
-    if (!f->info()) continue;
-    for (int i = 0; i < 3; ++i) {
-      if (f->neighbor(i)->info()) continue;  // infinite faces are never interior
-      const auto& a = f->vertex(Delaunay::ccw(i))->point();
-      const auto& b = f->vertex(Delaunay::cw(i))->point();
-      bound -= circularSegment(std::sqrt(CGAL::to_double(CGAL::squared_distance(a, b))), r);
-    }
-  }
+  forEachBoundaryEdge(dt, [&](const Kernel::Point_2& a, const Kernel::Point_2& b) {
+    bound -= circularSegment(std::sqrt(CGAL::to_double(CGAL::squared_distance(a, b))), r);
+  });
   return std::max(bound, 0.0);
 }
 
