@@ -138,6 +138,33 @@ TEST_F(Cli, ScalesWritesCompactByDefaultAndFloat32OnRequest) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+TEST_F(Cli, ExportCarriesTheInputAttributesOfTheStacksCloud) {
+  // A Stairs scene has a ground-truth attribute (gt_face); export --input carries it, in order.
+  ASSERT_EQ(run("generate stairs -n 3000 --seed 2 -q -o " + path("st.ply")).code, 0);
+  ASSERT_EQ(run("generate stairs -n 3000 --seed 3 -q -o " + path("other.ply")).code, 0);
+  Result r = run("scales " + path("st.ply") + " -o " + path("st.stack") + " --scales 2 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("export " + path("st.stack") + " --scale 1 -o " + path("e.ply") + " --input " +
+          path("st.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PointCloud in = readCloud(path("st.ply")), out = readCloud(path("e.ply"));
+  ASSERT_EQ(out.size(), in.size());
+  const auto* face = out.findAttribute("gt_face");
+  ASSERT_NE(face, nullptr);
+  EXPECT_EQ(face->values, in.findAttribute("gt_face")->values);
+  // The input's attributes come first, then the scale's quantities.
+  EXPECT_EQ(out.attributes().front().name, "gt_face");
+  EXPECT_NE(out.findAttribute("curv_mean"), nullptr);
+  // Another cloud of the same size is refused, naming it; --input needs --scale.
+  r = run("export " + path("st.stack") + " --scale 1 -o " + path("x.ply") + " --input " +
+          path("other.ply"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("other.ply"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("x.ply")));
+  r = run("export " + path("st.stack") + " --point 1 --input " + path("st.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+}
+
 TEST_F(Cli, CurvatureEstimatesNormalsWhenMissingAndNeverOverwritesItsInput) {
   {
     std::ofstream xyz(path("plane.xyz"));

@@ -1,11 +1,13 @@
 #include "scalespace/cli/ScalesCommands.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
@@ -116,7 +118,40 @@ void addScalesCommand(CLI::App& app) {
   });
 }
 
-void exportScale(const ScaleStackReader& reader, std::size_t j, const std::string& output) {
+/// The attributes of `input` (the cloud the stack was computed on, checked point by point against
+/// the stack's input positions) into `cloud`, in the input's order; a name that an exported
+/// quantity takes is prefixed with "input_".
+void addInputAttributes(const PointCloud& input, const std::string& inputPath,
+                        const ScaleStackReader& reader, const std::string& stackPath,
+                        PointCloud& cloud) {
+  const std::vector<Vec3> positions = reader.inputPositions();
+  const auto fix =
+      "pass the cloud the stack was computed from (with --drop-invalid if `scales` "
+      "had it)";
+  if (input.size() != positions.size())
+    throw FileError(inputPath, "",
+                    "has " + std::to_string(input.size()) + " points but " + stackPath +
+                        " was computed on " + std::to_string(positions.size()),
+                    fix);
+  // Equal up to the rounding of another file format's coordinates (a scan saved as LAS and PLY).
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (!((input.absolutePosition(i) - positions[i]).norm() <=
+          1e-9 * std::max(1.0, positions[i].norm())))
+      throw FileError(
+          inputPath, "",
+          "point " + std::to_string(i) + " is not the stack's input point " + std::to_string(i),
+          fix);
+  for (const AttributeColumn& a : input.attributes()) {
+    bool taken = false;
+    for (const ExportColumn& c : kColumns) taken = taken || a.name == c.name;
+    AttributeColumn& out = cloud.addAttribute(taken ? "input_" + a.name : a.name, a.type);
+    out.values = a.values;
+  }
+}
+
+void exportScale(const ScaleStackReader& reader, std::size_t j, const std::string& output,
+                 const PointCloud* input, const std::string& inputPath,
+                 const std::string& stackPath) {
   const ScaleLayer L = reader.readScale(j);
   const Vec3 origin = reader.info().origin;
   const std::size_t n = reader.pointCount();
@@ -126,6 +161,8 @@ void exportScale(const ScaleStackReader& reader, std::size_t j, const std::strin
   for (std::size_t i = 0; i < n; ++i)
     normals[i] = Vec3(L.normal[3 * i], L.normal[3 * i + 1], L.normal[3 * i + 2]);
   cloud.setNormals(std::move(normals));
+  // As in `curvature`: the input's own attributes first, then the scale's quantities.
+  if (input) addInputAttributes(*input, inputPath, reader, stackPath, cloud);
   for (const ExportColumn& c : kColumns) {
     const bool isProj = c.value == nullptr;
     const bool isInt = std::string(c.name) == "neighbors" || std::string(c.name) == "fit_valid";
@@ -169,6 +206,7 @@ void exportPoint(const ScaleStackReader& reader, std::size_t i, std::ostream& ou
 void addExportCommand(CLI::App& app) {
   struct Args {
     std::string stack, output;
+    InputOptions input;
     long long scale = -1, point = -1;
     bool quiet = false;
   };
@@ -184,14 +222,26 @@ void addExportCommand(CLI::App& app) {
   scale->excludes(point);
   cmd->add_option("-o,--output", args->output,
                   "output file (.ply for --scale; .csv for --point, stdout if omitted)");
+  auto* input = cmd->add_option("--input", args->input.path,
+                                "with --scale: the cloud the stack was computed on, whose own "
+                                "attributes (colours, intensity, ...) are carried over");
+  cmd->add_flag("--drop-invalid", args->input.dropInvalid,
+                "with --input: skip points with NaN/Inf coordinates (as `scales` did)");
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
-  cmd->callback([args, scale, point] {
+  cmd->callback([args, scale, point, input] {
     if (!*scale && !*point) throw OptionError("export needs --scale J or --point I");
+    if (*input && !*scale) throw OptionError("--input goes with --scale");
     ScaleStackReader reader(args->stack);
     if (*scale) {
       if (args->output.empty()) throw OptionError("export --scale needs -o OUT.ply");
       if (args->scale < 0) throw OptionError("--scale must be >= 0");
-      exportScale(reader, std::size_t(args->scale), args->output);
+      std::optional<PointCloud> cloud;
+      if (*input) {
+        checkOutputPath(args->input.path, args->output);
+        cloud = loadCloud(args->input, args->quiet);
+      }
+      exportScale(reader, std::size_t(args->scale), args->output, cloud ? &*cloud : nullptr,
+                  args->input.path, args->stack);
       if (!args->quiet)
         std::fprintf(stderr, "scale %lld -> %s\n", args->scale, args->output.c_str());
     } else {
