@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -144,6 +145,43 @@ TEST(PointRenderer, ViewsAndLabels) {
   opt.labelAttribute.clear();
   opt.width = 0;
   EXPECT_THROW(renderPoints(cloud, opt), OptionError);
+}
+
+TEST(PointRenderer, UpAxisTurnsTheNamedViews) {
+  // The frames are right-handed and the default (z) keeps the views as they were.
+  for (const char* up : {"x", "y", "z", "-x", "-y", "-z"}) {
+    const UpFrame f = upFrame(up);
+    EXPECT_NEAR((f.side.cross(f.ahead) - f.up).norm(), 0, 1e-15) << up;
+  }
+  EXPECT_NEAR((viewDirection("front", "z") - Vec3(0, 1, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((viewDirection("top", "y") - Vec3(0, -1, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((viewDirection("top", "-y") - Vec3(0, 1, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((viewDirection("front", "y") - Vec3(1, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((viewDirection("1,0,0", "y") - Vec3(1, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_THROW(upFrame("w"), OptionError);
+  EXPECT_THROW(upFrame("--z"), OptionError);
+  EXPECT_THROW(upFrame(""), OptionError);
+  // A floor in the xz plane of a y-up scan: seen from the top it fills the frame, seen from the
+  // top of a z-up world (edge-on) it is a line; with up = y the image's up is the scene's -z.
+  std::vector<Vec3> floor;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) floor.emplace_back(i / 39.0, 0.0, j / 39.0);
+  PointCloud cloud = cloudOf(floor);
+  RenderOptions opt;
+  opt.width = opt.height = 64;
+  opt.view = "top";
+  auto covered = [&](const Image& im) {
+    int count = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) count += im.at(x, y) != opt.background ? 1 : 0;
+    return count;
+  };
+  opt.up = "y";
+  const int fromAbove = covered(renderPoints(cloud, opt));
+  opt.up = "z";
+  const int edgeOn = covered(renderPoints(cloud, opt));
+  EXPECT_GT(fromAbove, 64 * 64 / 2);
+  EXPECT_LT(edgeOn, 64 * 64 / 8);
 }
 
 TEST(PngWriter, RoundTripIsExact) {

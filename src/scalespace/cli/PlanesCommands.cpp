@@ -49,7 +49,7 @@ void parseSize(const std::string& text, int& width, int& height) {
 void addRenderCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
-    std::string output, color, labels, view = "iso", size = "1024x768";
+    std::string output, color, labels, view = "iso", up = "z", size = "1024x768";
     int radius = -1;
     bool noShading = false, quiet = false;
   };
@@ -65,6 +65,8 @@ void addRenderCommand(CLI::App& app) {
       ->excludes(color);
   cmd->add_option("--view", args->view, "front | top | iso | X,Y,Z (viewing direction)")
       ->capture_default_str();
+  cmd->add_option("--up", args->up, "the cloud's up axis: x | y | z | -x | -y | -z")
+      ->capture_default_str();
   cmd->add_option("--size", args->size, "image size WIDTHxHEIGHT")->capture_default_str();
   cmd->add_option("--point-radius", args->radius, "splat radius in pixels (-1 = automatic)")
       ->capture_default_str();
@@ -76,7 +78,8 @@ void addRenderCommand(CLI::App& app) {
     RenderOptions options;
     parseSize(args->size, options.width, options.height);
     options.view = args->view;
-    viewDirection(options.view);  // validate before the (possibly long) read
+    options.up = args->up;
+    viewDirection(options.view, options.up);  // validate before the (possibly long) read
     options.colorAttribute = args->color;
     options.labelAttribute = args->labels;
     options.pointRadius = args->radius;

@@ -11,10 +11,26 @@
 
 namespace scalespace {
 
-Vec3 viewDirection(const std::string& view) {
-  if (view == "front") return Vec3::UnitY();
-  if (view == "top") return -Vec3::UnitZ();
-  if (view == "iso") return Vec3(-1, 1, -1).normalized();
+UpFrame upFrame(const std::string& up) {
+  const bool negated = !up.empty() && up[0] == '-';
+  const std::string axis = negated ? up.substr(1) : up;
+  if (axis.size() != 1 || axis[0] < 'x' || axis[0] > 'z')
+    throw OptionError("--up '" + up + "' is not x, y, z, -x, -y or -z");
+  // Cyclic order: up e_i, side e_(i+1), ahead +-e_(i+2), so side x ahead = up.
+  const int i = axis[0] - 'x';
+  const double sign = negated ? -1.0 : 1.0;
+  UpFrame f;
+  f.up = sign * Vec3::Unit(i);
+  f.side = Vec3::Unit((i + 1) % 3);
+  f.ahead = sign * Vec3::Unit((i + 2) % 3);
+  return f;
+}
+
+Vec3 viewDirection(const std::string& view, const std::string& up) {
+  const UpFrame f = upFrame(up);
+  if (view == "front") return f.ahead;
+  if (view == "top") return -f.up;
+  if (view == "iso") return (-f.side + f.ahead - f.up).normalized();
   std::stringstream in(view);
   Vec3 d;
   char c1 = 0, c2 = 0;
@@ -85,8 +101,9 @@ Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
     throw OptionError("--size must be between 1x1 and 16384x16384");
   if (options.margin < 0 || options.margin >= 0.5)
     throw OptionError("render margin must be in [0, 0.5)");
-  const Vec3 forward = viewDirection(options.view);
-  const Vec3 upHint = std::abs(forward.z()) > 0.99 ? Vec3::UnitY() : Vec3::UnitZ();
+  const Vec3 forward = viewDirection(options.view, options.up);
+  const UpFrame frame = upFrame(options.up);
+  const Vec3 upHint = std::abs(forward.dot(frame.up)) > 0.99 ? frame.ahead : frame.up;
   const Vec3 right = forward.cross(upHint).normalized();
   const Vec3 up = right.cross(forward);
 
