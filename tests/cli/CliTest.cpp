@@ -133,6 +133,16 @@ TEST_F(Cli, ScalesWritesCompactByDefaultAndFloat32OnRequest) {
   r = run("export " + path("c.stack") + " --scale 1 -o " + path("c1.ply"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(readCloud(path("c1.ply")).size(), 2000u);
+  // Without -q: a per-scale table at the end (one line per scale after its header).
+  r = run("scales " + path("s.ply") + " -o " + path("t.stack") + " --scales 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto header = r.err.find("  scale        t  samples  mean_nbrs");
+  ASSERT_NE(header, std::string::npos) << r.err;
+  const auto summary = r.err.find("2000 points x 3 scales");
+  ASSERT_NE(summary, std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin() + std::ptrdiff_t(header),
+                       r.err.begin() + std::ptrdiff_t(summary), '\n'),
+            4);
   r = run("scales " + path("s.ply") + " -o " + path("x.stack") + " --encoding float8");
   EXPECT_NE(r.code, 0);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

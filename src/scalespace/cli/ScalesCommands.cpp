@@ -8,6 +8,8 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
@@ -55,6 +57,23 @@ const ExportColumn kColumns[] = {
 };
 #undef SS_VEC
 #undef SS_SCALAR
+
+/// One line per scale: t, samples, mean neighbours per projection, MLS steps, valid fits, and the
+/// sampling and projection seconds (what `scales` prints at the end and `stack-info` shows).
+std::string scaleTable(const std::vector<ScaleStats>& stats, std::size_t points) {
+  std::string table =
+      "  scale        t  samples  mean_nbrs  mls_steps  valid%  sample_s  project_s\n";
+  for (std::size_t j = 0; j < stats.size(); ++j) {
+    const ScaleStats& s = stats[j];
+    char line[160];
+    std::snprintf(line, sizeof line, "  %5zu %8.4g %8zu %10.1f %10.2f %7.2f %9.3f %10.3f\n", j, s.t,
+                  s.samples, s.meanNeighbors, s.meanMlsSteps,
+                  points ? 100.0 * double(s.validPoints) / double(points) : 0.0, s.samplingSeconds,
+                  s.projectionSeconds);
+    table += line;
+  }
+  return table;
+}
 
 void addScalesCommand(CLI::App& app) {
   struct Args {
@@ -112,8 +131,9 @@ void addScalesCommand(CLI::App& app) {
     const ScaleSpaceSummary s =
         computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet), write);
     if (!args->quiet)
-      std::fprintf(stderr, "%zu points x %zu scales (t = %.6g .. %.6g) -> %s\n", cloud.size(),
-                   s.series.scales.size(), s.series.tMin, s.series.tMax, args->output.c_str());
+      std::fprintf(stderr, "%s%zu points x %zu scales (t = %.6g .. %.6g) -> %s\n",
+                   scaleTable(s.stats, cloud.size()).c_str(), cloud.size(), s.series.scales.size(),
+                   s.series.tMin, s.series.tMax, args->output.c_str());
     reportDone("scales", start, args->quiet);
   });
 }
@@ -298,16 +318,7 @@ bool printStackInfo(const std::string& path, std::ostream& out) {
   out << "  input checksum: " << std::hex << std::setw(16) << std::setfill('0')
       << info.inputChecksum << std::dec << std::setfill(' ')
       << "\n  parameters: " << info.parametersJson << "\n";
-  out << "  scale        t  samples  mean_nbrs  mls_steps  valid%  sample_s  project_s\n";
-  for (std::size_t j = 0; j < info.stats.size(); ++j) {
-    const ScaleStats& s = info.stats[j];
-    char line[160];
-    std::snprintf(line, sizeof line, "  %5zu %8.4g %8zu %10.1f %10.2f %7.2f %9.3f %10.3f\n", j, s.t,
-                  s.samples, s.meanNeighbors, s.meanMlsSteps,
-                  info.pointCount ? 100.0 * double(s.validPoints) / double(info.pointCount) : 0.0,
-                  s.samplingSeconds, s.projectionSeconds);
-    out << line;
-  }
+  out << scaleTable(info.stats, info.pointCount);
   return true;
 }
 
