@@ -39,8 +39,9 @@ std::uint64_t packCell(std::int64_t x, std::int64_t y, std::int64_t z) {
 /// and their targets grow with the cell's own key: asked for cells of increasing key (one colour
 /// of a task's range), each search gallops forward from where it ended for the previous cell.
 /// Measured (bench/fig_1_10 --points 1000000 --mode timing): the sampling of the 50 levels took
-/// 2.68 s with 9 binary searches over all cells per cell, 1.69 s with these cursors (with the
-/// flag scan of increasingIndices); the first level, about one point per cell, 0.47 -> 0.32 s.
+/// 2.68 s with 9 binary searches over all cells per cell, 1.69 s with these cursors and
+/// 1.45-1.60 s with the flag scan of increasingIndices too; the first level, about one point per
+/// cell, 0.47 -> 0.32 s.
 class NeighbourCells {
  public:
   explicit NeighbourCells(const std::vector<std::uint64_t>& keys) : keys_(keys) {}
