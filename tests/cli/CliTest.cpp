@@ -173,6 +173,8 @@ TEST_F(Cli, ExportCarriesTheInputAttributesOfTheStacksCloud) {
   EXPECT_FALSE(fs::exists(path("x.ply")));
   r = run("export " + path("st.stack") + " --point 1 --input " + path("st.ply"));
   EXPECT_EQ(r.code, 2) << r.err;
+  r = run("export " + path("st.stack") + " --scale 1 -o " + path("x.ply") + " --drop-invalid");
+  EXPECT_EQ(r.code, 2) << r.err;
 }
 
 TEST_F(Cli, CurvatureEstimatesNormalsWhenMissingAndNeverOverwritesItsInput) {

@@ -135,6 +135,14 @@ TEST_F(StackFixture, LayersInProcessingOrderAreWrittenInInputOrder) {
     // The streamed stack (computeScaleStack) too.
     computeScaleStack(cloud, options, b, {}, write);
     EXPECT_TRUE(stackFiles(b) == fa);
+    // Input indices that are not a permutation are refused (the encoder writes at them), and the
+    // stack already in place stays.
+    ScaleStack bad = permuted;
+    bad.layers[1].inputIndex[3] = bad.layers[1].inputIndex[4];
+    EXPECT_THROW(writeScaleStack(b, cloud, options, bad, write), Error);
+    bad.layers[1].inputIndex[3] = Index(cloud.size());
+    EXPECT_THROW(writeScaleStack(b, cloud, options, bad, write), Error);
+    EXPECT_TRUE(stackFiles(b) == fa);
   }
 }
 

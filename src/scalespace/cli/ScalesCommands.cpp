@@ -251,6 +251,7 @@ void addExportCommand(CLI::App& app) {
   cmd->callback([args, scale, point, input] {
     if (!*scale && !*point) throw OptionError("export needs --scale J or --point I");
     if (*input && !*scale) throw OptionError("--input goes with --scale");
+    if (args->input.dropInvalid && !*input) throw OptionError("--drop-invalid goes with --input");
     ScaleStackReader reader(args->stack);
     if (*scale) {
       if (args->output.empty()) throw OptionError("export --scale needs -o OUT.ply");

@@ -109,12 +109,9 @@ bool ScaleLayer::complete() const {
 
 ScaleLayer inInputOrder(const ScaleLayer& layer) {
   if (layer.inputIndex.empty()) return layer;
-  const std::size_t n = layer.size();
-  std::vector<Index> rank(n);
-  for (std::size_t k = 0; k < n; ++k) rank[layer.inputIndex[k]] = Index(k);
   ScaleLayer out;
-  out.resize(n);
-  toInputOrder(layer, rank, LayerContents::All, out);
+  out.resize(layer.size());
+  toInputOrder(layer, invertPermutation(layer.inputIndex), LayerContents::All, out);
   return out;
 }
 

@@ -81,7 +81,8 @@ struct ScaleLayer {
   bool complete() const;
 };
 
-/// The layer in input order (a copy of an input-order layer as it is).
+/// The layer in input order (a copy of an input-order layer as it is). Throws OptionError when
+/// inputIndex is not a permutation of 0..N-1.
 ScaleLayer inInputOrder(const ScaleLayer& layer);
 
 /// Receives each scale as soon as it is computed (j = 0..M-1), e.g. to stream it to disk.

@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/SpatialOrder.hpp"
 #include "scalespace/scales/StackQuantization.hpp"
 
 #ifndef SCALESPACE_VERSION
@@ -464,8 +465,8 @@ struct ScaleStackWriter::Impl {
   Vec3 origin;
   std::vector<double> scales;                    // t_j given to writeScale
   std::vector<double> inputRel;                  // compact: input positions - origin, 3 N
-  std::vector<Index> layerIndex;                 // compact: the inputIndex of the last layer...
-  std::vector<double> layerRel;                  // ... and inputRel in its order
+  std::vector<Index> layerIndex;                 // the inputIndex of the last layer (checked)...
+  std::vector<double> layerRel;                  // ... and, compact, inputRel in its order
   std::vector<std::uint8_t> validScratch;        // compact: the validity flags in input order
   std::vector<std::vector<unsigned char>> bufs;  // compact: one scale, encoded
   std::vector<std::size_t> clamped;              // compact: clamped values per file
@@ -572,21 +573,25 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
   if (!(t > 0) || !std::isfinite(t))
     throw Error("ScaleStackWriter: scale " + std::to_string(j) + " has t = " + std::to_string(t));
   const bool compact = d.encoding == StackEncoding::Compact;
-  if (compact) {
-    const std::vector<double>* rel = &d.inputRel;
-    if (!layer.inputIndex.empty()) {
-      // The same processing order at every scale of a stack: the positions reordered once.
-      if (layer.inputIndex != d.layerIndex) {
-        d.layerIndex = layer.inputIndex;
-        d.layerRel.resize(3 * d.n);
-        for (std::size_t e = 0; e < d.n; ++e)
-          for (std::size_t c = 0; c < 3; ++c)
-            d.layerRel[3 * e + c] = d.inputRel[3 * std::size_t(d.layerIndex[e]) + c];
-      }
-      rel = &d.layerRel;
+  // A layer in processing order: the same order at every scale of a stack, so it is checked (the
+  // encoder writes at these indices) and the positions are put in its order once.
+  if (!layer.inputIndex.empty() && layer.inputIndex != d.layerIndex) {
+    try {
+      invertPermutation(layer.inputIndex);
+    } catch (const OptionError& e) {
+      throw Error(std::string("ScaleStackWriter: the layer's input indices: ") + e.what());
     }
-    encodeCompact(layer, t, *rel, d.codecs, d.bufs, d.clamped, d.validScratch);
+    d.layerIndex = layer.inputIndex;
+    if (compact) {
+      d.layerRel.resize(3 * d.n);
+      for (std::size_t e = 0; e < d.n; ++e)
+        for (std::size_t c = 0; c < 3; ++c)
+          d.layerRel[3 * e + c] = d.inputRel[3 * std::size_t(d.layerIndex[e]) + c];
+    }
   }
+  if (compact)
+    encodeCompact(layer, t, layer.inputIndex.empty() ? d.inputRel : d.layerRel, d.codecs, d.bufs,
+                  d.clamped, d.validScratch);
   // Float32 stores the arrays as they are: in input order.
   std::optional<ScaleLayer> reordered;
   if (!compact && !layer.inputIndex.empty()) reordered = inInputOrder(layer);
