@@ -7,7 +7,9 @@
 
 #include "PlanesTestScenes.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/planes/PlaneDetection.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
 
 using namespace scalespace;
 
@@ -75,6 +77,24 @@ TEST(RegionGrowing, SeedNormalCriterionAndDeterminism) {
   std::size_t assigned = 0;
   for (const auto& r : seg.regions) assigned += r.size();
   EXPECT_EQ(assigned, 5u);
+}
+
+// The graph's distance to the k-th neighbour is knnRadii's (brute force), so the stack can take
+// its automatic t_min from it; a graph of k points or fewer has none.
+TEST(KnnGraph, KthDistanceIsTheKnnRadius) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 500; ++i) pts.emplace_back(u(rng), u(rng), 0.1 * u(rng));
+  pts.push_back(pts[7]);  // a duplicate
+  const KnnGraph graph = buildKnnGraph(pts, 10);
+  const BruteForceIndex brute(pts);
+  const std::vector<double> radii = knnRadii(pts, brute, 10);
+  ASSERT_EQ(graph.kthDistance.size(), pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(graph.kthDistance[i], radii[i]) << i;
+  EXPECT_EQ(lowerMedian(graph.kthDistance), medianKnnRadius(pts, brute, 10));
+  const std::vector<Vec3> few(pts.begin(), pts.begin() + 10);
+  EXPECT_TRUE(buildKnnGraph(few, 10).kthDistance.empty());
 }
 
 TEST(RegionGrowing, MortonOrderedWalkGivesTheSameRegions) {

@@ -53,6 +53,11 @@ TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
   ASSERT_EQ(model.scaleCount(), 8);
+  // t_min came from the k-NN graph's distances: the same series as the stack computes alone.
+  const ScaleSeriesResult alone = makeScaleSeries(cloud.positions(), stack.series);
+  EXPECT_TRUE(result.stack.series.tMinAuto);
+  EXPECT_EQ(result.stack.series.tMin, alone.tMin);
+  EXPECT_EQ(result.stack.series.scales, alone.scales);
 
   const std::map<int, int> bestPersistence = facePersistence(model, gt);
   EXPECT_EQ(bestPersistence.size(), 6u);

@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
@@ -19,11 +21,14 @@ KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k,
   graph.neighbors.resize(n * perPoint);
   for (std::size_t i = 0; i <= n; ++i) graph.offsets[i] = i * perPoint;
   const auto index = makeSpatialIndex(positions);
+  if (n > k) graph.kthDistance.resize(n);
   ProgressTracker tracker(progress, "neighbour graph", n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
     std::vector<Neighbor> found;
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       index->knnSearch(positions[i], perPoint + 1, found);
+      // The k + 1 nearest, the point itself included: what knnRadii queries for K = k.
+      if (!graph.kthDistance.empty()) graph.kthDistance[i] = std::sqrt(found.back().distSq);
       std::size_t out = graph.offsets[i];
       for (const Neighbor& nb : found) {
         if (nb.index == i || out == graph.offsets[i + 1]) continue;

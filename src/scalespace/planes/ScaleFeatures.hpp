@@ -31,6 +31,10 @@ struct KnnGraph {
   /// neighbours of a point lie anywhere in memory and the walk waited on cache misses (perf, 200k
   /// points); on 1M Stairs points segmentation went from 17.2 s to 11.8 s.
   std::vector<Index> order, rank, localNeighbors;
+  /// Per point, the distance to its k-th nearest other point (knnRadii of scales/ScaleSeries with
+  /// K = k, from the same queries): its median is the automatic t_min of the stack, which then
+  /// needs no second round of k-NN queries (filled by buildKnnGraph when n > k).
+  std::vector<double> kthDistance;
 };
 
 /// Builds the graph with makeSpatialIndex (k = 10 in Sec. 2.3.1). Parallel; deterministic.

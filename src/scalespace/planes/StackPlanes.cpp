@@ -39,6 +39,11 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   };
   start = std::chrono::steady_clock::now();
   ScaleSpaceOptions stack = stackOptions;
+  // The graph's queries are those of the automatic t_min when its k is the series' K (both 10:
+  // Sec. 1.5.1 and 2.3.1).
+  if (!knn.kthDistance.empty() && stack.series.K > 0 &&
+      std::size_t(stack.series.K) * knn.size() == knn.neighbors.size())
+    stack.series.knownMedianKnnRadius = lowerMedian(knn.kthDistance);
   stack.layerContents = LayerContents::NormalAndCurvatures;  // what scaleFeaturesFromLayer reads
   out.stack = runScaleSpace(cloud, stack, sink, progress);
   out.stackSeconds =

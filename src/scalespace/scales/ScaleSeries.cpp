@@ -65,11 +65,15 @@ std::vector<double> knnRadii(const std::vector<Vec3>& positions, const SpatialIn
   return radii;
 }
 
+double lowerMedian(std::vector<double> values) {
+  if (values.empty()) throw OptionError("the median of no values is undefined");
+  const std::size_t mid = (values.size() - 1) / 2;
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(mid), values.end());
+  return values[mid];
+}
+
 double medianKnnRadius(const std::vector<Vec3>& positions, const SpatialIndex& index, int K) {
-  std::vector<double> radii = knnRadii(positions, index, K);
-  const std::size_t mid = (radii.size() - 1) / 2;
-  std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(mid), radii.end());
-  return radii[mid];
+  return lowerMedian(knnRadii(positions, index, K));
 }
 
 ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
@@ -81,7 +85,9 @@ ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
   r.tMaxAuto = options.tMax == 0;
   r.tMin = options.tMin;
   r.tMax = options.tMax;
-  if (r.tMinAuto) {
+  if (r.tMinAuto && options.knownMedianKnnRadius > 0) {
+    r.tMin = options.knownMedianKnnRadius;
+  } else if (r.tMinAuto) {
     std::unique_ptr<SpatialIndex> own;
     if (!index) {
       own = makeSpatialIndex(positions);

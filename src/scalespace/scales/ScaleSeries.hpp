@@ -25,6 +25,10 @@ struct ScaleSeriesOptions {
   double tMin = 0;  // 0: median K-NN radius (Sec. 1.5.1)
   double tMax = 0;  // 0: bounding-box diagonal (Sec. 1.5.1)
   int K = 10;       // neighbours enclosed by t_min (Sec. 1.5.1: K = 10)
+  /// The median K-NN radius when the caller has the K-NN distances already (planes/: from the
+  /// k-NN graph of Sec. 2.3.1, whose k is this K): used for the automatic t_min instead of
+  /// querying every point again. 0: computed. Must be medianOf(knnRadii(positions, ., K)).
+  double knownMedianKnnRadius = 0;
 };
 
 /// t_j for j = 1..M (returned 0-based). Log: t_j = tMin (tMax/tMin)^((j-1)/(M-1)) (corrected
@@ -39,6 +43,10 @@ std::vector<double> knnRadii(const std::vector<Vec3>& positions, const SpatialIn
 
 /// The homogeneous t_min of Sec. 1.5.1: the median of knnRadii (lower median for even counts).
 double medianKnnRadius(const std::vector<Vec3>& positions, const SpatialIndex& index, int K);
+
+/// The lower median of `values` (what medianKnnRadius takes of the radii). Throws OptionError
+/// when empty.
+double lowerMedian(std::vector<double> values);
 
 struct ScaleSeriesResult {
   std::vector<double> scales;  // t_1..t_M

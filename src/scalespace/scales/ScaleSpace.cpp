@@ -154,10 +154,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   const std::vector<Index> order = spatialOrder(cloud.positions());
   const std::vector<Vec3> positions = applyPermutation(cloud.positions(), order);
   const std::vector<Vec3> normals = applyPermutation(cloud.normals(), order);
-  {
-    auto index = makeSpatialIndex(positions);
-    summary.series = makeScaleSeries(positions, options.series, index.get());
-  }
+  // Builds an index only when t_min is automatic and not known already.
+  summary.series = makeScaleSeries(positions, options.series);
   const std::vector<double>& scales = summary.series.scales;
   const std::size_t m = scales.size();
   if (!(options.alpha >= 0) || !std::isfinite(options.alpha))
