@@ -1,5 +1,7 @@
 #include "scalespace/fit/DerivativeSums.hpp"
 
+#include <algorithm>
+
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
 // GCC 12's AVX-512 intrinsics trip -Wuninitialized inside the header (GCC bug 105593; see
 // fit/RobustReweighting.cpp).
@@ -16,7 +18,47 @@ namespace {
 void accumulatePortable(const DerivativeChunk& c, int m, DerivativeSums& sums) {
   for (int k = 0; k < m; ++k)
     for (int i = 0; i < 9; ++i)
-      for (int j = 0; j < 12; ++j) sums[i][j] += c.items[k][i] * c.factors[k][j];
+      for (int j = 0; j < 12; ++j) sums[i][j] += c.items[i][k] * c.factors[k][j];
+}
+
+/// One sample's item and factors into row m of the chunk; false (nothing written) when it has
+/// no positive weight.
+inline bool formSample(const Vec3& q, const Vec3& n, double e, const WeightKernel& kernel,
+                       DerivativeChunk& chunk, int m) {
+  const double d2 = q.squaredNorm();
+  const double r = kernel.ratio(d2);
+  if (r >= 1) return false;
+  const double rm1 = r - 1;
+  const double w = rm1 * rm1 * e;
+  if (!(w > 0)) return false;
+  const double item[9] = {1.0, q.x(), q.y(), q.z(), n.x(), n.y(), n.z(), q.dot(n), d2};
+  for (int i = 0; i < 9; ++i) chunk.items[i][m] = item[i];
+  const double g = -4 * rm1 * kernel.invT2 * e;  // grad_x w = g q
+  const double b = 8 * kernel.invT2 * kernel.invT2 * e;
+  double* f = chunk.factors[m];
+  f[0] = w;
+  f[1] = g * q.x(), f[2] = g * q.y(), f[3] = g * q.z();
+  f[4] = 4 * rm1 * kernel.invT2 * e;
+  f[5] = b * q.x() * q.x(), f[6] = b * q.y() * q.y(), f[7] = b * q.z() * q.z();
+  f[8] = b * q.x() * q.y(), f[9] = b * q.x() * q.z(), f[10] = b * q.y() * q.z();
+  f[11] = kernel.scaleDerivative(r) * e;
+  return true;
+}
+
+int addSamplesOneByOne(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
+                       const Vec3& x, const WeightKernel& kernel, DerivativeSums& sums,
+                       SimdKernel simd) {
+  DerivativeChunk chunk;
+  int used = 0;
+  std::size_t k = 0;
+  while (k < count) {
+    int m = 0;
+    for (; k < count && m < DerivativeChunk::kSize; ++k)
+      if (formSample(p[k] - x, n[k], e[k], kernel, chunk, m)) ++m;
+    used += m;
+    accumulateDerivativeSums(chunk, m, sums, simd);
+  }
+  return used;
 }
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
@@ -30,7 +72,7 @@ __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c
     for (int k = 0; k < m; ++k) {
       const __m256d f = _mm256_load_pd(&c.factors[k][jb]);
       for (int i = 0; i < 9; ++i)
-        acc[i] = _mm256_fmadd_pd(_mm256_broadcast_sd(&c.items[k][i]), f, acc[i]);
+        acc[i] = _mm256_fmadd_pd(_mm256_broadcast_sd(&c.items[i][k]), f, acc[i]);
     }
     for (int i = 0; i < 9; ++i) {
       alignas(32) double lane[4];
@@ -51,7 +93,7 @@ __attribute__((target("avx512f,avx512dq,avx512vl,fma"))) void accumulateAvx512(
     const __m512d f0 = _mm512_loadu_pd(&c.factors[k][0]);
     const __m256d f1 = _mm256_load_pd(&c.factors[k][8]);
     for (int i = 0; i < 9; ++i) {
-      const double item = c.items[k][i];
+      const double item = c.items[i][k];
       lo[i] = _mm512_fmadd_pd(_mm512_set1_pd(item), f0, lo[i]);
       hi[i] = _mm256_fmadd_pd(_mm256_set1_pd(item), f1, hi[i]);
     }
@@ -63,9 +105,148 @@ __attribute__((target("avx512f,avx512dq,avx512vl,fma"))) void accumulateAvx512(
     for (int j = 0; j < 12; ++j) sums[i][j] += lane[j];
   }
 }
+
+#define SCALESPACE_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,fma")))
+
+/// Rows k of eight factor vectors (lane k = sample k): an 8 x 8 transpose in three rounds of
+/// two-element, 128-bit and 256-bit interleaves; row k goes to out[k][0..7].
+SCALESPACE_AVX512 inline void storeRows8(const __m512d* f, double (*out)[12]) {
+  __m512d t[8], u[8];
+  for (int p = 0; p < 4; ++p) {
+    t[2 * p] = _mm512_unpacklo_pd(f[2 * p], f[2 * p + 1]);      // f_{2p}, f_{2p+1} at even k
+    t[2 * p + 1] = _mm512_unpackhi_pd(f[2 * p], f[2 * p + 1]);  // and at odd k
+  }
+  // u[0]: k = 0, 4 of f0..f3; u[1]: k = 2, 6; u[2]: k = 1, 5; u[3]: k = 3, 7 (u[4..7]: f4..f7).
+  for (int h = 0; h < 2; ++h) {
+    u[4 * h + 0] = _mm512_shuffle_f64x2(t[4 * h + 0], t[4 * h + 2], 0x88);
+    u[4 * h + 1] = _mm512_shuffle_f64x2(t[4 * h + 0], t[4 * h + 2], 0xDD);
+    u[4 * h + 2] = _mm512_shuffle_f64x2(t[4 * h + 1], t[4 * h + 3], 0x88);
+    u[4 * h + 3] = _mm512_shuffle_f64x2(t[4 * h + 1], t[4 * h + 3], 0xDD);
+  }
+  const int rowOf[4][2] = {{0, 4}, {2, 6}, {1, 5}, {3, 7}};
+  for (int v = 0; v < 4; ++v) {
+    _mm512_storeu_pd(out[rowOf[v][0]], _mm512_shuffle_f64x2(u[v], u[v + 4], 0x88));
+    _mm512_storeu_pd(out[rowOf[v][1]], _mm512_shuffle_f64x2(u[v], u[v + 4], 0xDD));
+  }
+}
+
+/// Rows k of four factor vectors into out[k][8..11].
+SCALESPACE_AVX512 inline void storeRows4(const __m512d* f, double (*out)[12]) {
+  const __m512d lo01 = _mm512_unpacklo_pd(f[0], f[1]), hi01 = _mm512_unpackhi_pd(f[0], f[1]);
+  const __m512d lo23 = _mm512_unpacklo_pd(f[2], f[3]), hi23 = _mm512_unpackhi_pd(f[2], f[3]);
+  // Rows 0 and 2 from the even samples' pairs, rows 4 and 6 from the next ones.
+  const __m512i first = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
+  const __m512i second = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+  const __m512d r02 = _mm512_permutex2var_pd(lo01, first, lo23);
+  const __m512d r46 = _mm512_permutex2var_pd(lo01, second, lo23);
+  const __m512d r13 = _mm512_permutex2var_pd(hi01, first, hi23);
+  const __m512d r57 = _mm512_permutex2var_pd(hi01, second, hi23);
+  const __m512d pairs[4] = {r02, r13, r46, r57};  // rows (0, 2), (1, 3), (4, 6), (5, 7)
+  const int rowOf[4] = {0, 1, 4, 5};
+  for (int v = 0; v < 4; ++v) {
+    _mm256_store_pd(out[rowOf[v]] + 8, _mm512_castpd512_pd256(pairs[v]));
+    _mm256_store_pd(out[rowOf[v] + 2] + 8, _mm512_extractf64x4_pd(pairs[v], 1));
+  }
+}
+
+/// Coordinates x, y, z of eight packed Vec3 (24 doubles from `base`; `count` < 8 reads only
+/// 3 count doubles, the other lanes are 0).
+SCALESPACE_AVX512 inline void loadVec3x8(const double* base, std::size_t count, __m512d& x,
+                                         __m512d& y, __m512d& z) {
+  const unsigned nd = unsigned(3 * std::min<std::size_t>(count, 8));
+  auto maskOf = [](unsigned from, unsigned nd) {
+    return nd >= from + 8 ? __mmask8(0xff) : nd > from ? __mmask8((1u << (nd - from)) - 1) : 0;
+  };
+  const __m512d v0 = _mm512_maskz_loadu_pd(maskOf(0, nd), base);
+  const __m512d v1 = _mm512_maskz_loadu_pd(maskOf(8, nd), base + 8);
+  const __m512d v2 = _mm512_maskz_loadu_pd(maskOf(16, nd), base + 16);
+  // Element 3 s + c of the 24 is coordinate c of sample s: the first six samples come from
+  // v0 and v1, the last two or three from v2.
+  x = _mm512_permutex2var_pd(
+      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), v1),
+      _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), v2);
+  y = _mm512_permutex2var_pd(
+      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), v1),
+      _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), v2);
+  z = _mm512_permutex2var_pd(
+      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), v1),
+      _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), v2);
+}
+
+/// addDerivativeSamples with eight samples formed at a time (formSample's arithmetic, lanes
+/// without a positive weight zeroed instead of skipped). Measured with perf on the robust 200k
+/// Stairs stack: see fit/OrientedSphereFit.cpp.
+SCALESPACE_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
+                                       std::size_t count, const Vec3& x,
+                                       const WeightKernel& kernel, DerivativeSums& sums) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays must be packed x, y, z");
+  static_assert(DerivativeChunk::kSize % 8 == 0, "chunks hold whole groups of eight");
+  alignas(64) DerivativeChunk chunk;
+  const __m512d cx = _mm512_set1_pd(x.x()), cy = _mm512_set1_pd(x.y()), cz = _mm512_set1_pd(x.z());
+  const __m512d invT2 = _mm512_set1_pd(kernel.invT2), one = _mm512_set1_pd(1.0);
+  const __m512d minus4InvT2 = _mm512_set1_pd(-4 * kernel.invT2);
+  const __m512d b0 = _mm512_set1_pd(8 * kernel.invT2 * kernel.invT2);
+  const __m512d minus4InvT = _mm512_set1_pd(-4 / kernel.t);
+  const __m512d zero = _mm512_setzero_pd();
+  const double* pd = p->data();
+  const double* nd = n->data();
+  int used = 0;
+  std::size_t k = 0;
+  while (k < count) {
+    int m = 0;
+    for (; k < count && m < DerivativeChunk::kSize; k += 8, m += 8) {
+      const std::size_t rest = count - k;
+      const __mmask8 lanes = rest >= 8 ? __mmask8(0xff) : __mmask8((1u << rest) - 1);
+      __m512d px, py, pz, nx, ny, nz;
+      loadVec3x8(pd + 3 * k, rest, px, py, pz);
+      loadVec3x8(nd + 3 * k, rest, nx, ny, nz);
+      const __m512d qx = _mm512_sub_pd(px, cx), qy = _mm512_sub_pd(py, cy),
+                    qz = _mm512_sub_pd(pz, cz);
+      const __m512d ew = _mm512_maskz_loadu_pd(lanes, e + k);
+      const __m512d d2 = _mm512_fmadd_pd(qx, qx, _mm512_fmadd_pd(qy, qy, _mm512_mul_pd(qz, qz)));
+      const __m512d r = _mm512_mul_pd(d2, invT2);
+      const __m512d rm1 = _mm512_sub_pd(r, one);
+      const __m512d w = _mm512_mul_pd(_mm512_mul_pd(rm1, rm1), ew);
+      // formSample's tests: r < 1 and w > 0 (both false for NaN).
+      const __mmask8 live = _mm512_mask_cmp_pd_mask(
+          _mm512_mask_cmp_pd_mask(lanes, r, one, _CMP_LT_OQ), w, zero, _CMP_GT_OQ);
+      used += __builtin_popcount(live);
+      const __m512d g = _mm512_mul_pd(_mm512_mul_pd(minus4InvT2, rm1), ew);
+      const __m512d b = _mm512_mul_pd(b0, ew);
+      const __m512d bx = _mm512_mul_pd(b, qx), by = _mm512_mul_pd(b, qy);
+      __m512d f[12];
+      f[0] = w;
+      f[1] = _mm512_mul_pd(g, qx), f[2] = _mm512_mul_pd(g, qy), f[3] = _mm512_mul_pd(g, qz);
+      f[4] = _mm512_sub_pd(zero, g);  // 4 (r - 1) e / t^2
+      f[5] = _mm512_mul_pd(bx, qx), f[6] = _mm512_mul_pd(by, qy);
+      f[7] = _mm512_mul_pd(_mm512_mul_pd(b, qz), qz);
+      f[8] = _mm512_mul_pd(bx, qy), f[9] = _mm512_mul_pd(bx, qz), f[10] = _mm512_mul_pd(by, qz);
+      f[11] = _mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(minus4InvT, rm1), r), ew);  // dw/dt e
+      for (__m512d& v : f) v = _mm512_maskz_mov_pd(live, v);
+      const __m512d item[9] = {
+          one, qx, qy, qz, nx, ny, nz,
+          _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))), d2};
+      for (int i = 0; i < 9; ++i)
+        _mm512_store_pd(&chunk.items[i][m], _mm512_maskz_mov_pd(live, item[i]));
+      storeRows8(f, chunk.factors + m);
+      storeRows4(f + 8, chunk.factors + m);
+    }
+    accumulateAvx512(chunk, m, sums);
+  }
+  return used;
+}
 #endif
 
 }  // namespace
+
+int addDerivativeSamples(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
+                         const Vec3& x, const WeightKernel& weight, DerivativeSums& sums,
+                         SimdKernel kernel) {
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx512(kernel)) return addSamplesAvx512(p, n, e, count, x, weight, sums);
+#endif
+  return addSamplesOneByOne(p, n, e, count, x, weight, sums, kernel);
+}
 
 void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,
                               SimdKernel kernel) {

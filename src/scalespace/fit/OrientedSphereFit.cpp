@@ -135,40 +135,8 @@ void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
                                                 const double* extraWeight, std::size_t count) {
   // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
   // instead of updating 108 member sums per sample.
-  DerivativeChunk chunk;
   DerivativeSums sums = {};
-  std::size_t k = 0;
-  while (k < count) {
-    int m = 0;
-    for (; k < count && m < DerivativeChunk::kSize; ++k) {
-      const Vec3 q = p[k] - x_;
-      const double d2 = q.squaredNorm();
-      const double r = kernel_.ratio(d2);
-      if (r >= 1) continue;
-      const double rm1 = r - 1;
-      const double e = extraWeight[k];
-      const double w = rm1 * rm1 * e;
-      if (!(w > 0)) continue;
-      double* item = chunk.items[m];
-      item[0] = 1.0;
-      item[1] = q.x(), item[2] = q.y(), item[3] = q.z();
-      item[4] = n[k].x(), item[5] = n[k].y(), item[6] = n[k].z();
-      item[7] = q.dot(n[k]);
-      item[8] = d2;
-      const double g = -4 * rm1 * kernel_.invT2 * e;  // grad_x w = g q
-      const double b = 8 * kernel_.invT2 * kernel_.invT2 * e;
-      double* f = chunk.factors[m];
-      f[0] = w;
-      f[1] = g * q.x(), f[2] = g * q.y(), f[3] = g * q.z();
-      f[4] = 4 * rm1 * kernel_.invT2 * e;
-      f[5] = b * q.x() * q.x(), f[6] = b * q.y() * q.y(), f[7] = b * q.z() * q.z();
-      f[8] = b * q.x() * q.y(), f[9] = b * q.x() * q.z(), f[10] = b * q.y() * q.z();
-      f[11] = kernel_.scaleDerivative(r) * e;
-      ++m;
-    }
-    count_ += m;
-    accumulateDerivativeSums(chunk, m, sums);
-  }
+  count_ += addDerivativeSamples(p, n, extraWeight, count, x_, kernel_, sums);
   for (int i = 0; i < 9; ++i) {
     s_[i] += sums[i][0];
     if (order_ >= FitDerivatives::First)
