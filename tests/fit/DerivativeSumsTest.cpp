@@ -87,15 +87,15 @@ void referenceSamples(const std::vector<Vec3>& p, const std::vector<Vec3>& n,
   used = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const Vec3 q = p[k] - x;
-    const long double d2 = (long double)q.x() * q.x() + (long double)q.y() * q.y() +
-                           (long double)q.z() * q.z();
+    const long double d2 =
+        (long double)q.x() * q.x() + (long double)q.y() * q.y() + (long double)q.z() * q.z();
     const long double r = d2 * kernel.invT2, rm1 = r - 1, w = rm1 * rm1 * e[k];
     if (!(r < 1) || !(w > 0)) continue;
     ++used;
     const long double b = 8.0L * kernel.invT2 * kernel.invT2 * e[k];
     const long double g = -4.0L * rm1 * kernel.invT2 * e[k];
-    const long double item[9] = {1, q.x(), q.y(), q.z(), n[k].x(), n[k].y(), n[k].z(),
-                                 (long double)q.dot(n[k]), d2};
+    const long double item[9] = {
+        1, q.x(), q.y(), q.z(), n[k].x(), n[k].y(), n[k].z(), (long double)q.dot(n[k]), d2};
     const long double f[12] = {w,
                                g * q.x(),
                                g * q.y(),
@@ -131,8 +131,8 @@ void expectSamplesMatchReference(SimdKernel kernel) {
   p[20] = Vec3(NAN, 0, 0);  // skipped, as by add()
   for (std::size_t count = 0; count <= p.size(); ++count) {
     DerivativeSums sums = {};
-    const int used = addDerivativeSamples(p.data(), n.data(), e.data(), count, x, weight, sums,
-                                          kernel);
+    const int used =
+        addDerivativeSamples(p.data(), n.data(), e.data(), count, x, weight, sums, kernel);
     long double ref[9][12], mag[9][12];
     int refUsed = 0;
     referenceSamples(p, n, e, count, x, weight, ref, mag, refUsed);

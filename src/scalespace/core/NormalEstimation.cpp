@@ -7,6 +7,9 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <string>
+#include <vector>
+
+#include "scalespace/core/SpatialOrder.hpp"
 
 namespace scalespace {
 namespace {
@@ -72,13 +75,17 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
   result.surfaceVariation.assign(n, 1.0 / 3.0);
   result.valid.assign(n, 0);
 
+  // Queries along the Morton curve walk the same branches of the index one after another (a
+  // scan's points may come in any order); each point's result is its own, so nothing changes.
+  const std::vector<Index> order = spatialOrder(points);
   ProgressTracker tracker(progress, "normal estimation", n);
   tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       if (tracker.cancelled()) return;
                       std::vector<Neighbor>& nbrs = scratch.local();
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const std::size_t i = order[v];
                         if (options.radius > 0.0)
                           index.radiusSearch(points[i], options.radius, nbrs);
                         else

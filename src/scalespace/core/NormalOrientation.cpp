@@ -8,6 +8,9 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
+
+#include "scalespace/core/SpatialOrder.hpp"
 
 namespace scalespace {
 namespace {
@@ -118,13 +121,16 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   std::vector<Edge> edges(n * k, Edge{0.0f, kNone, kNone});
   std::vector<Index> adopter(n, kNone);
   {
+    // Queries along the Morton curve (as in NormalEstimation); each point fills its own slots.
+    const std::vector<Index> order = spatialOrder(points);
     ProgressTracker tracker(progress, "orientation graph", n);
     tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         if (tracker.cancelled()) return;
                         std::vector<Neighbor>& nbrs = scratch.local();
-                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                          const std::size_t i = order[v];
                           if (!usable(oriented[i])) continue;
                           index.knnSearch(points[i], k + 1, nbrs);
                           std::size_t slot = 0;

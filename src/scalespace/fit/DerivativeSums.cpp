@@ -177,8 +177,8 @@ SCALESPACE_AVX512 inline void loadVec3x8(const double* base, std::size_t count, 
 /// without a positive weight zeroed instead of skipped). Measured with perf on the robust 200k
 /// Stairs stack: see fit/OrientedSphereFit.cpp.
 SCALESPACE_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
-                                       std::size_t count, const Vec3& x,
-                                       const WeightKernel& kernel, DerivativeSums& sums) {
+                                       std::size_t count, const Vec3& x, const WeightKernel& kernel,
+                                       DerivativeSums& sums) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays must be packed x, y, z");
   static_assert(DerivativeChunk::kSize % 8 == 0, "chunks hold whole groups of eight");
   alignas(64) DerivativeChunk chunk;
@@ -224,8 +224,9 @@ SCALESPACE_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const doubl
       f[11] = _mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(minus4InvT, rm1), r), ew);  // dw/dt e
       for (__m512d& v : f) v = _mm512_maskz_mov_pd(live, v);
       const __m512d item[9] = {
-          one, qx, qy, qz, nx, ny, nz,
-          _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))), d2};
+          one, qx, qy, qz,
+          nx,  ny, nz, _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))),
+          d2};
       for (int i = 0; i < 9; ++i)
         _mm512_store_pd(&chunk.items[i][m], _mm512_maskz_mov_pd(live, item[i]));
       storeRows8(f, chunk.factors + m);

@@ -22,10 +22,15 @@ KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k,
   for (std::size_t i = 0; i <= n; ++i) graph.offsets[i] = i * perPoint;
   const auto index = makeSpatialIndex(positions);
   if (n > k) graph.kthDistance.resize(n);
+  // The queries run along the Morton curve: consecutive queries walk the same branches of the
+  // tree (in input order, a scan's points may come in any order). Each query is independent, so
+  // the graph is the same.
+  graph.order = spatialOrder(positions);
   ProgressTracker tracker(progress, "neighbour graph", n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
     std::vector<Neighbor> found;
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+    for (std::size_t v = range.begin(); v != range.end(); ++v) {
+      const std::size_t i = graph.order[v];
       index->knnSearch(positions[i], perPoint + 1, found);
       // The k + 1 nearest, the point itself included: what knnRadii queries for K = k.
       if (!graph.kthDistance.empty()) graph.kthDistance[i] = std::sqrt(found.back().distSq);
@@ -40,7 +45,6 @@ KnnGraph buildKnnGraph(const std::vector<Vec3>& positions, std::size_t k,
     tracker.advance(range.size());
   });
   tracker.finish();
-  graph.order = spatialOrder(positions);
   graph.rank.resize(n);
   for (std::size_t v = 0; v < n; ++v) graph.rank[graph.order[v]] = Index(v);
   graph.localNeighbors.resize(graph.neighbors.size());
