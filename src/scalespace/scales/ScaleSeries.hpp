@@ -27,7 +27,7 @@ struct ScaleSeriesOptions {
   int K = 10;       // neighbours enclosed by t_min (Sec. 1.5.1: K = 10)
   /// The median K-NN radius when the caller has the K-NN distances already (planes/: from the
   /// k-NN graph of Sec. 2.3.1, whose k is this K): used for the automatic t_min instead of
-  /// querying every point again. 0: computed. Must be medianOf(knnRadii(positions, ., K)).
+  /// querying every point again. 0: computed. Must be lowerMedian(knnRadii(positions, ., K)).
   double knownMedianKnnRadius = 0;
 };
 
