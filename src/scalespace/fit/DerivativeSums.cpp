@@ -64,8 +64,7 @@ int addSamplesOneByOne(const Vec3* p, const Vec3* n, const double* e, std::size_
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
 // 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by.
 // Measured with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
-__attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c, int m,
-                                                        DerivativeSums& sums) {
+SCALESPACE_TARGET_AVX2 void accumulateAvx2(const DerivativeChunk& c, int m, DerivativeSums& sums) {
   for (int jb = 0; jb < 12; jb += 4) {
     __m256d acc[9];
     for (__m256d& a : acc) a = _mm256_setzero_pd();
@@ -84,8 +83,8 @@ __attribute__((target("avx2,fma"))) void accumulateAvx2(const DerivativeChunk& c
 
 // The same block with 8 + 4 columns per pass over the samples instead of 4 + 4 + 4: 18
 // fused multiply-adds per sample instead of 27, all accumulators in the 32 registers.
-__attribute__((target("avx512f,avx512dq,avx512vl,fma"))) void accumulateAvx512(
-    const DerivativeChunk& c, int m, DerivativeSums& sums) {
+SCALESPACE_TARGET_AVX512 void accumulateAvx512(const DerivativeChunk& c, int m,
+                                               DerivativeSums& sums) {
   __m512d lo[9];
   __m256d hi[9];
   for (int i = 0; i < 9; ++i) lo[i] = _mm512_setzero_pd(), hi[i] = _mm256_setzero_pd();
@@ -106,11 +105,9 @@ __attribute__((target("avx512f,avx512dq,avx512vl,fma"))) void accumulateAvx512(
   }
 }
 
-#define SCALESPACE_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,fma")))
-
 /// Rows k of eight factor vectors (lane k = sample k): an 8 x 8 transpose in three rounds of
 /// two-element, 128-bit and 256-bit interleaves; row k goes to out[k][0..7].
-SCALESPACE_AVX512 inline void storeRows8(const __m512d* f, double (*out)[12]) {
+SCALESPACE_TARGET_AVX512 inline void storeRows8(const __m512d* f, double (*out)[12]) {
   __m512d t[8], u[8];
   for (int p = 0; p < 4; ++p) {
     t[2 * p] = _mm512_unpacklo_pd(f[2 * p], f[2 * p + 1]);      // f_{2p}, f_{2p+1} at even k
@@ -131,7 +128,7 @@ SCALESPACE_AVX512 inline void storeRows8(const __m512d* f, double (*out)[12]) {
 }
 
 /// Rows k of four factor vectors into out[k][8..11].
-SCALESPACE_AVX512 inline void storeRows4(const __m512d* f, double (*out)[12]) {
+SCALESPACE_TARGET_AVX512 inline void storeRows4(const __m512d* f, double (*out)[12]) {
   const __m512d lo01 = _mm512_unpacklo_pd(f[0], f[1]), hi01 = _mm512_unpackhi_pd(f[0], f[1]);
   const __m512d lo23 = _mm512_unpacklo_pd(f[2], f[3]), hi23 = _mm512_unpackhi_pd(f[2], f[3]);
   // Rows 0 and 2 from the even samples' pairs, rows 4 and 6 from the next ones.
@@ -151,8 +148,8 @@ SCALESPACE_AVX512 inline void storeRows4(const __m512d* f, double (*out)[12]) {
 
 /// Coordinates x, y, z of eight packed Vec3 (24 doubles from `base`; `count` < 8 reads only
 /// 3 count doubles, the other lanes are 0).
-SCALESPACE_AVX512 inline void loadVec3x8(const double* base, std::size_t count, __m512d& x,
-                                         __m512d& y, __m512d& z) {
+SCALESPACE_TARGET_AVX512 inline void loadVec3x8(const double* base, std::size_t count, __m512d& x,
+                                                __m512d& y, __m512d& z) {
   const unsigned nd = unsigned(3 * std::min<std::size_t>(count, 8));
   auto maskOf = [](unsigned from, unsigned nd) {
     return nd >= from + 8 ? __mmask8(0xff) : nd > from ? __mmask8((1u << (nd - from)) - 1) : 0;
@@ -177,12 +174,12 @@ SCALESPACE_AVX512 inline void loadVec3x8(const double* base, std::size_t count, 
 /// without a positive weight zeroed instead of skipped). Measured: the robust 200k Stairs stack
 /// with one thread took 22.8-23.1 s against 23.8-24.0 s forming one sample at a time (runs
 /// interleaved); forming was ~2/3 of the pass in perf, the accumulation the rest.
-SCALESPACE_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
-                                       std::size_t count, const Vec3& x, const WeightKernel& kernel,
-                                       DerivativeSums& sums) {
+SCALESPACE_TARGET_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
+                                              std::size_t count, const Vec3& x,
+                                              const WeightKernel& kernel, DerivativeSums& sums) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays must be packed x, y, z");
   static_assert(DerivativeChunk::kSize % 8 == 0, "chunks hold whole groups of eight");
-  alignas(64) DerivativeChunk chunk;
+  DerivativeChunk chunk;  // alignas(64): its item columns take aligned stores
   const __m512d cx = _mm512_set1_pd(x.x()), cy = _mm512_set1_pd(x.y()), cz = _mm512_set1_pd(x.z());
   const __m512d invT2 = _mm512_set1_pd(kernel.invT2), one = _mm512_set1_pd(1.0);
   const __m512d minus4InvT2 = _mm512_set1_pd(-4 * kernel.invT2);

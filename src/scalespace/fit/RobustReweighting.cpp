@@ -69,12 +69,12 @@ double reweightPortable(const AlgebraicSphere& s, double invSr2, double invSn2,
 }
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-__attribute__((target("avx2,fma"))) inline __m256d splat(double v) { return _mm256_set1_pd(v); }
+SCALESPACE_TARGET_AVX2 inline __m256d splat(double v) { return _mm256_set1_pd(v); }
 
 /// expNegative (fit/FastExp.hpp) on four lanes: the same reduction and polynomial; the scaling by
 /// 2^-n goes through the exponent bits for every lane (FastExp uses ldexp for n > 1000, where
 /// exp(-x) < 1e-301: a weight that small is 0 for any purpose). x >= 708 and NaN give 0.
-__attribute__((target("avx2,fma"))) inline __m256d expNegative4(__m256d x) {
+SCALESPACE_TARGET_AVX2 inline __m256d expNegative4(__m256d x) {
   using namespace fastexp;
   const __m256d valid = _mm256_cmp_pd(x, splat(kMaxArgument), _CMP_LT_OQ);  // false for NaN
   x = _mm256_max_pd(_mm256_min_pd(x, splat(kMaxArgument)), _mm256_setzero_pd());
@@ -95,11 +95,10 @@ __attribute__((target("avx2,fma"))) inline __m256d expNegative4(__m256d x) {
   return _mm256_and_pd(_mm256_mul_pd(p, _mm256_castsi256_pd(e)), valid);
 }
 
-__attribute__((target("avx2,fma"))) double reweightAvx2(const AlgebraicSphere& s, double invSr2,
-                                                        double invSn2, const NeighborColumns& c,
-                                                        const std::vector<double>& previous,
-                                                        std::vector<double>& rho,
-                                                        SphereSums& next) {
+SCALESPACE_TARGET_AVX2 double reweightAvx2(const AlgebraicSphere& s, double invSr2, double invSn2,
+                                           const NeighborColumns& c,
+                                           const std::vector<double>& previous,
+                                           std::vector<double>& rho, SphereSums& next) {
   const __m256d uc = _mm256_set1_pd(s.uc), uq = _mm256_set1_pd(s.uq);
   const __m256d two_uq = _mm256_set1_pd(2 * s.uq);
   const __m256d ulx = _mm256_set1_pd(s.ul.x()), uly = _mm256_set1_pd(s.ul.y()),
@@ -166,13 +165,11 @@ __attribute__((target("avx2,fma"))) double reweightAvx2(const AlgebraicSphere& s
   return maxChange;
 }
 
-#define SCALESPACE_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,fma")))
-
-SCALESPACE_AVX512 inline __m512d splat8(double v) { return _mm512_set1_pd(v); }
+SCALESPACE_TARGET_AVX512 inline __m512d splat8(double v) { return _mm512_set1_pd(v); }
 
 /// expNegative (fit/FastExp.hpp) on eight lanes: the same reduction and polynomial as
 /// expNegative4; vscalefpd multiplies by 2^-n. x >= 708 and NaN give 0.
-SCALESPACE_AVX512 inline __m512d expNegative8(__m512d x) {
+SCALESPACE_TARGET_AVX512 inline __m512d expNegative8(__m512d x) {
   using namespace fastexp;
   const __mmask8 valid = _mm512_cmp_pd_mask(x, splat8(kMaxArgument), _CMP_LT_OQ);
   x = _mm512_max_pd(_mm512_min_pd(x, splat8(kMaxArgument)), _mm512_setzero_pd());
@@ -191,9 +188,9 @@ SCALESPACE_AVX512 inline __m512d expNegative8(__m512d x) {
 
 /// Adds eight neighbours with weights w to the 9 sums of SphereSums (lanes with w = 0 add
 /// nothing) and returns how many have a positive weight.
-SCALESPACE_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d qx, __m512d qy,
-                                         __m512d qz, __m512d nx, __m512d ny, __m512d nz,
-                                         __m512d d2) {
+SCALESPACE_TARGET_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d qx, __m512d qy,
+                                                __m512d qz, __m512d nx, __m512d ny, __m512d nz,
+                                                __m512d d2) {
   acc[0] = _mm512_add_pd(acc[0], w);
   acc[1] = _mm512_fmadd_pd(w, qx, acc[1]);
   acc[2] = _mm512_fmadd_pd(w, qy, acc[2]);
@@ -211,10 +208,10 @@ SCALESPACE_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d qx, __
 /// against 190 ns for the AVX2 one, whose body (~120 instructions for 4 neighbours, accumulators
 /// spilled: 16 registers) is latency-bound; here 32 registers hold everything and the last group's
 /// mask is a mask register.
-SCALESPACE_AVX512 double reweightAvx512(const AlgebraicSphere& s, double invSr2, double invSn2,
-                                        const NeighborColumns& c,
-                                        const std::vector<double>& previous,
-                                        std::vector<double>& rho, SphereSums& next) {
+SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double invSr2,
+                                               double invSn2, const NeighborColumns& c,
+                                               const std::vector<double>& previous,
+                                               std::vector<double>& rho, SphereSums& next) {
   const __m512d uc = splat8(s.uc), uq = splat8(s.uq), two_uq = splat8(2 * s.uq);
   const __m512d ulx = splat8(s.ul.x()), uly = splat8(s.ul.y()), ulz = splat8(s.ul.z());
   const __m512d sr = splat8(invSr2), sn = splat8(invSn2);
@@ -260,7 +257,7 @@ SCALESPACE_AVX512 double reweightAvx512(const AlgebraicSphere& s, double invSr2,
   return _mm512_reduce_max_pd(change);
 }
 
-SCALESPACE_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c, SphereSums& out) {
+SCALESPACE_TARGET_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c, SphereSums& out) {
   __m512d acc[9];
   for (__m512d& v : acc) v = _mm512_setzero_pd();
   int used = 0;

@@ -8,6 +8,10 @@
 // last bits (FMA rounds once).
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define SCALESPACE_HAVE_AVX2_TARGET 1
+// The instruction sets a function of each path is compiled for: what avx2FmaAvailable() and
+// avx512Available() check at run time.
+#define SCALESPACE_TARGET_AVX2 __attribute__((target("avx2,fma")))
+#define SCALESPACE_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,fma")))
 #endif
 
 namespace scalespace {
