@@ -197,9 +197,10 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
               double(found) / faceCount, persistent ? double(matched) / double(persistent) : 0.0,
               persistent, result.totalSeconds);
   std::printf(
-      "#   time split (s): stack %.2f, knn %.2f, segmentation %.2f, filtering %.2f, "
-      "graph %.3f, components %.2f\n",
-      result.stackSeconds, result.knnSeconds, t.segmentation, t.filtering, t.graph, t.components);
+      "#   time split (s): stack %.2f, knn %.2f, segmentation %.2f, filtering %.2f (both during "
+      "the stack; %.2f after it), graph %.3f, components %.2f\n",
+      result.stackSeconds, result.knnSeconds, t.segmentation, t.filtering,
+      result.segmentationWaitSeconds, t.graph, t.components);
   for (int q = 1; q <= 4; ++q) {
     const int level = q * model.scaleCount() / 5;
     std::map<int, std::vector<Index>> planes;

@@ -4,6 +4,7 @@
 #include <map>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/Parallel.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
 #include "scalespace/planes/StackPlanes.hpp"
@@ -82,4 +83,66 @@ TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
     EXPECT_THROW(detectPlanesFromStack(generateScene(SceneKind::Box, other), reader), FileError);
   }
   std::filesystem::remove_all(path);
+}
+
+namespace {
+PointCloud smallStairs() {
+  SceneOptions scene;
+  scene.pointCount = 4000;
+  scene.noise = 1e-4;
+  return generateScene(SceneKind::Stairs, scene);
+}
+
+ScaleSpaceOptions robustStack(int scales) {
+  ScaleSpaceOptions stack;
+  stack.series.count = scales;
+  stack.robust = true;
+  return stack;
+}
+
+void expectSameDetection(const PlaneDetection& a, const PlaneDetection& b) {
+  ASSERT_EQ(a.scaleCount(), b.scaleCount());
+  ASSERT_EQ(a.components.size(), b.components.size());
+  for (int level = 0; level < a.scaleCount(); ++level)
+    EXPECT_EQ(a.graph.componentLabels(level), b.graph.componentLabels(level)) << level;
+  for (std::size_t c = 0; c < a.components.size(); ++c) {
+    EXPECT_EQ(a.components[c].birthLevel, b.components[c].birthLevel);
+    EXPECT_EQ(a.components[c].deathLevel, b.components[c].deathLevel);
+    EXPECT_EQ(a.components[c].area, b.components[c].area);
+  }
+}
+}  // namespace
+
+// The pipeline segments scale j while the stack projects scale j+1 (tasks): its result must be
+// the sequential one (the whole stack first, then detectPlanes on every scale in order), for one
+// thread and for two.
+TEST(StackPlanes, OverlappedSegmentationEqualsTheSequentialPipeline) {
+  const PointCloud cloud = smallStairs();
+  const ScaleSpaceOptions stack = robustStack(12);
+  const ScaleStack layers = computeScaleSpace(cloud, stack);
+  std::vector<ScaleFeatures> features;
+  for (std::size_t j = 0; j < layers.layers.size(); ++j)
+    features.push_back(scaleFeaturesFromLayer(layers.layers[j], layers.summary.series.scales[j]));
+  const PlaneDetection sequential =
+      detectPlanes(cloud.positions(), buildKnnGraph(cloud.positions(), 10), features);
+  ASSERT_GT(sequential.components.size(), 2u);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    ThreadLimit limit(threads);
+    const StackPlaneDetection overlapped = detectPlanesInCloud(cloud, stack);
+    expectSameDetection(sequential, overlapped.detection);
+    EXPECT_GE(overlapped.segmentationWaitSeconds, 0);
+    EXPECT_GT(overlapped.detection.timings.segmentation, 0);
+  }
+}
+
+// Cancelling the stack while segmentations are pending: the tasks, which refer to the caller's
+// frame, end before it unwinds (the sanitizer build would report a use after return), and the
+// exception is the cancellation.
+TEST(StackPlanes, CancellingWhileSegmentingThrowsCancelled) {
+  const PointCloud cloud = smallStairs();
+  for (double stopAt : {0.05, 0.5, 0.95}) {
+    const ProgressCallback cancel = [stopAt](double f, std::string_view) { return f < stopAt; };
+    EXPECT_THROW(detectPlanesInCloud(cloud, robustStack(10), {}, cancel), Cancelled) << stopAt;
+  }
 }

@@ -312,11 +312,12 @@ void addPlanesCommand(CLI::App& app) {
     writePlaneModel(model, cloud.origin(), args->input.path, args->output);
     if (!args->quiet) {
       const auto& t = result.detection.timings;
+      // With a stack computed here, segmentation and filtering ran during it (StackPlanes.hpp).
       std::fprintf(stderr,
-                   "%zu components; time (s): stack %.2f, segmentation %.2f, filtering %.2f, "
+                   "%zu components; time (s): stack %.2f, segmentation %.2f, filtering %.2f%s, "
                    "graph %.2f, components %.2f\n",
                    model.components.size(), result.stackSeconds, t.segmentation, t.filtering,
-                   t.graph, t.components);
+                   args->stack.empty() ? " (during the stack)" : "", t.graph, t.components);
     }
     reportDone("planes", start, args->quiet);
   });
