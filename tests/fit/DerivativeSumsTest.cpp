@@ -1,6 +1,7 @@
 // The derivative-pass kernels: every implementation equals a long-double reference for every
-// chunk length, and the whole pass over samples (items and factors formed one by one or eight
-// at a time) equals the formula of OrientedSphereFit::add for every sample count.
+// chunk length, and the whole pass over samples, packed or as columns (items and factors formed
+// one by one or eight at a time), equals the formula of OrientedSphereFit::add for every sample
+// count.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -116,7 +117,9 @@ void referenceSamples(const std::vector<Vec3>& p, const std::vector<Vec3>& n,
   }
 }
 
-void expectSamplesMatchReference(SimdKernel kernel) {
+/// The pass over packed Vec3 samples (addDerivativeSamples) or, with `columns`, over the same
+/// samples as columns (addDerivativeColumns).
+void expectSamplesMatchReference(SimdKernel kernel, bool columns = false) {
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> u(-1, 1);
   const WeightKernel weight(0.7);
@@ -131,8 +134,14 @@ void expectSamplesMatchReference(SimdKernel kernel) {
   p[20] = Vec3(NAN, 0, 0);  // skipped, as by add()
   for (std::size_t count = 0; count <= p.size(); ++count) {
     DerivativeSums sums = {};
-    const int used =
-        addDerivativeSamples(p.data(), n.data(), e.data(), count, x, weight, sums, kernel);
+    int used = 0;
+    if (columns) {
+      NeighborColumns c;
+      for (std::size_t k = 0; k < count; ++k) c.push(p[k], n[k], -1.0);  // d2, weight unread
+      used = addDerivativeColumns(c, e.data(), x, weight, sums, kernel);
+    } else {
+      used = addDerivativeSamples(p.data(), n.data(), e.data(), count, x, weight, sums, kernel);
+    }
     long double ref[9][12], mag[9][12];
     int refUsed = 0;
     referenceSamples(p, n, e, count, x, weight, ref, mag, refUsed);
@@ -157,4 +166,13 @@ TEST(DerivativeSums, Avx512SamplePassMatchesTheFormula) {
 
 TEST(DerivativeSums, DefaultSamplePassMatchesTheFormula) {
   expectSamplesMatchReference(SimdKernel::Auto);
+}
+
+TEST(DerivativeSums, PortableColumnPassMatchesTheFormula) {
+  expectSamplesMatchReference(SimdKernel::Portable, true);
+}
+
+TEST(DerivativeSums, Avx512ColumnPassMatchesTheFormula) {
+  expectSamplesMatchReference(SimdKernel::Avx512, true);
+  if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: another kernel ran";
 }

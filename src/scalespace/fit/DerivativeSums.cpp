@@ -61,6 +61,24 @@ int addSamplesOneByOne(const Vec3* p, const Vec3* n, const double* e, std::size_
   return used;
 }
 
+int addColumnsOneByOne(const NeighborColumns& c, const double* e, const Vec3& x,
+                       const WeightKernel& kernel, DerivativeSums& sums, SimdKernel simd) {
+  DerivativeChunk chunk;
+  int used = 0;
+  std::size_t k = 0;
+  const std::size_t count = c.size();
+  while (k < count) {
+    int m = 0;
+    for (; k < count && m < DerivativeChunk::kSize; ++k) {
+      const Vec3 q = Vec3(c.qx[k], c.qy[k], c.qz[k]) - x;
+      if (formSample(q, Vec3(c.nx[k], c.ny[k], c.nz[k]), e[k], kernel, chunk, m)) ++m;
+    }
+    used += m;
+    accumulateDerivativeSums(chunk, m, sums, simd);
+  }
+  return used;
+}
+
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
 // 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by.
 // Measured with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
@@ -170,9 +188,57 @@ SCALESPACE_TARGET_AVX512 inline void loadVec3x8(const double* base, std::size_t 
       _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), v2);
 }
 
-/// addDerivativeSamples with eight samples formed at a time (formSample's arithmetic, lanes
-/// without a positive weight zeroed instead of skipped). Measured: the robust 200k Stairs stack
-/// with one thread took 22.8-23.1 s against 23.8-24.0 s forming one sample at a time (runs
+/// The constants of formSample's arithmetic for one kernel, splatted.
+struct FormConstants {
+  __m512d invT2, one, minus4InvT2, b0, minus4InvT, zero;
+  SCALESPACE_TARGET_AVX512 explicit FormConstants(const WeightKernel& kernel)
+      : invT2(_mm512_set1_pd(kernel.invT2)),
+        one(_mm512_set1_pd(1.0)),
+        minus4InvT2(_mm512_set1_pd(-4 * kernel.invT2)),
+        b0(_mm512_set1_pd(8 * kernel.invT2 * kernel.invT2)),
+        minus4InvT(_mm512_set1_pd(-4 / kernel.t)),
+        zero(_mm512_setzero_pd()) {}
+};
+
+/// formSample on eight samples (lanes without a positive weight zeroed instead of skipped) into
+/// rows m..m+7 of the chunk; `lanes` marks the samples that exist. Returns how many have a
+/// positive weight.
+SCALESPACE_TARGET_AVX512 inline int formSamples8(__m512d qx, __m512d qy, __m512d qz, __m512d nx,
+                                                 __m512d ny, __m512d nz, __m512d ew, __mmask8 lanes,
+                                                 const FormConstants& c, DerivativeChunk& chunk,
+                                                 int m) {
+  const __m512d d2 = _mm512_fmadd_pd(qx, qx, _mm512_fmadd_pd(qy, qy, _mm512_mul_pd(qz, qz)));
+  const __m512d r = _mm512_mul_pd(d2, c.invT2);
+  const __m512d rm1 = _mm512_sub_pd(r, c.one);
+  const __m512d w = _mm512_mul_pd(_mm512_mul_pd(rm1, rm1), ew);
+  // formSample's tests: r < 1 and w > 0 (both false for NaN).
+  const __mmask8 live = _mm512_mask_cmp_pd_mask(
+      _mm512_mask_cmp_pd_mask(lanes, r, c.one, _CMP_LT_OQ), w, c.zero, _CMP_GT_OQ);
+  const __m512d g = _mm512_mul_pd(_mm512_mul_pd(c.minus4InvT2, rm1), ew);
+  const __m512d b = _mm512_mul_pd(c.b0, ew);
+  const __m512d bx = _mm512_mul_pd(b, qx), by = _mm512_mul_pd(b, qy);
+  __m512d f[12];
+  f[0] = w;
+  f[1] = _mm512_mul_pd(g, qx), f[2] = _mm512_mul_pd(g, qy), f[3] = _mm512_mul_pd(g, qz);
+  f[4] = _mm512_sub_pd(c.zero, g);  // 4 (r - 1) e / t^2
+  f[5] = _mm512_mul_pd(bx, qx), f[6] = _mm512_mul_pd(by, qy);
+  f[7] = _mm512_mul_pd(_mm512_mul_pd(b, qz), qz);
+  f[8] = _mm512_mul_pd(bx, qy), f[9] = _mm512_mul_pd(bx, qz), f[10] = _mm512_mul_pd(by, qz);
+  f[11] = _mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(c.minus4InvT, rm1), r), ew);  // dw/dt e
+  for (__m512d& v : f) v = _mm512_maskz_mov_pd(live, v);
+  const __m512d item[9] = {
+      c.one, qx, qy, qz,
+      nx,    ny, nz, _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))),
+      d2};
+  for (int i = 0; i < 9; ++i)
+    _mm512_store_pd(&chunk.items[i][m], _mm512_maskz_mov_pd(live, item[i]));
+  storeRows8(f, chunk.factors + m);
+  storeRows4(f + 8, chunk.factors + m);
+  return __builtin_popcount(live);
+}
+
+/// addDerivativeSamples with eight samples formed at a time. Measured: the robust 200k Stairs
+/// stack with one thread took 22.8-23.1 s against 23.8-24.0 s forming one sample at a time (runs
 /// interleaved); forming was ~2/3 of the pass in perf, the accumulation the rest.
 SCALESPACE_TARGET_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
                                               std::size_t count, const Vec3& x,
@@ -180,12 +246,8 @@ SCALESPACE_TARGET_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, cons
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays must be packed x, y, z");
   static_assert(DerivativeChunk::kSize % 8 == 0, "chunks hold whole groups of eight");
   DerivativeChunk chunk;  // alignas(64): its item columns take aligned stores
+  const FormConstants constants(kernel);
   const __m512d cx = _mm512_set1_pd(x.x()), cy = _mm512_set1_pd(x.y()), cz = _mm512_set1_pd(x.z());
-  const __m512d invT2 = _mm512_set1_pd(kernel.invT2), one = _mm512_set1_pd(1.0);
-  const __m512d minus4InvT2 = _mm512_set1_pd(-4 * kernel.invT2);
-  const __m512d b0 = _mm512_set1_pd(8 * kernel.invT2 * kernel.invT2);
-  const __m512d minus4InvT = _mm512_set1_pd(-4 / kernel.t);
-  const __m512d zero = _mm512_setzero_pd();
   const double* pd = p->data();
   const double* nd = n->data();
   int used = 0;
@@ -198,37 +260,39 @@ SCALESPACE_TARGET_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, cons
       __m512d px, py, pz, nx, ny, nz;
       loadVec3x8(pd + 3 * k, rest, px, py, pz);
       loadVec3x8(nd + 3 * k, rest, nx, ny, nz);
-      const __m512d qx = _mm512_sub_pd(px, cx), qy = _mm512_sub_pd(py, cy),
-                    qz = _mm512_sub_pd(pz, cz);
-      const __m512d ew = _mm512_maskz_loadu_pd(lanes, e + k);
-      const __m512d d2 = _mm512_fmadd_pd(qx, qx, _mm512_fmadd_pd(qy, qy, _mm512_mul_pd(qz, qz)));
-      const __m512d r = _mm512_mul_pd(d2, invT2);
-      const __m512d rm1 = _mm512_sub_pd(r, one);
-      const __m512d w = _mm512_mul_pd(_mm512_mul_pd(rm1, rm1), ew);
-      // formSample's tests: r < 1 and w > 0 (both false for NaN).
-      const __mmask8 live = _mm512_mask_cmp_pd_mask(
-          _mm512_mask_cmp_pd_mask(lanes, r, one, _CMP_LT_OQ), w, zero, _CMP_GT_OQ);
-      used += __builtin_popcount(live);
-      const __m512d g = _mm512_mul_pd(_mm512_mul_pd(minus4InvT2, rm1), ew);
-      const __m512d b = _mm512_mul_pd(b0, ew);
-      const __m512d bx = _mm512_mul_pd(b, qx), by = _mm512_mul_pd(b, qy);
-      __m512d f[12];
-      f[0] = w;
-      f[1] = _mm512_mul_pd(g, qx), f[2] = _mm512_mul_pd(g, qy), f[3] = _mm512_mul_pd(g, qz);
-      f[4] = _mm512_sub_pd(zero, g);  // 4 (r - 1) e / t^2
-      f[5] = _mm512_mul_pd(bx, qx), f[6] = _mm512_mul_pd(by, qy);
-      f[7] = _mm512_mul_pd(_mm512_mul_pd(b, qz), qz);
-      f[8] = _mm512_mul_pd(bx, qy), f[9] = _mm512_mul_pd(bx, qz), f[10] = _mm512_mul_pd(by, qz);
-      f[11] = _mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(minus4InvT, rm1), r), ew);  // dw/dt e
-      for (__m512d& v : f) v = _mm512_maskz_mov_pd(live, v);
-      const __m512d item[9] = {
-          one, qx, qy, qz,
-          nx,  ny, nz, _mm512_fmadd_pd(qx, nx, _mm512_fmadd_pd(qy, ny, _mm512_mul_pd(qz, nz))),
-          d2};
-      for (int i = 0; i < 9; ++i)
-        _mm512_store_pd(&chunk.items[i][m], _mm512_maskz_mov_pd(live, item[i]));
-      storeRows8(f, chunk.factors + m);
-      storeRows4(f + 8, chunk.factors + m);
+      used += formSamples8(_mm512_sub_pd(px, cx), _mm512_sub_pd(py, cy), _mm512_sub_pd(pz, cz), nx,
+                           ny, nz, _mm512_maskz_loadu_pd(lanes, e + k), lanes, constants, chunk, m);
+    }
+    accumulateAvx512(chunk, m, sums);
+  }
+  return used;
+}
+
+/// addDerivativeColumns with eight samples formed at a time, read straight from the columns.
+SCALESPACE_TARGET_AVX512 int addColumnsAvx512(const NeighborColumns& c, const double* e,
+                                              const Vec3& x, const WeightKernel& kernel,
+                                              DerivativeSums& sums) {
+  DerivativeChunk chunk;
+  const FormConstants constants(kernel);
+  const __m512d cx = _mm512_set1_pd(x.x()), cy = _mm512_set1_pd(x.y()), cz = _mm512_set1_pd(x.z());
+  const double *qx = c.qx.data(), *qy = c.qy.data(), *qz = c.qz.data();
+  const double *nx = c.nx.data(), *ny = c.ny.data(), *nz = c.nz.data();
+  const std::size_t count = c.size();
+  int used = 0;
+  std::size_t k = 0;
+  while (k < count) {
+    int m = 0;
+    for (; k < count && m < DerivativeChunk::kSize; k += 8, m += 8) {
+      const std::size_t rest = count - k;
+      const __mmask8 lanes = rest >= 8 ? __mmask8(0xff) : __mmask8((1u << rest) - 1);
+      // (A lambda for the loads would not inherit this function's target attribute.)
+      used +=
+          formSamples8(_mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, qx + k), cx),
+                       _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, qy + k), cy),
+                       _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, qz + k), cz),
+                       _mm512_maskz_loadu_pd(lanes, nx + k), _mm512_maskz_loadu_pd(lanes, ny + k),
+                       _mm512_maskz_loadu_pd(lanes, nz + k), _mm512_maskz_loadu_pd(lanes, e + k),
+                       lanes, constants, chunk, m);
     }
     accumulateAvx512(chunk, m, sums);
   }
@@ -245,6 +309,14 @@ int addDerivativeSamples(const Vec3* p, const Vec3* n, const double* e, std::siz
   if (useAvx512(kernel)) return addSamplesAvx512(p, n, e, count, x, weight, sums);
 #endif
   return addSamplesOneByOne(p, n, e, count, x, weight, sums, kernel);
+}
+
+int addDerivativeColumns(const NeighborColumns& c, const double* e, const Vec3& x,
+                         const WeightKernel& weight, DerivativeSums& sums, SimdKernel kernel) {
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx512(kernel)) return addColumnsAvx512(c, e, x, weight, sums);
+#endif
+  return addColumnsOneByOne(c, e, x, weight, sums, kernel);
 }
 
 void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,

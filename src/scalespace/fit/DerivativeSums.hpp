@@ -6,6 +6,7 @@
 #include <cstddef>
 
 #include "scalespace/core/Types.hpp"
+#include "scalespace/fit/NeighborColumns.hpp"
 #include "scalespace/fit/SimdKernel.hpp"
 #include "scalespace/fit/WeightKernel.hpp"
 
@@ -33,6 +34,12 @@ void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSum
 /// transposes their factors into rows; the others form one at a time.
 int addDerivativeSamples(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
                          const Vec3& x, const WeightKernel& weight, DerivativeSums& sums,
+                         SimdKernel kernel = SimdKernel::Auto);
+
+/// addDerivativeSamples on samples held as columns: sample k is p = (qx, qy, qz)[k] with normal
+/// (nx, ny, nz)[k] (the columns' d2 and weight are not read: both are formed again from p - x).
+int addDerivativeColumns(const NeighborColumns& c, const double* e, const Vec3& x,
+                         const WeightKernel& weight, DerivativeSums& sums,
                          SimdKernel kernel = SimdKernel::Auto);
 
 }  // namespace scalespace

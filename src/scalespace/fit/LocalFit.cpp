@@ -6,6 +6,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/JetFit.hpp"
 #include "scalespace/fit/MeanFit.hpp"
+#include "scalespace/fit/NeighborColumns.hpp"
 #include "scalespace/fit/OrientedSphereFit.hpp"
 #include "scalespace/fit/PlaneFit.hpp"
 #include "scalespace/fit/QuadricFit.hpp"
@@ -60,43 +61,23 @@ namespace {
 constexpr double kRobustSigmaR = 0.2;  // times t
 constexpr double kRobustSigmaN = 0.5;
 
-/// Gathers the samples within t of y (offsets q = p - y and normals) into contiguous buffers:
-/// the robust passes read them several times. Reads the driver's prefetched samples when they
-/// cover the ball, else queries the index.
+/// Gathers the samples within t of y into ws.columns (offsets q = p - y, normals, kernel
+/// weights): the robust passes read them several times. Reads the driver's prefetched samples
+/// when they cover the ball, else queries the index.
 void gatherNeighbors(const Vec3& y, double t, const SurfaceSamples& samples, FitWorkspace& ws) {
-  ws.offsets.clear();
-  ws.normals.clear();
   if (ws.cache.covers(samples, y, t)) {
     ++ws.cache.hits;
-    const std::vector<Vec3>& p = ws.cache.positions();
-    const std::vector<Vec3>& n = ws.cache.normals();
-    const double t2 = t * t;
-    // Branch-free: about half of the candidates are kept, in no predictable pattern.
-    // Raw pointers: stores through ws.offsets[...] could alias ws itself, and the compiler would
-    // reload the vectors' data pointers at every candidate.
-    ws.offsets.resize(p.size());
-    ws.normals.resize(p.size());
-    const Vec3* pIn = p.data();
-    const Vec3* nIn = n.data();
-    Vec3* qOut = ws.offsets.data();
-    Vec3* nOut = ws.normals.data();
-    const std::size_t count = p.size();
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < count; ++k) {
-      const Vec3 q = pIn[k] - y;
-      qOut[kept] = q;
-      nOut[kept] = nIn[k];
-      kept += q.squaredNorm() < t2 ? 1 : 0;  // the index's test: |p - y|^2 < t^2
-    }
-    ws.offsets.resize(kept);
-    ws.normals.resize(kept);
+    gatherWithin(ws.cache.samples(), y, t, ws.columns);
     return;
   }
   ++ws.cache.misses;
   samples.index.radiusSearch(y, t, ws.neighbors);
+  const WeightKernel kernel(t);
+  ws.columns.clear();
   for (const Neighbor& nb : ws.neighbors) {
-    ws.offsets.push_back(samples.positions[nb.index] - y);
-    ws.normals.push_back(samples.normals[nb.index]);
+    const Vec3 q = samples.positions[nb.index] - y;
+    ws.columns.push(q, samples.normals[nb.index],
+                    WeightKernel::value(kernel.ratio(q.squaredNorm())));  // Eq. 1.6
   }
 }
 
@@ -106,28 +87,21 @@ OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::
                                    FitDerivatives order, bool scaleDerivatives, int minNeighbors) {
   OrientedSphereFit acc;
   acc.begin(Vec3::Zero(), t, order, scaleDerivatives);
-  acc.addBatch(ws.offsets.data(), ws.normals.data(), rho.data(), ws.offsets.size());
+  acc.addColumns(ws.columns, rho.data());
   return acc.finish(minNeighbors);
 }
 
-/// The gathered neighbours as columns with their kernel weights (what reweight() reads).
-void fillColumns(double t, FitWorkspace& ws) {
-  const WeightKernel kernel(t);
-  NeighborColumns& c = ws.columns;
-  const std::size_t n = ws.offsets.size();
-  for (auto* v : {&c.qx, &c.qy, &c.qz, &c.nx, &c.ny, &c.nz, &c.d2, &c.weight}) v->resize(n);
-  // Raw pointers, as in gatherNeighbors: no reloads of the vectors' data pointers per neighbour.
-  const Vec3* q = ws.offsets.data();
-  const Vec3* nIn = ws.normals.data();
-  double *qx = c.qx.data(), *qy = c.qy.data(), *qz = c.qz.data();
-  double *nx = c.nx.data(), *ny = c.ny.data(), *nz = c.nz.data();
-  double *d2 = c.d2.data(), *w = c.weight.data();
-  for (std::size_t k = 0; k < n; ++k) {
-    qx[k] = q[k].x(), qy[k] = q[k].y(), qz[k] = q[k].z();
-    nx[k] = nIn[k].x(), ny[k] = nIn[k].y(), nz[k] = nIn[k].z();
-    d2[k] = q[k].squaredNorm();
-    w[k] = WeightKernel::value(kernel.ratio(d2[k]));  // Eq. 1.6
-  }
+/// The sphere of the kernel weights alone, without derivatives (what spherePass gives for
+/// FitDerivatives::None and factors 1), with its sums.
+OrientedSphereFitResult kernelSphere(double t, const FitWorkspace& ws, int minNeighbors,
+                                     SphereSums& sums) {
+  kernelWeightedSums(ws.columns, sums);
+  OrientedSphereFitResult res;
+  res.neighbors = sums.used;
+  res.weightSum = sums.s[0];
+  res.valid = sphereFromSums(sums.s, sums.used, t, minNeighbors, res.sphere);
+  res.gradient = res.sphere.ul;
+  return res;
 }
 
 bool isAlgebraicSphere(EstimatorKind kind) {
@@ -158,20 +132,12 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
                                      bool reported) {
   const int passes = options.robust ? std::max(0, options.robustIterations) : 0;
   const FitDerivatives order = derivativesOf(options.estimator);
-  ws.weights.assign(ws.offsets.size(), 1.0);
+  ws.weights.assign(ws.columns.size(), 1.0);
   bool full = reported && passes == 0;
-  if (passes == 0)
-    return spherePass(t, ws, ws.weights, full ? order : FitDerivatives::None, full,
-                      options.minNeighbors);
-  // The robust passes read the neighbours as columns, the first (kernel weights only) too.
-  fillColumns(t, ws);
+  if (full) return spherePass(t, ws, ws.weights, order, true, options.minNeighbors);
   SphereSums sums;
-  kernelWeightedSums(ws.columns, sums);
-  OrientedSphereFitResult res;
-  res.neighbors = sums.used;
-  res.weightSum = sums.s[0];
-  res.valid = sphereFromSums(sums.s, sums.used, t, options.minNeighbors, res.sphere);
-  res.gradient = res.sphere.ul;
+  OrientedSphereFitResult res = kernelSphere(t, ws, options.minNeighbors, sums);
+  if (passes == 0) return res;
   const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
   const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
   for (int it = 0; it < passes && res.valid; ++it) {

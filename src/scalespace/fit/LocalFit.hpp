@@ -102,9 +102,8 @@ struct FitWorkspace {
   /// the support ball, fit/NeighborhoodCache.hpp); empty unless the driver fills it.
   NeighborhoodCache cache;
   std::vector<Neighbor> neighbors;
-  std::vector<Vec3> offsets, normals;         // neighbours gathered once per query: p - x and n
+  NeighborColumns columns;                    // the neighbours of the current fit (p - x, n)
   std::vector<double> weights, trialWeights;  // robust re-weighting factors
-  NeighborColumns columns;                    // the neighbours as columns (robust passes)
 };
 
 /// Estimates the differential quantities at x with support radius t.

@@ -18,11 +18,18 @@ void NeighborhoodCache::prefetch(const SurfaceSamples& samples, const Vec3& cent
   if (!(radius > 0) || !std::isfinite(radius) || !center.allFinite()) return;
   samples.index.radiusSearch(center, radius, found_);
   const bool withNormals = samples.normals.size() == samples.positions.size();
-  positions_.resize(found_.size());
-  normals_.resize(withNormals ? found_.size() : 0);
-  for (std::size_t k = 0; k < found_.size(); ++k) {
-    positions_[k] = samples.positions[found_[k].index];
-    if (withNormals) normals_[k] = samples.normals[found_[k].index];
+  const std::size_t n = found_.size();
+  for (auto* v : {&samples_.px, &samples_.py, &samples_.pz}) v->resize(n);
+  for (auto* v : {&samples_.nx, &samples_.ny, &samples_.nz}) v->resize(withNormals ? n : 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& p = samples.positions[found_[k].index];
+    samples_.px[k] = p.x(), samples_.py[k] = p.y(), samples_.pz[k] = p.z();
+  }
+  if (withNormals) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec3& nk = samples.normals[found_[k].index];
+      samples_.nx[k] = nk.x(), samples_.ny[k] = nk.y(), samples_.nz[k] = nk.z();
+    }
   }
   source_ = &samples.index;
   center_ = center;

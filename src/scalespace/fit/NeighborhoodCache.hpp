@@ -15,6 +15,7 @@
 
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Types.hpp"
+#include "scalespace/fit/NeighborColumns.hpp"
 
 namespace scalespace {
 
@@ -34,8 +35,9 @@ class NeighborhoodCache {
   /// True when every sample of `samples` within r of q is in the cache.
   bool covers(const SurfaceSamples& samples, const Vec3& q, double r) const;
 
-  const std::vector<Vec3>& positions() const { return positions_; }
-  const std::vector<Vec3>& normals() const { return normals_; }
+  /// The prefetched samples, as columns (fit/NeighborColumns: gatherWithin reads them). The
+  /// normal columns are empty when the samples have no normals.
+  const SampleColumns& samples() const { return samples_; }
 
   /// Fits served from the cache / from the index since construction (benchmarks, tests).
   std::size_t hits = 0, misses = 0;
@@ -44,7 +46,7 @@ class NeighborhoodCache {
   const SpatialIndex* source_ = nullptr;
   Vec3 center_ = Vec3::Zero();
   double radius_ = 0;
-  std::vector<Vec3> positions_, normals_;
+  SampleColumns samples_;
   std::vector<Neighbor> found_;
 };
 

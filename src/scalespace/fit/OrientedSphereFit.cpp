@@ -136,7 +136,12 @@ void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
   // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
   // instead of updating 108 member sums per sample.
   DerivativeSums sums = {};
-  count_ += addDerivativeSamples(p, n, extraWeight, count, x_, kernel_, sums);
+  const int used = addDerivativeSamples(p, n, extraWeight, count, x_, kernel_, sums);
+  addDerivativeBlock(sums, used);
+}
+
+void OrientedSphereFit::addDerivativeBlock(const double (&sums)[9][12], int used) {
+  count_ += used;
   for (int i = 0; i < 9; ++i) {
     s_[i] += sums[i][0];
     if (order_ >= FitDerivatives::First)
@@ -147,6 +152,18 @@ void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
     }
     if (scale_) dt_[i] += sums[i][11];
   }
+}
+
+void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double* extraWeight) {
+  if (order_ != FitDerivatives::None || scale_) {
+    DerivativeSums sums = {};
+    const int used = addDerivativeColumns(columns, extraWeight, x_, kernel_, sums);
+    addDerivativeBlock(sums, used);
+    return;
+  }
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    add(Vec3(columns.qx[k], columns.qy[k], columns.qz[k]),
+        Vec3(columns.nx[k], columns.ny[k], columns.nz[k]), extraWeight[k]);
 }
 
 void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* extraWeight,

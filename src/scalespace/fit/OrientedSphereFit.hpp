@@ -11,6 +11,7 @@
 
 #include "scalespace/core/Types.hpp"
 #include "scalespace/fit/AlgebraicSphere.hpp"
+#include "scalespace/fit/NeighborColumns.hpp"
 #include "scalespace/fit/WeightKernel.hpp"
 
 namespace scalespace {
@@ -50,6 +51,10 @@ class OrientedSphereFit {
   /// add(p[k], n[k], extraWeight[k]) for k < count. Without derivatives this runs a tight loop
   /// that keeps the sums in registers (the robust passes of fit/LocalFit make most calls).
   void addBatch(const Vec3* p, const Vec3* n, const double* extraWeight, std::size_t count);
+  /// add(p_k, n_k, extraWeight[k]) for every sample k of the columns, p_k = (qx, qy, qz)[k] and
+  /// n_k = (nx, ny, nz)[k] (their d2 and weight are not read). The derivative pass reads the
+  /// columns eight at a time (fit/DerivativeSums).
+  void addColumns(const NeighborColumns& columns, const double* extraWeight);
   /// Adds sums made elsewhere (fit/RobustReweighting: sum w, w q, w n, w q.n, w |q|^2 over
   /// `count` samples of positive weight, frame centred at x). Only for fits without derivatives.
   void addSums(const double* sums, int count);
@@ -63,6 +68,8 @@ class OrientedSphereFit {
  private:
   void addBatchWithDerivatives(const Vec3* p, const Vec3* n, const double* extraWeight,
                                std::size_t count);
+  /// Adds the 9 x 12 block of the derivative pass (fit/DerivativeSums) to the member sums.
+  void addDerivativeBlock(const double (&sums)[9][12], int used);
   using Item = Eigen::Matrix<double, 9, 1>;  // 1, q, n, q.n, |q|^2
   Vec3 x_ = Vec3::Zero();
   WeightKernel kernel_{1.0};

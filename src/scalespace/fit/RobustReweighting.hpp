@@ -11,19 +11,10 @@
 #include <vector>
 
 #include "scalespace/fit/AlgebraicSphere.hpp"
+#include "scalespace/fit/NeighborColumns.hpp"
 #include "scalespace/fit/SimdKernel.hpp"
 
 namespace scalespace {
-
-/// Neighbours as columns (structure of arrays), offsets q = p - y from the evaluation point.
-struct NeighborColumns {
-  std::vector<double> qx, qy, qz, nx, ny, nz;
-  std::vector<double> d2;      // |q|^2
-  std::vector<double> weight;  // kernel weight w(|q|) (Eq. 1.6)
-  std::size_t size() const { return qx.size(); }
-  void clear();
-  void push(const Vec3& q, const Vec3& n, double kernelWeight);
-};
 
 /// The 9 sums of a sphere fit: sum w, sum w q, sum w n, sum w q.n, sum w |q|^2, and how many
 /// samples had a positive weight.

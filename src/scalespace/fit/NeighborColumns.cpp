@@ -1,0 +1,127 @@
+#include "scalespace/fit/NeighborColumns.hpp"
+
+#include "scalespace/fit/WeightKernel.hpp"
+
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+// GCC 12's AVX-512 intrinsics trip -Wuninitialized inside the header (GCC bug 105593; see
+// fit/RobustReweighting.cpp).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <immintrin.h>
+#endif
+
+namespace scalespace {
+
+void NeighborColumns::clear() {
+  for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->clear();
+}
+
+void NeighborColumns::push(const Vec3& q, const Vec3& n, double kernelWeight) {
+  qx.push_back(q.x()), qy.push_back(q.y()), qz.push_back(q.z());
+  nx.push_back(n.x()), ny.push_back(n.y()), nz.push_back(n.z());
+  d2.push_back(q.squaredNorm());
+  weight.push_back(kernelWeight);
+}
+
+void NeighborColumns::resize(std::size_t n) {
+  for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->resize(n);
+}
+
+void SampleColumns::resize(std::size_t n) {
+  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz}) v->resize(n);
+}
+
+namespace {
+
+/// Raw pointers to the columns: stores through the output vectors could alias the vectors
+/// themselves, and the compiler would reload their data pointers at every candidate.
+struct Outputs {
+  double *qx, *qy, *qz, *nx, *ny, *nz, *d2, *w;
+  explicit Outputs(NeighborColumns& c)
+      : qx(c.qx.data()),
+        qy(c.qy.data()),
+        qz(c.qz.data()),
+        nx(c.nx.data()),
+        ny(c.ny.data()),
+        nz(c.nz.data()),
+        d2(c.d2.data()),
+        w(c.weight.data()) {}
+};
+
+std::size_t gatherPortable(const SampleColumns& s, const Vec3& y, double t, Outputs o) {
+  const WeightKernel kernel(t);
+  const double t2 = t * t;
+  const std::size_t count = s.size();
+  std::size_t kept = 0;
+  // Branch-free: about half of the candidates are kept, in no predictable pattern. Every
+  // candidate is written at `kept`, which only advances past the kept ones.
+  for (std::size_t k = 0; k < count; ++k) {
+    const Vec3 q(s.px[k] - y.x(), s.py[k] - y.y(), s.pz[k] - y.z());
+    const double d2 = q.squaredNorm();
+    o.qx[kept] = q.x(), o.qy[kept] = q.y(), o.qz[kept] = q.z();
+    o.nx[kept] = s.nx[k], o.ny[kept] = s.ny[k], o.nz[kept] = s.nz[k];
+    o.d2[kept] = d2;
+    o.w[kept] = WeightKernel::value(kernel.ratio(d2));
+    kept += d2 < t2 ? 1 : 0;  // the index's test: |p - y|^2 < t^2
+  }
+  return kept;
+}
+
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+/// Eight candidates at a time: the kept lanes are packed to the front (vcompresspd) and stored
+/// at the output's end. (Compressing in registers and storing whole vectors was slower here.)
+/// Gathering and filling the columns one candidate at a time (scalar code) was ~45% of fitAt's own
+/// time in a robust stack's profile.
+SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const Vec3& y, double t,
+                                                  Outputs o) {
+  const WeightKernel kernel(t);
+  const __m512d yx = _mm512_set1_pd(y.x()), yy = _mm512_set1_pd(y.y()), yz = _mm512_set1_pd(y.z());
+  const __m512d t2 = _mm512_set1_pd(t * t), invT2 = _mm512_set1_pd(kernel.invT2);
+  const __m512d one = _mm512_set1_pd(1.0);
+  const double *px = s.px.data(), *py = s.py.data(), *pz = s.pz.data();
+  const double *nx = s.nx.data(), *ny = s.ny.data(), *nz = s.nz.data();
+  const std::size_t count = s.size();
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < count; k += 8) {
+    const __mmask8 lanes = count - k >= 8 ? __mmask8(0xff) : __mmask8((1u << (count - k)) - 1);
+    const __m512d qx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, px + k), yx);
+    const __m512d qy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, py + k), yy);
+    const __m512d qz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, pz + k), yz);
+    const __m512d d2 = _mm512_fmadd_pd(qx, qx, _mm512_fmadd_pd(qy, qy, _mm512_mul_pd(qz, qz)));
+    const __mmask8 in = _mm512_mask_cmp_pd_mask(lanes, d2, t2, _CMP_LT_OQ);
+    if (!in) continue;
+    // r < 1 on every kept lane: WeightKernel::value is (r - 1)^2 there.
+    const __m512d rm1 = _mm512_sub_pd(_mm512_mul_pd(d2, invT2), one);
+    _mm512_mask_compressstoreu_pd(o.qx + kept, in, qx);
+    _mm512_mask_compressstoreu_pd(o.qy + kept, in, qy);
+    _mm512_mask_compressstoreu_pd(o.qz + kept, in, qz);
+    _mm512_mask_compressstoreu_pd(o.nx + kept, in, _mm512_maskz_loadu_pd(lanes, nx + k));
+    _mm512_mask_compressstoreu_pd(o.ny + kept, in, _mm512_maskz_loadu_pd(lanes, ny + k));
+    _mm512_mask_compressstoreu_pd(o.nz + kept, in, _mm512_maskz_loadu_pd(lanes, nz + k));
+    _mm512_mask_compressstoreu_pd(o.d2 + kept, in, d2);
+    _mm512_mask_compressstoreu_pd(o.w + kept, in, _mm512_mul_pd(rm1, rm1));
+    kept += std::size_t(__builtin_popcount(in));
+  }
+  return kept;
+}
+#endif
+
+}  // namespace
+
+void gatherWithin(const SampleColumns& samples, const Vec3& y, double t, NeighborColumns& out,
+                  SimdKernel kernel) {
+  out.resize(samples.size());
+  std::size_t kept = 0;
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx512(kernel))
+    kept = gatherAvx512(samples, y, t, Outputs(out));
+  else
+#endif
+    kept = gatherPortable(samples, y, t, Outputs(out));
+  (void)kernel;
+  out.resize(kept);
+}
+
+}  // namespace scalespace
