@@ -186,6 +186,28 @@ SCALESPACE_TARGET_AVX512 inline __m512d inverseSqrt8(__m512d x) {
   return _mm512_mul_pd(y, _mm512_fnmadd_pd(half, _mm512_mul_pd(y, y), threeHalves));
 }
 
+/// out[i] += the sum of the lanes of acc[i], i < 8: _mm512_reduce_add_pd's pairing exactly
+/// (halves, then quarters, then the last two lanes), so the sums are the same to the bit, but
+/// the eight reductions share their shuffles: 21 instructions instead of 48 per pass.
+SCALESPACE_TARGET_AVX512 inline void addReduced8(const __m512d* acc, double* out) {
+  // Lanes k + 4 onto k: two accumulators per vector, four lanes each.
+  __m512d half[4];
+  for (int p = 0; p < 4; ++p)
+    half[p] = _mm512_add_pd(_mm512_shuffle_f64x2(acc[2 * p], acc[2 * p + 1], 0x44),
+                            _mm512_shuffle_f64x2(acc[2 * p], acc[2 * p + 1], 0xEE));
+  // Lanes k + 2 onto k: four accumulators per vector, two lanes each.
+  __m512d quarter[2];
+  for (int p = 0; p < 2; ++p)
+    quarter[p] = _mm512_add_pd(_mm512_shuffle_f64x2(half[2 * p], half[2 * p + 1], 0x88),
+                               _mm512_shuffle_f64x2(half[2 * p], half[2 * p + 1], 0xDD));
+  // The last two lanes: lane order 0, 4, 1, 5, 2, 6, 3, 7.
+  alignas(64) double sums[8];
+  _mm512_store_pd(sums, _mm512_add_pd(_mm512_unpacklo_pd(quarter[0], quarter[1]),
+                                      _mm512_unpackhi_pd(quarter[0], quarter[1])));
+  const int accOf[8] = {0, 4, 1, 5, 2, 6, 3, 7};
+  for (int l = 0; l < 8; ++l) out[accOf[l]] += sums[l];
+}
+
 /// Adds eight neighbours with weights w to the 9 sums of SphereSums (lanes with w = 0 add
 /// nothing) and returns how many have a positive weight.
 SCALESPACE_TARGET_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d qx, __m512d qy,
@@ -251,7 +273,8 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
     const __m512d w = _mm512_mul_pd(_mm512_maskz_loadu_pd(m, ws + k), rh);
     used += accumulate8(acc, w, qx, qy, qz, nx, ny, nz, d2);
   }
-  for (int i = 0; i < 9; ++i) next.s[i] += _mm512_reduce_add_pd(acc[i]);
+  addReduced8(acc, next.s);
+  next.s[8] += _mm512_reduce_add_pd(acc[8]);
   next.used += used;
   return _mm512_reduce_max_pd(change);
 }
@@ -273,7 +296,8 @@ SCALESPACE_TARGET_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c,
     const __m512d w = _mm512_maskz_loadu_pd(m, ws + k);
     used += accumulate8(acc, w, qx, qy, qz, nx, ny, nz, _mm512_maskz_loadu_pd(m, d2s + k));
   }
-  for (int i = 0; i < 9; ++i) out.s[i] += _mm512_reduce_add_pd(acc[i]);
+  addReduced8(acc, out.s);
+  out.s[8] += _mm512_reduce_add_pd(acc[8]);
   out.used += used;
 }
 #endif
