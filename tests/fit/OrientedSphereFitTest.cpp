@@ -149,3 +149,53 @@ TEST(OrientedSphereFit, BatchAccumulationEqualsOneByOne) {
     EXPECT_NEAR(a.dUqDt, b.dUqDt, 1e-10 * (1 + std::abs(a.dUqDt)));
   }
 }
+
+// The AVX-512 second-order (W3) solve equals the portable Jet2 one (fused multiply-adds round
+// once, so to a few ulps) on fits of several shapes, scales and frames, and degenerate sums are
+// refused by both.
+TEST(OrientedSphereFit, Avx512SecondOrderSolveEqualsPortable) {
+  const auto generic = genericCloud();
+  const auto sphere = sampleCloud(SurfaceShape::Sphere, Vec3(0.3, -0.2, 0.1), 0.8, 3000, 5);
+  const auto torus = sampleCloud(SurfaceShape::Torus, Vec3(1.5, 0, 0), 1.2, 4000, 6);
+  int compared = 0;
+  for (const TestCloud* c : {generic.get(), sphere.get(), torus.get()}) {
+    for (const Vec3& x : {Vec3(0.05, 0.02, -0.01), Vec3(0.3, -0.1, 0.2), Vec3(-0.4, 0.3, 0.0)}) {
+      for (double t : {0.2, 0.5}) {
+        OrientedSphereFit f;
+        f.begin(x, t, FitDerivatives::Second, true);
+        for (std::size_t i = 0; i < c->positions.size(); ++i) f.add(c->positions[i], c->normals[i]);
+        const OrientedSphereFitResult a = f.finish(6, SimdKernel::Portable);
+        const OrientedSphereFitResult b = f.finish(6, SimdKernel::Avx512);
+        ASSERT_EQ(a.valid, b.valid);
+        if (!a.valid) continue;
+        ++compared;
+        // Relative to each quantity's natural size at scale t (u_l and the gradients are unit
+        // sized; u_q, the Jacobian and the Hessians are 1 / t): near-zero entries (u_q's
+        // gradient on a sphere) carry only rounding noise.
+        auto near = [](double u, double v, double size) { EXPECT_NEAR(u, v, 1e-11 * size); };
+        const double perT = 1 / t + std::abs(a.sphere.uq) + a.hessianW3.norm();
+        near(a.sphere.uc, b.sphere.uc, t);
+        near(a.sphere.uq, b.sphere.uq, perT);
+        for (int i = 0; i < 3; ++i) {
+          near(a.sphere.ul[i], b.sphere.ul[i], 1);
+          near(a.gradient[i], b.gradient[i], 1);
+          near(a.gradUc[i], b.gradUc[i], 1);
+          near(a.gradUq[i], b.gradUq[i], perT / t);
+          for (int j = 0; j < 3; ++j) {
+            near(a.hessianW3(i, j), b.hessianW3(i, j), perT);
+            near(a.hessianW2(i, j), b.hessianW2(i, j), perT);
+            near(a.jacobianUl(i, j), b.jacobianUl(i, j), perT);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(compared, 10);
+  // All samples at one point: den = 0, refused by both.
+  OrientedSphereFit f;
+  f.begin(Vec3::Zero(), 1.0, FitDerivatives::Second);
+  for (int i = 0; i < 10; ++i) f.add(Vec3(0.1, 0.1, 0.1), Vec3::UnitZ());
+  EXPECT_FALSE(f.finish(6, SimdKernel::Portable).valid);
+  EXPECT_FALSE(f.finish(6, SimdKernel::Avx512).valid);
+  if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: the portable solve ran twice";
+}

@@ -12,6 +12,7 @@
 #include "scalespace/core/Types.hpp"
 #include "scalespace/fit/AlgebraicSphere.hpp"
 #include "scalespace/fit/NeighborColumns.hpp"
+#include "scalespace/fit/SimdKernel.hpp"
 #include "scalespace/fit/WeightKernel.hpp"
 
 namespace scalespace {
@@ -59,8 +60,9 @@ class OrientedSphereFit {
   /// `count` samples of positive weight, frame centred at x). Only for fits without derivatives.
   void addSums(const double* sums, int count);
   /// Solves Eq. 1.7-1.9 (and the derivatives). Invalid when fewer than minNeighbors samples
-  /// have weight, when the positions are degenerate (all equal) or Delta <= 0.
-  OrientedSphereFitResult finish(int minNeighbors) const;
+  /// have weight, when the positions are degenerate (all equal) or Delta <= 0. `kernel`
+  /// (fit/SimdKernel.hpp): the second-order (W3) solve has an AVX-512 version.
+  OrientedSphereFitResult finish(int minNeighbors, SimdKernel kernel = SimdKernel::Auto) const;
 
   const Vec3& center() const { return x_; }
   double support() const { return kernel_.t; }
