@@ -137,3 +137,30 @@ TEST(RobustReweighting, DegenerateSphereAndFarSamplesGiveZeroFactors) {
     for (double v : sums.s) EXPECT_TRUE(std::isfinite(v));
   }
 }
+
+// No previous factors (an empty vector) means all 1: the first re-weighting after the
+// kernel-only fit. Same factors, sums and change, to the bit, as with a vector of ones, on every
+// path and count.
+TEST(RobustReweighting, EmptyPreviousFactorsAreOnes) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (SimdKernel kernel :
+       {SimdKernel::Portable, SimdKernel::Avx2Fma, SimdKernel::Avx512, SimdKernel::Auto}) {
+    for (std::size_t n = 0; n <= 19; ++n) {
+      const NeighborColumns c = randomNeighbors(n, rng);
+      AlgebraicSphere s;
+      s.uc = 0.05 * u(rng);
+      s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
+      s.uq = 0.3 * u(rng);
+      std::vector<double> rhoOnes, rhoEmpty;
+      SphereSums a, b;
+      const double changeOnes =
+          reweight(s, 25, 4, c, std::vector<double>(n, 1.0), rhoOnes, a, kernel);
+      const double changeEmpty = reweight(s, 25, 4, c, {}, rhoEmpty, b, kernel);
+      EXPECT_EQ(changeOnes, changeEmpty) << n;
+      EXPECT_EQ(rhoOnes, rhoEmpty);
+      for (int i = 0; i < 9; ++i) EXPECT_EQ(a.s[i], b.s[i]);
+      EXPECT_EQ(a.used, b.used);
+    }
+  }
+}

@@ -114,12 +114,18 @@ FitDerivatives derivativesOf(EstimatorKind kind) {
                                      : FitDerivatives::None;
 }
 
+/// ws.weights, filled with 1 when empty (robustSphere leaves it empty for the kernel-only fit).
+const std::vector<double>& factorsOf(FitWorkspace& ws) {
+  if (ws.weights.empty()) ws.weights.assign(ws.columns.size(), 1.0);
+  return ws.weights;
+}
+
 /// The pass whose result is reported again, with the spatial derivatives the estimator needs
 /// and the scale derivatives (nu), on the factors left in ws.weights.
-OrientedSphereFitResult reportedPass(double t, const FitOptions& options, const FitWorkspace& ws,
+OrientedSphereFitResult reportedPass(double t, const FitOptions& options, FitWorkspace& ws,
                                      int neighbors) {
   OrientedSphereFitResult res =
-      spherePass(t, ws, ws.weights, derivativesOf(options.estimator), true, 1);
+      spherePass(t, ws, factorsOf(ws), derivativesOf(options.estimator), true, 1);
   res.neighbors = neighbors;
   return res;
 }
@@ -127,14 +133,16 @@ OrientedSphereFitResult reportedPass(double t, const FitOptions& options, const 
 /// The (robust) APSS sphere at y over the gathered neighbours. Only the sums of the weights feed
 /// the next re-weighting, so every pass is made without derivatives except, when `reported` is
 /// set, the last one (redone with derivatives if a re-weighting failed and an earlier pass is
-/// kept). On return ws.weights holds the factors of the returned fit.
+/// kept). On return ws.weights holds the factors of the returned fit (empty: all 1).
 OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWorkspace& ws,
                                      bool reported) {
   const int passes = options.robust ? std::max(0, options.robustIterations) : 0;
   const FitDerivatives order = derivativesOf(options.estimator);
-  ws.weights.assign(ws.columns.size(), 1.0);
+  // Empty: every factor is 1 (the kernel-only fit); filled only where a pass reads them
+  // (factorsOf): filling them for every fit showed in the profile.
+  ws.weights.clear();
   bool full = reported && passes == 0;
-  if (full) return spherePass(t, ws, ws.weights, order, true, options.minNeighbors);
+  if (full) return spherePass(t, ws, factorsOf(ws), order, true, options.minNeighbors);
   SphereSums sums;
   OrientedSphereFitResult res = kernelSphere(t, ws, options.minNeighbors, sums);
   if (passes == 0) return res;

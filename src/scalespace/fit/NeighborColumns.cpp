@@ -1,5 +1,7 @@
 #include "scalespace/fit/NeighborColumns.hpp"
 
+#include <algorithm>
+
 #include "scalespace/fit/WeightKernel.hpp"
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
@@ -14,18 +16,17 @@
 
 namespace scalespace {
 
-void NeighborColumns::clear() {
-  for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->clear();
-}
-
 void NeighborColumns::push(const Vec3& q, const Vec3& n, double kernelWeight) {
-  qx.push_back(q.x()), qy.push_back(q.y()), qz.push_back(q.z());
-  nx.push_back(n.x()), ny.push_back(n.y()), nz.push_back(n.z());
-  d2.push_back(q.squaredNorm());
-  weight.push_back(kernelWeight);
+  if (size_ == qx.size()) reserve(std::max<std::size_t>(16, 2 * size_));
+  const std::size_t k = size_++;
+  qx[k] = q.x(), qy[k] = q.y(), qz[k] = q.z();
+  nx[k] = n.x(), ny[k] = n.y(), nz[k] = n.z();
+  d2[k] = q.squaredNorm();
+  weight[k] = kernelWeight;
 }
 
-void NeighborColumns::resize(std::size_t n) {
+void NeighborColumns::reserve(std::size_t n) {
+  if (qx.size() >= n) return;
   for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->resize(n);
 }
 
@@ -112,7 +113,7 @@ SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const 
 
 void gatherWithin(const SampleColumns& samples, const Vec3& y, double t, NeighborColumns& out,
                   SimdKernel kernel) {
-  out.resize(samples.size());
+  out.reserve(samples.size());
   std::size_t kept = 0;
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
   if (useAvx512(kernel))
@@ -121,7 +122,7 @@ void gatherWithin(const SampleColumns& samples, const Vec3& y, double t, Neighbo
 #endif
     kept = gatherPortable(samples, y, t, Outputs(out));
   (void)kernel;
-  out.resize(kept);
+  out.setSize(kept);
 }
 
 }  // namespace scalespace

@@ -35,15 +35,24 @@ struct UninitializedAllocator : std::allocator<T> {
 };
 using Column = std::vector<double, UninitializedAllocator<double>>;
 
-/// Neighbours as columns, offsets q = p - y from the evaluation point y.
-struct NeighborColumns {
+/// Neighbours as columns, offsets q = p - y from the evaluation point y. The columns keep their
+/// length between fits (at least size(); entries past size() are stale): resizing eight vectors
+/// twice per fit showed in the profile.
+class NeighborColumns {
+ public:
   Column qx, qy, qz, nx, ny, nz;
   Column d2;      // |q|^2
   Column weight;  // kernel weight w(|q|) (Eq. 1.6)
-  std::size_t size() const { return qx.size(); }
-  void clear();
+  std::size_t size() const { return size_; }
+  void clear() { size_ = 0; }
   void push(const Vec3& q, const Vec3& n, double kernelWeight);
-  void resize(std::size_t n);
+  /// Makes the columns at least n long; size() and the first size() entries are kept.
+  void reserve(std::size_t n);
+  /// The first n entries (n <= the columns' length) are the neighbours.
+  void setSize(std::size_t n) { size_ = n; }
+
+ private:
+  std::size_t size_ = 0;
 };
 
 /// Samples (positions and unit normals) as columns.

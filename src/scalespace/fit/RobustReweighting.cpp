@@ -51,7 +51,7 @@ double reweightPortable(const AlgebraicSphere& s, double invSr2, double invSn2,
   double change = 0;
   for (std::size_t k = 0; k < c.size(); ++k) {
     rho[k] = factorOf(s, invSr2, invSn2, c, k);
-    change = std::max(change, std::abs(rho[k] - previous[k]));
+    change = std::max(change, std::abs(rho[k] - (previous.empty() ? 1.0 : previous[k])));
     addSample(next, c, k, c.weight[k] * rho[k]);
   }
   return change;
@@ -125,8 +125,10 @@ SCALESPACE_TARGET_AVX2 double reweightAvx2(const AlgebraicSphere& s, double invS
         expNegative4(_mm256_fmadd_pd(_mm256_mul_pd(r, r), sr, _mm256_mul_pd(dn, sn))), live);
     _mm256_maskstore_pd(&rho[k], mask, rh);
     change = _mm256_max_pd(
-        change,
-        _mm256_andnot_pd(signMask, _mm256_sub_pd(rh, _mm256_maskload_pd(&previous[k], mask))));
+        change, _mm256_andnot_pd(
+                    signMask,
+                    _mm256_sub_pd(rh, previous.empty() ? _mm256_and_pd(_mm256_set1_pd(1.0), live)
+                                                       : _mm256_maskload_pd(&previous[k], mask))));
     const __m256d w = _mm256_mul_pd(_mm256_maskload_pd(&c.weight[k], mask), rh);
     used = _mm256_sub_epi64(used,
                             _mm256_castpd_si256(_mm256_cmp_pd(w, _mm256_setzero_pd(), _CMP_GT_OQ)));
@@ -247,6 +249,8 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
   const double *qxs = c.qx.data(), *qys = c.qy.data(), *qzs = c.qz.data();
   const double *nxs = c.nx.data(), *nys = c.ny.data(), *nzs = c.nz.data();
   const double *d2s = c.d2.data(), *ws = c.weight.data(), *prev = previous.data();
+  // No previous factors: all 1 (the lanes that exist), the others 0 as the factors there.
+  const bool ones = previous.empty();
   double* out = rho.data();
   for (std::size_t k = 0; k < n; k += 8) {
     const __mmask8 m = n - k >= 8 ? __mmask8(0xff) : __mmask8((1u << (n - k)) - 1);
@@ -268,8 +272,10 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
     const __m512d rh = _mm512_maskz_mov_pd(
         m, expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn))));
     _mm512_mask_storeu_pd(out + k, m, rh);
-    change =
-        _mm512_max_pd(change, _mm512_abs_pd(_mm512_sub_pd(rh, _mm512_maskz_loadu_pd(m, prev + k))));
+    change = _mm512_max_pd(
+        change, _mm512_abs_pd(_mm512_sub_pd(
+                    rh, _mm512_mask_loadu_pd(_mm512_maskz_mov_pd(ones ? m : 0, splat8(1.0)),
+                                             ones ? 0 : m, prev + k))));
     const __m512d w = _mm512_mul_pd(_mm512_maskz_loadu_pd(m, ws + k), rh);
     used += accumulate8(acc, w, qx, qy, qz, nx, ny, nz, d2);
   }

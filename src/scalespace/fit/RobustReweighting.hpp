@@ -29,7 +29,8 @@ void kernelWeightedSums(const NeighborColumns& c, SphereSums& out,
                         SimdKernel kernel = SimdKernel::Auto);
 
 /// Re-weights against `sphere`: writes rho_k to rho (resized), accumulates the sums with weights
-/// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]|. invSr2 = 1 /
+/// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]| (`previous` empty:
+/// every previous factor is 1, as for the kernel-only fit). invSr2 = 1 /
 /// sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets rho = 0.
 /// `kernel`: fit/SimdKernel.hpp.
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
