@@ -1,7 +1,6 @@
 // The derivative-pass kernels: every implementation equals a long-double reference for every
-// chunk length, and the whole pass over samples, packed or as columns (items and factors formed
-// one by one or eight at a time), equals the formula of OrientedSphereFit::add for every sample
-// count.
+// chunk length, and the whole pass over samples held as columns (items and factors formed one by
+// one or eight at a time) equals the formula of OrientedSphereFit::add for every sample count.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -117,9 +116,9 @@ void referenceSamples(const std::vector<Vec3>& p, const std::vector<Vec3>& n,
   }
 }
 
-/// The pass over packed Vec3 samples (addDerivativeSamples) or, with `columns`, over the same
-/// samples as columns (addDerivativeColumns).
-void expectSamplesMatchReference(SimdKernel kernel, bool columns = false) {
+/// The pass over samples held as columns (addDerivativeColumns) against the reference, for every
+/// sample count (whole and partial groups of eight, chunks of 32 and a tail).
+void expectColumnsMatchReference(SimdKernel kernel) {
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> u(-1, 1);
   const WeightKernel weight(0.7);
@@ -134,14 +133,9 @@ void expectSamplesMatchReference(SimdKernel kernel, bool columns = false) {
   p[20] = Vec3(NAN, 0, 0);  // skipped, as by add()
   for (std::size_t count = 0; count <= p.size(); ++count) {
     DerivativeSums sums = {};
-    int used = 0;
-    if (columns) {
-      NeighborColumns c;
-      for (std::size_t k = 0; k < count; ++k) c.push(p[k], n[k], -1.0);  // d2, weight unread
-      used = addDerivativeColumns(c, e.data(), x, weight, sums, kernel);
-    } else {
-      used = addDerivativeSamples(p.data(), n.data(), e.data(), count, x, weight, sums, kernel);
-    }
+    NeighborColumns c;
+    for (std::size_t k = 0; k < count; ++k) c.push(p[k], n[k], -1.0);  // d2, weight unread
+    const int used = addDerivativeColumns(c, e.data(), x, weight, sums, kernel);
     long double ref[9][12], mag[9][12];
     int refUsed = 0;
     referenceSamples(p, n, e, count, x, weight, ref, mag, refUsed);
@@ -155,24 +149,15 @@ void expectSamplesMatchReference(SimdKernel kernel, bool columns = false) {
 
 }  // namespace
 
-TEST(DerivativeSums, PortableSamplePassMatchesTheFormula) {
-  expectSamplesMatchReference(SimdKernel::Portable);
-}
-
-TEST(DerivativeSums, Avx512SamplePassMatchesTheFormula) {
-  expectSamplesMatchReference(SimdKernel::Avx512);
-  if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: another kernel ran";
-}
-
-TEST(DerivativeSums, DefaultSamplePassMatchesTheFormula) {
-  expectSamplesMatchReference(SimdKernel::Auto);
-}
-
 TEST(DerivativeSums, PortableColumnPassMatchesTheFormula) {
-  expectSamplesMatchReference(SimdKernel::Portable, true);
+  expectColumnsMatchReference(SimdKernel::Portable);
 }
 
 TEST(DerivativeSums, Avx512ColumnPassMatchesTheFormula) {
-  expectSamplesMatchReference(SimdKernel::Avx512, true);
+  expectColumnsMatchReference(SimdKernel::Avx512);
   if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: another kernel ran";
+}
+
+TEST(DerivativeSums, DefaultColumnPassMatchesTheFormula) {
+  expectColumnsMatchReference(SimdKernel::Auto);
 }

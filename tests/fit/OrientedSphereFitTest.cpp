@@ -123,7 +123,7 @@ TEST(OrientedSphereFit, PlaneBranchOfTheProjection) {
   EXPECT_NEAR(s.project(Vec3(0.2, 0.1, 0.7)).z(), 0.15, 1e-9);
 }
 
-TEST(OrientedSphereFit, BatchAccumulationEqualsOneByOne) {
+TEST(OrientedSphereFit, ColumnAccumulationEqualsOneByOne) {
   const auto c = genericCloud();
   std::vector<double> extra(c->positions.size());
   for (std::size_t i = 0; i < extra.size(); ++i) extra[i] = 0.25 + 0.5 * double(i % 3);
@@ -136,7 +136,10 @@ TEST(OrientedSphereFit, BatchAccumulationEqualsOneByOne) {
     batch.begin(x, 0.8, order, true);
     for (std::size_t i = 0; i < c->positions.size(); ++i)
       one.add(c->positions[i], c->normals[i], extra[i]);
-    batch.addBatch(c->positions.data(), c->normals.data(), extra.data(), c->positions.size());
+    NeighborColumns columns;
+    for (std::size_t i = 0; i < c->positions.size(); ++i)
+      columns.push(c->positions[i], c->normals[i], -1.0);  // d2 and weight are not read
+    batch.addColumns(columns, extra.data());
     const OrientedSphereFitResult a = one.finish(6), b = batch.finish(6);
     ASSERT_TRUE(a.valid);
     EXPECT_EQ(a.neighbors, b.neighbors);

@@ -45,22 +45,6 @@ inline bool formSample(const Vec3& q, const Vec3& n, double e, const WeightKerne
   return true;
 }
 
-int addSamplesOneByOne(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
-                       const Vec3& x, const WeightKernel& kernel, DerivativeSums& sums,
-                       SimdKernel simd) {
-  DerivativeChunk chunk;
-  int used = 0;
-  std::size_t k = 0;
-  while (k < count) {
-    int m = 0;
-    for (; k < count && m < DerivativeChunk::kSize; ++k)
-      if (formSample(p[k] - x, n[k], e[k], kernel, chunk, m)) ++m;
-    used += m;
-    accumulateDerivativeSums(chunk, m, sums, simd);
-  }
-  return used;
-}
-
 int addColumnsOneByOne(const NeighborColumns& c, const double* e, const Vec3& x,
                        const WeightKernel& kernel, DerivativeSums& sums, SimdKernel simd) {
   DerivativeChunk chunk;
@@ -164,30 +148,6 @@ SCALESPACE_TARGET_AVX512 inline void storeRows4(const __m512d* f, double (*out)[
   }
 }
 
-/// Coordinates x, y, z of eight packed Vec3 (24 doubles from `base`; `count` < 8 reads only
-/// 3 count doubles, the other lanes are 0).
-SCALESPACE_TARGET_AVX512 inline void loadVec3x8(const double* base, std::size_t count, __m512d& x,
-                                                __m512d& y, __m512d& z) {
-  const unsigned nd = unsigned(3 * std::min<std::size_t>(count, 8));
-  auto maskOf = [](unsigned from, unsigned nd) {
-    return nd >= from + 8 ? __mmask8(0xff) : nd > from ? __mmask8((1u << (nd - from)) - 1) : 0;
-  };
-  const __m512d v0 = _mm512_maskz_loadu_pd(maskOf(0, nd), base);
-  const __m512d v1 = _mm512_maskz_loadu_pd(maskOf(8, nd), base + 8);
-  const __m512d v2 = _mm512_maskz_loadu_pd(maskOf(16, nd), base + 16);
-  // Element 3 s + c of the 24 is coordinate c of sample s: the first six samples come from
-  // v0 and v1, the last two or three from v2.
-  x = _mm512_permutex2var_pd(
-      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), v1),
-      _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), v2);
-  y = _mm512_permutex2var_pd(
-      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), v1),
-      _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), v2);
-  z = _mm512_permutex2var_pd(
-      _mm512_permutex2var_pd(v0, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), v1),
-      _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), v2);
-}
-
 /// The constants of formSample's arithmetic for one kernel, splatted.
 struct FormConstants {
   __m512d invT2, one, minus4InvT2, b0, minus4InvT, zero;
@@ -237,38 +197,10 @@ SCALESPACE_TARGET_AVX512 inline int formSamples8(__m512d qx, __m512d qy, __m512d
   return __builtin_popcount(live);
 }
 
-/// addDerivativeSamples with eight samples formed at a time. Measured: the robust 200k Stairs
+/// addDerivativeColumns with eight samples formed at a time, read straight from the columns.
+/// Measured (forming eight packed samples at a time, before the columns): the robust 200k Stairs
 /// stack with one thread took 22.8-23.1 s against 23.8-24.0 s forming one sample at a time (runs
 /// interleaved); forming was ~2/3 of the pass in perf, the accumulation the rest.
-SCALESPACE_TARGET_AVX512 int addSamplesAvx512(const Vec3* p, const Vec3* n, const double* e,
-                                              std::size_t count, const Vec3& x,
-                                              const WeightKernel& kernel, DerivativeSums& sums) {
-  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 arrays must be packed x, y, z");
-  static_assert(DerivativeChunk::kSize % 8 == 0, "chunks hold whole groups of eight");
-  DerivativeChunk chunk;  // alignas(64): its item columns take aligned stores
-  const FormConstants constants(kernel);
-  const __m512d cx = _mm512_set1_pd(x.x()), cy = _mm512_set1_pd(x.y()), cz = _mm512_set1_pd(x.z());
-  const double* pd = p->data();
-  const double* nd = n->data();
-  int used = 0;
-  std::size_t k = 0;
-  while (k < count) {
-    int m = 0;
-    for (; k < count && m < DerivativeChunk::kSize; k += 8, m += 8) {
-      const std::size_t rest = count - k;
-      const __mmask8 lanes = rest >= 8 ? __mmask8(0xff) : __mmask8((1u << rest) - 1);
-      __m512d px, py, pz, nx, ny, nz;
-      loadVec3x8(pd + 3 * k, rest, px, py, pz);
-      loadVec3x8(nd + 3 * k, rest, nx, ny, nz);
-      used += formSamples8(_mm512_sub_pd(px, cx), _mm512_sub_pd(py, cy), _mm512_sub_pd(pz, cz), nx,
-                           ny, nz, _mm512_maskz_loadu_pd(lanes, e + k), lanes, constants, chunk, m);
-    }
-    accumulateAvx512(chunk, m, sums);
-  }
-  return used;
-}
-
-/// addDerivativeColumns with eight samples formed at a time, read straight from the columns.
 SCALESPACE_TARGET_AVX512 int addColumnsAvx512(const NeighborColumns& c, const double* e,
                                               const Vec3& x, const WeightKernel& kernel,
                                               DerivativeSums& sums) {
@@ -301,15 +233,6 @@ SCALESPACE_TARGET_AVX512 int addColumnsAvx512(const NeighborColumns& c, const do
 #endif
 
 }  // namespace
-
-int addDerivativeSamples(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
-                         const Vec3& x, const WeightKernel& weight, DerivativeSums& sums,
-                         SimdKernel kernel) {
-#ifdef SCALESPACE_HAVE_AVX2_TARGET
-  if (useAvx512(kernel)) return addSamplesAvx512(p, n, e, count, x, weight, sums);
-#endif
-  return addSamplesOneByOne(p, n, e, count, x, weight, sums, kernel);
-}
 
 int addDerivativeColumns(const NeighborColumns& c, const double* e, const Vec3& x,
                          const WeightKernel& weight, DerivativeSums& sums, SimdKernel kernel) {

@@ -26,18 +26,13 @@ using DerivativeSums = double[9][12];
 void accumulateDerivativeSums(const DerivativeChunk& chunk, int m, DerivativeSums& sums,
                               SimdKernel kernel = SimdKernel::Auto);
 
-/// The whole derivative pass over `count` samples p[k], n[k] with extra weights e[k] (robust
-/// factors) around the evaluation point x: forms each sample's item and factors (q = p - x,
+/// The whole derivative pass over the samples of `c` with extra weights e[k] (robust factors)
+/// around the evaluation point x: sample k is p = (qx, qy, qz)[k] with normal (nx, ny, nz)[k]
+/// (the columns' d2 and weight are not read). Forms each sample's item and factors (q = p - x,
 /// w = (r - 1)^2 e with r = |q|^2 / t^2, Eq. 1.6, and its derivatives, OrientedSphereFit::add)
 /// and adds I F^T to `sums`. Samples with r >= 1 or no positive weight add nothing. Returns how
 /// many samples have a positive weight. The AVX-512 version forms eight samples at a time and
 /// transposes their factors into rows; the others form one at a time.
-int addDerivativeSamples(const Vec3* p, const Vec3* n, const double* e, std::size_t count,
-                         const Vec3& x, const WeightKernel& weight, DerivativeSums& sums,
-                         SimdKernel kernel = SimdKernel::Auto);
-
-/// addDerivativeSamples on samples held as columns: sample k is p = (qx, qy, qz)[k] with normal
-/// (nx, ny, nz)[k] (the columns' d2 and weight are not read: both are formed again from p - x).
 int addDerivativeColumns(const NeighborColumns& c, const double* e, const Vec3& x,
                          const WeightKernel& weight, DerivativeSums& sums,
                          SimdKernel kernel = SimdKernel::Auto);

@@ -270,15 +270,6 @@ void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
   if (scale_) dt_.noalias() += (kernel_.scaleDerivative(r) * extraWeight) * item;
 }
 
-void OrientedSphereFit::addBatchWithDerivatives(const Vec3* p, const Vec3* n,
-                                                const double* extraWeight, std::size_t count) {
-  // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
-  // instead of updating 108 member sums per sample.
-  DerivativeSums sums = {};
-  const int used = addDerivativeSamples(p, n, extraWeight, count, x_, kernel_, sums);
-  addDerivativeBlock(sums, used);
-}
-
 void OrientedSphereFit::addDerivativeBlock(const double (&sums)[9][12], int used) {
   count_ += used;
   for (int i = 0; i < 9; ++i) {
@@ -295,6 +286,8 @@ void OrientedSphereFit::addDerivativeBlock(const double (&sums)[9][12], int used
 
 void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double* extraWeight) {
   if (order_ != FitDerivatives::None || scale_) {
+    // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
+    // instead of updating 108 member sums per sample.
     DerivativeSums sums = {};
     const int used = addDerivativeColumns(columns, extraWeight, x_, kernel_, sums);
     addDerivativeBlock(sums, used);
@@ -303,42 +296,6 @@ void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double*
   for (std::size_t k = 0; k < columns.size(); ++k)
     add(Vec3(columns.qx[k], columns.qy[k], columns.qz[k]),
         Vec3(columns.nx[k], columns.ny[k], columns.nz[k]), extraWeight[k]);
-}
-
-void OrientedSphereFit::addBatch(const Vec3* p, const Vec3* n, const double* extraWeight,
-                                 std::size_t count) {
-  if (order_ != FitDerivatives::None || scale_) {
-    addBatchWithDerivatives(p, n, extraWeight, count);
-    return;
-  }
-  // Same arithmetic as add(), accumulated in locals: the member sums would be reloaded and
-  // stored at every sample (a loop-carried dependency through memory).
-  double s0 = 0, sq0 = 0, sq1 = 0, sq2 = 0, sn0 = 0, sn1 = 0, sn2 = 0, sqn = 0, sqq = 0;
-  int used = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    const Vec3 q = p[k] - x_;
-    const double d2 = q.squaredNorm();
-    const double r = kernel_.ratio(d2);
-    if (r >= 1) continue;
-    const double rm1 = r - 1;
-    const double w = rm1 * rm1 * extraWeight[k];
-    if (!(w > 0)) continue;
-    ++used;
-    s0 += w;
-    sq0 += w * q.x(), sq1 += w * q.y(), sq2 += w * q.z();
-    sn0 += w * n[k].x(), sn1 += w * n[k].y(), sn2 += w * n[k].z();
-    sqn += w * q.dot(n[k]);
-    sqq += w * d2;
-  }
-  count_ += used;
-  Item item;
-  item << s0, sq0, sq1, sq2, sn0, sn1, sn2, sqn, sqq;
-  s_ += item;
-}
-
-void OrientedSphereFit::addSums(const double* sums, int count) {
-  for (int k = 0; k < 9; ++k) s_[k] += sums[k];
-  count_ += count;
 }
 
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel kernel) const {

@@ -37,8 +37,9 @@ struct OrientedSphereFitResult {
 };
 
 /// The sphere of precomputed sums without derivatives: what finish() gives for
-/// FitDerivatives::None after addSums(sums, count), without a fit object (the robust passes'
-/// intermediate fits, fit/LocalFit). `sums` as in addSums; false where finish() is invalid.
+/// FitDerivatives::None on the same sums, without a fit object (the robust passes' intermediate
+/// fits, fit/LocalFit). `sums`: sum w, w q (3), w n (3), w q.n, w |q|^2 over `count` samples of
+/// positive weight, frame centred at the fit's point; false where finish() is invalid.
 bool sphereFromSums(const double* sums, int count, double t, int minNeighbors,
                     AlgebraicSphere& sphere);
 
@@ -49,16 +50,10 @@ class OrientedSphereFit {
   /// Adds sample p with unit normal n; `extraWeight` multiplies the kernel weight (robust
   /// re-weighting; treated as a constant when differentiating).
   void add(const Vec3& p, const Vec3& n, double extraWeight = 1.0);
-  /// add(p[k], n[k], extraWeight[k]) for k < count. Without derivatives this runs a tight loop
-  /// that keeps the sums in registers (the robust passes of fit/LocalFit make most calls).
-  void addBatch(const Vec3* p, const Vec3* n, const double* extraWeight, std::size_t count);
   /// add(p_k, n_k, extraWeight[k]) for every sample k of the columns, p_k = (qx, qy, qz)[k] and
   /// n_k = (nx, ny, nz)[k] (their d2 and weight are not read). The derivative pass reads the
   /// columns eight at a time (fit/DerivativeSums).
   void addColumns(const NeighborColumns& columns, const double* extraWeight);
-  /// Adds sums made elsewhere (fit/RobustReweighting: sum w, w q, w n, w q.n, w |q|^2 over
-  /// `count` samples of positive weight, frame centred at x). Only for fits without derivatives.
-  void addSums(const double* sums, int count);
   /// Solves Eq. 1.7-1.9 (and the derivatives). Invalid when fewer than minNeighbors samples
   /// have weight, when the positions are degenerate (all equal) or Delta <= 0. `kernel`
   /// (fit/SimdKernel.hpp): the second-order (W3) solve has an AVX-512 version.
@@ -68,8 +63,6 @@ class OrientedSphereFit {
   double support() const { return kernel_.t; }
 
  private:
-  void addBatchWithDerivatives(const Vec3* p, const Vec3* n, const double* extraWeight,
-                               std::size_t count);
   /// Adds the 9 x 12 block of the derivative pass (fit/DerivativeSums) to the member sums.
   void addDerivativeBlock(const double (&sums)[9][12], int used);
   using Item = Eigen::Matrix<double, 9, 1>;  // 1, q, n, q.n, |q|^2
