@@ -41,12 +41,17 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
       graph.order.size() == n && graph.localNeighbors.size() == graph.neighbors.size();
   const std::vector<Index>& adjacency = local ? graph.localNeighbors : graph.neighbors;
   auto pointOf = [&](Index v) { return local ? graph.order[v] : v; };
-  std::vector<Vec3> normal(n);
-  std::vector<int> label(n);  // -1 free, -2 invalid (joins no region), else the region
+  // What the walk reads of a neighbour, its label and normal, in one 32-byte slot: the walk is
+  // bound by these reads (two cache misses per edge with separate arrays).
+  struct alignas(32) Vertex {
+    double normal[3];
+    int label;  // -1 free, -2 invalid (joins no region), else the region
+  };
+  std::vector<Vertex> vertex(n);
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t v) {
     const Index i = pointOf(Index(v));
-    normal[v] = scale.normals[i];
-    label[v] = scale.valid[i] ? -1 : -2;
+    const Vec3& normal = scale.normals[i];
+    vertex[v] = {{normal.x(), normal.y(), normal.z()}, scale.valid[i] ? -1 : -2};
   });
 
   // The walk labels the regions; their point lists are then filled in one pass over the points
@@ -55,30 +60,32 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
   std::vector<std::size_t> regionSize;
   for (const KeyedIndex& item : order) {
     const Index seed = local ? graph.rank[item.index] : item.index;
-    if (label[seed] != -1) continue;
+    if (vertex[seed].label != -1) continue;
     const int id = int(regionSize.size());
-    const Vec3 seedNormal = normal[seed];
+    const double* seedNormal = vertex[seed].normal;
+    const double sx = seedNormal[0], sy = seedNormal[1], sz = seedNormal[2];
     std::size_t size = 1;
-    label[seed] = id;
+    vertex[seed].label = id;
     frontier.assign(1, seed);
     while (!frontier.empty()) {
       const Index p = frontier.back();
       frontier.pop_back();
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
-        const Index q = adjacency[e];
-        if (label[q] != -1) continue;
+        Vertex& q = vertex[adjacency[e]];
+        if (q.label != -1) continue;
         // Against the seed's normal, not the neighbour's: the region stays planar (Sec. 2.3.1).
-        if (!(normal[q].dot(seedNormal) >= cosTheta)) continue;
-        label[q] = id;
+        // (Vec3::dot's order of operations, so the regions are those of the Vec3 version.)
+        if (!(q.normal[0] * sx + q.normal[1] * sy + q.normal[2] * sz >= cosTheta)) continue;
+        q.label = id;
         ++size;
-        frontier.push_back(q);
+        frontier.push_back(adjacency[e]);
       }
     }
     regionSize.push_back(size);
   }
   Segmentation seg;
   seg.labels.assign(n, -1);
-  for (std::size_t v = 0; v < n; ++v) seg.labels[pointOf(Index(v))] = std::max(label[v], -1);
+  for (std::size_t v = 0; v < n; ++v) seg.labels[pointOf(Index(v))] = std::max(vertex[v].label, -1);
   seg.regions.resize(regionSize.size());
   for (std::size_t r = 0; r < regionSize.size(); ++r) seg.regions[r].reserve(regionSize[r]);
   for (std::size_t i = 0; i < n; ++i)
