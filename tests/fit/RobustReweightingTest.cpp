@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "scalespace/fit/RobustReweighting.hpp"
@@ -161,6 +162,39 @@ TEST(RobustReweighting, EmptyPreviousFactorsAreOnes) {
       EXPECT_EQ(rhoOnes, rhoEmpty);
       for (int i = 0; i < 9; ++i) EXPECT_EQ(a.s[i], b.s[i]);
       EXPECT_EQ(a.used, b.used);
+    }
+  }
+}
+
+// Asking for less (ReweightOutput) changes nothing that is computed: the same factors on every
+// path, the same sums without their count, and no change measured.
+TEST(RobustReweighting, PartialOutputsEqualTheFullPass) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (SimdKernel kernel :
+       {SimdKernel::Portable, SimdKernel::Avx2Fma, SimdKernel::Avx512, SimdKernel::Auto}) {
+    for (std::size_t n = 0; n <= 19; ++n) {
+      const NeighborColumns c = randomNeighbors(n, rng);
+      AlgebraicSphere s;
+      s.uc = 0.05 * u(rng);
+      s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
+      s.uq = 0.3 * u(rng);
+      std::vector<double> previous(n, 0.5), rhoAll, rhoSums, rhoFactors;
+      SphereSums all, sums, factors;
+      reweight(s, 25, 4, c, previous, rhoAll, all, kernel, ReweightOutput::All);
+      EXPECT_EQ(reweight(s, 25, 4, c, previous, rhoSums, sums, kernel, ReweightOutput::Sums), inf);
+      EXPECT_EQ(
+          reweight(s, 25, 4, c, previous, rhoFactors, factors, kernel, ReweightOutput::FactorsOnly),
+          inf);
+      EXPECT_EQ(rhoAll, rhoSums);
+      EXPECT_EQ(rhoAll, rhoFactors);
+      for (int i = 0; i < 9; ++i) {
+        EXPECT_EQ(sums.s[i], all.s[i]);
+        EXPECT_EQ(factors.s[i], 0.0);
+      }
+      EXPECT_EQ(sums.used, 0);
+      EXPECT_EQ(factors.used, 0);
     }
   }
 }

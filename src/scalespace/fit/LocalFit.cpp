@@ -148,13 +148,21 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
   if (passes == 0) return res;
   const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
   const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
+  // With no tolerance, the change of the factors is not measured: stopping when it is exactly 0
+  // would give the same fit (equal factors make equal sums). The pass whose fit is redone with
+  // derivatives needs only its factors.
+  const bool track = options.robustTolerance > 0;
   for (int it = 0; it < passes && res.valid; ++it) {
+    const bool last = reported && it + 1 == passes;
+    const ReweightOutput output = track  ? ReweightOutput::All
+                                  : last ? ReweightOutput::FactorsOnly
+                                         : ReweightOutput::Sums;
     // Converged: the next fit would be (nearly) the current one.
-    const double change =
-        reweight(res.sphere, invSr2, invSn2, ws.columns, ws.weights, ws.trialWeights, sums);
+    const double change = reweight(res.sphere, invSr2, invSn2, ws.columns, ws.weights,
+                                   ws.trialWeights, sums, SimdKernel::Auto, output);
     if (change <= options.robustTolerance) break;
     // min 1: re-weighting may zero far outliers; the neighbour count check was done above.
-    if (reported && it + 1 == passes) {
+    if (last) {
       OrientedSphereFitResult next = spherePass(t, ws, ws.trialWeights, order, true, 1);
       if (!next.valid) break;
       next.neighbors = res.neighbors;
@@ -163,8 +171,10 @@ OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWor
     } else {
       // An intermediate pass: only the sphere feeds the next re-weighting (what finish() would
       // give for these sums without derivatives, at a fraction of its cost).
+      // Without the count (ReweightOutput::Sums), s0 > 0 exactly when a sample has weight.
+      const int count = track ? sums.used : sums.s[0] > 0 ? 1 : 0;
       AlgebraicSphere next;
-      if (!sphereFromSums(sums.s, sums.used, t, 1, next)) break;
+      if (!sphereFromSums(sums.s, count, t, 1, next)) break;
       res.sphere = next;
       res.gradient = next.ul;
       res.weightSum = sums.s[0];

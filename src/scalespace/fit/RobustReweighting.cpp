@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scalespace/fit/FastExp.hpp"
 
@@ -232,6 +233,9 @@ SCALESPACE_TARGET_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d
 /// against 190 ns for the AVX2 one, whose body (~120 instructions for 4 neighbours, accumulators
 /// spilled: 16 registers) is latency-bound; here 32 registers hold everything and the last group's
 /// mask is a mask register.
+/// kSums: accumulate the next fit's sums; kTrack: count the samples of positive weight and
+/// measure the largest change (ReweightOutput; each is a few instructions of ~70 per group).
+template <bool kSums, bool kTrack>
 SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double invSr2,
                                                double invSn2, const NeighborColumns& c,
                                                const std::vector<double>& previous,
@@ -272,17 +276,23 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
     const __m512d rh = _mm512_maskz_mov_pd(
         m, expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn))));
     _mm512_mask_storeu_pd(out + k, m, rh);
-    change = _mm512_max_pd(
-        change, _mm512_abs_pd(_mm512_sub_pd(
-                    rh, _mm512_mask_loadu_pd(_mm512_maskz_mov_pd(ones ? m : 0, splat8(1.0)),
-                                             ones ? 0 : m, prev + k))));
-    const __m512d w = _mm512_mul_pd(_mm512_maskz_loadu_pd(m, ws + k), rh);
-    used += accumulate8(acc, w, qx, qy, qz, nx, ny, nz, d2);
+    if (kTrack)
+      change = _mm512_max_pd(
+          change, _mm512_abs_pd(_mm512_sub_pd(
+                      rh, _mm512_mask_loadu_pd(_mm512_maskz_mov_pd(ones ? m : 0, splat8(1.0)),
+                                               ones ? 0 : m, prev + k))));
+    if (kSums) {
+      const __m512d w = _mm512_mul_pd(_mm512_maskz_loadu_pd(m, ws + k), rh);
+      const int positive = accumulate8(acc, w, qx, qy, qz, nx, ny, nz, d2);
+      if (kTrack) used += positive;  // (the count is dropped by the compiler otherwise)
+    }
   }
-  addReduced8(acc, next.s);
-  next.s[8] += _mm512_reduce_add_pd(acc[8]);
+  if (kSums) {
+    addReduced8(acc, next.s);
+    next.s[8] += _mm512_reduce_add_pd(acc[8]);
+  }
   next.used += used;
-  return _mm512_reduce_max_pd(change);
+  return kTrack ? _mm512_reduce_max_pd(change) : std::numeric_limits<double>::infinity();
 }
 
 SCALESPACE_TARGET_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c, SphereSums& out) {
@@ -321,15 +331,35 @@ void kernelWeightedSums(const NeighborColumns& c, SphereSums& out, SimdKernel ke
 
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
                 const NeighborColumns& c, const std::vector<double>& previous,
-                std::vector<double>& rho, SphereSums& next, SimdKernel kernel) {
+                std::vector<double>& rho, SphereSums& next, SimdKernel kernel,
+                ReweightOutput output) {
   rho.resize(c.size());
   next = SphereSums{};
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-  if (useAvx512(kernel)) return reweightAvx512(sphere, invSr2, invSn2, c, previous, rho, next);
-  if (useAvx2Fma(kernel)) return reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
+  if (useAvx512(kernel)) {
+    switch (output) {
+      case ReweightOutput::All:
+        return reweightAvx512<true, true>(sphere, invSr2, invSn2, c, previous, rho, next);
+      case ReweightOutput::Sums:
+        return reweightAvx512<true, false>(sphere, invSr2, invSn2, c, previous, rho, next);
+      case ReweightOutput::FactorsOnly:
+        return reweightAvx512<false, false>(sphere, invSr2, invSn2, c, previous, rho, next);
+    }
+  }
 #endif
+  // The other paths compute everything and drop what was not asked for.
+  double change = 0;
+#ifdef SCALESPACE_HAVE_AVX2_TARGET
+  if (useAvx2Fma(kernel))
+    change = reweightAvx2(sphere, invSr2, invSn2, c, previous, rho, next);
+  else
+#endif
+    change = reweightPortable(sphere, invSr2, invSn2, c, previous, rho, next);
   (void)kernel;
-  return reweightPortable(sphere, invSr2, invSn2, c, previous, rho, next);
+  if (output == ReweightOutput::All) return change;
+  next.used = 0;
+  if (output == ReweightOutput::FactorsOnly) next = SphereSums{};
+  return std::numeric_limits<double>::infinity();
 }
 
 }  // namespace scalespace

@@ -28,13 +28,21 @@ struct SphereSums {
 void kernelWeightedSums(const NeighborColumns& c, SphereSums& out,
                         SimdKernel kernel = SimdKernel::Auto);
 
+/// What reweight() computes besides the factors (always all of them).
+enum class ReweightOutput {
+  All,         // the next fit's sums with their count, and the largest change of a factor
+  Sums,        // the sums alone (next.used 0, returns +infinity): a pass with no tolerance
+  FactorsOnly  // nothing else (next zero, returns +infinity): the pass redone with derivatives
+};
+
 /// Re-weights against `sphere`: writes rho_k to rho (resized), accumulates the sums with weights
 /// w_k rho_k into `next` (from zero) and returns max_k |rho_k - previous[k]| (`previous` empty:
-/// every previous factor is 1, as for the kernel-only fit). invSr2 = 1 /
-/// sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets rho = 0.
-/// `kernel`: fit/SimdKernel.hpp.
+/// every previous factor is 1, as for the kernel-only fit), or less as `output` says.
+/// invSr2 = 1 / sigma_r^2, invSn2 = 1 / sigma_n^2. A neighbour where the gradient vanishes gets
+/// rho = 0. `kernel`: fit/SimdKernel.hpp.
 double reweight(const AlgebraicSphere& sphere, double invSr2, double invSn2,
                 const NeighborColumns& c, const std::vector<double>& previous,
-                std::vector<double>& rho, SphereSums& next, SimdKernel kernel = SimdKernel::Auto);
+                std::vector<double>& rho, SphereSums& next, SimdKernel kernel = SimdKernel::Auto,
+                ReweightOutput output = ReweightOutput::All);
 
 }  // namespace scalespace
