@@ -232,13 +232,8 @@ void OrientedSphereFit::begin(const Vec3& x, double t, FitDerivatives order, boo
   order_ = order;
   scale_ = scale;
   count_ = 0;
-  s_.setZero();
-  if (order_ >= FitDerivatives::First) g_.setZero();
-  if (order_ >= FitDerivatives::Second) {
-    a_.setZero();
-    b_.setZero();
-  }
-  if (scale_) dt_.setZero();
+  for (auto& row : sums_)
+    for (double& v : row) v = 0;
 }
 
 void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
@@ -250,47 +245,37 @@ void OrientedSphereFit::add(const Vec3& p, const Vec3& n, double extraWeight) {
   const double w = rm1 * rm1 * extraWeight;
   if (!(w > 0)) return;
   ++count_;
-  Item item;
-  item << 1.0, q.x(), q.y(), q.z(), n.x(), n.y(), n.z(), q.dot(n), d2;
-  s_.noalias() += w * item;
+  const double item[9] = {1.0, q.x(), q.y(), q.z(), n.x(), n.y(), n.z(), q.dot(n), d2};
+  for (int i = 0; i < 9; ++i) sums_[i][0] += w * item[i];
   if (order_ >= FitDerivatives::First) {
     // grad_x w = -grad_q w = -4 (r - 1) q / t^2 (dq/dx = -I).
     const Vec3 gx = (-4 * rm1 * kernel_.invT2 * extraWeight) * q;
-    g_.noalias() += item * gx.transpose();
+    for (int i = 0; i < 9; ++i)
+      for (int c = 0; c < 3; ++c) sums_[i][1 + c] += item[i] * gx[c];
   }
   if (order_ >= FitDerivatives::Second) {
     // hess_x w = hess_q w = 4 (r - 1) I / t^2 + 8 q q^T / t^4 (two sign flips cancel).
     const double a = 4 * rm1 * kernel_.invT2 * extraWeight;
     const double b = 8 * kernel_.invT2 * kernel_.invT2 * extraWeight;
-    a_.noalias() += a * item;
-    Eigen::Matrix<double, 1, 6> qq;
-    qq << q.x() * q.x(), q.y() * q.y(), q.z() * q.z(), q.x() * q.y(), q.x() * q.z(), q.y() * q.z();
-    b_.noalias() += (b * item) * qq;
-  }
-  if (scale_) dt_.noalias() += (kernel_.scaleDerivative(r) * extraWeight) * item;
-}
-
-void OrientedSphereFit::addDerivativeBlock(const double (&sums)[9][12], int used) {
-  count_ += used;
-  for (int i = 0; i < 9; ++i) {
-    s_[i] += sums[i][0];
-    if (order_ >= FitDerivatives::First)
-      for (int c = 0; c < 3; ++c) g_(i, c) += sums[i][1 + c];
-    if (order_ >= FitDerivatives::Second) {
-      a_[i] += sums[i][4];
-      for (int c = 0; c < 6; ++c) b_(i, c) += sums[i][5 + c];
+    const double qq[6] = {q.x() * q.x(), q.y() * q.y(), q.z() * q.z(),
+                          q.x() * q.y(), q.x() * q.z(), q.y() * q.z()};
+    for (int i = 0; i < 9; ++i) {
+      sums_[i][4] += a * item[i];
+      for (int c = 0; c < 6; ++c) sums_[i][5 + c] += (b * item[i]) * qq[c];
     }
-    if (scale_) dt_[i] += sums[i][11];
+  }
+  if (scale_) {
+    const double dt = kernel_.scaleDerivative(r) * extraWeight;
+    for (int i = 0; i < 9; ++i) sums_[i][11] += dt * item[i];
   }
 }
 
 void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double* extraWeight) {
   if (order_ != FitDerivatives::None || scale_) {
-    // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp): the block stays in registers
-    // instead of updating 108 member sums per sample.
-    DerivativeSums sums = {};
-    const int used = addDerivativeColumns(columns, extraWeight, x_, kernel_, sums);
-    addDerivativeBlock(sums, used);
+    // add()'s sums as one 9 x 12 block (fit/DerivativeSums.hpp), accumulated in registers
+    // chunk by chunk straight onto the members (the columns an order does not need are formed
+    // too, and never read).
+    count_ += addDerivativeColumns(columns, extraWeight, x_, kernel_, sums_);
     return;
   }
   for (std::size_t k = 0; k < columns.size(); ++k)
@@ -301,17 +286,19 @@ void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double*
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel kernel) const {
   OrientedSphereFitResult res;
   res.neighbors = count_;
-  res.weightSum = s_[0];
-  if (count_ < minNeighbors || count_ < 1 || !(s_[0] > 0)) return res;
+  double s[9];  // sum w item
+  for (int k = 0; k < 9; ++k) s[k] = sums_[k][0];
+  res.weightSum = s[0];
+  if (count_ < minNeighbors || count_ < 1 || !(s[0] > 0)) return res;
   const double t2 = kernel_.t * kernel_.t;
-  const double degenerate = 1e-14 * s_[0] * s_[0] * t2;
+  const double degenerate = 1e-14 * s[0] * s[0] * t2;
   AlgebraicSphere sphere;
   if (order_ == FitDerivatives::None) {
-    if (!solvePlain(s_.data(), kernel_.t, sphere)) return res;
+    if (!solvePlain(s, kernel_.t, sphere)) return res;
     res.gradient = sphere.ul;
   } else if (order_ == FitDerivatives::First) {
     Jet1 items[9];
-    for (int k = 0; k < 9; ++k) items[k] = {s_[k], g_.row(k).transpose()};
+    for (int k = 0; k < 9; ++k) items[k] = {s[k], Vec3(sums_[k][1], sums_[k][2], sums_[k][3])};
     const auto u = solveSphere<Jet1>(items, degenerate);
     if (!u.ok) return res;
     sphere.uc = u.uc.v;
@@ -326,9 +313,9 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel k
     Jet2 items[9];
     for (int k = 0; k < 9; ++k) {
       // hess_x of the sum: a I + b qq^T (add(): xx, yy, zz, xy, xz, yz)
-      items[k].v = s_[k];
-      items[k].g = g_.row(k).transpose();
-      for (int e = 0; e < 6; ++e) items[k].h[e] = b_(k, e) + (e < 3 ? a_[k] : 0.0);
+      items[k].v = s[k];
+      items[k].g = Vec3(sums_[k][1], sums_[k][2], sums_[k][3]);
+      for (int e = 0; e < 6; ++e) items[k].h[e] = sums_[k][5 + e] + (e < 3 ? sums_[k][4] : 0.0);
     }
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
     const SecondOrderTerms u = useAvx512(kernel) ? secondOrderAvx512(items, degenerate)
@@ -355,7 +342,7 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel k
   }
   if (scale_) {
     Dual items[9];
-    for (int k = 0; k < 9; ++k) items[k] = {s_[k], dt_[k]};
+    for (int k = 0; k < 9; ++k) items[k] = {s[k], sums_[k][11]};
     const auto u = solveSphere<Dual>(items, degenerate);
     if (u.ok) {
       res.dUcDt = u.uc.d;

@@ -63,19 +63,15 @@ class OrientedSphereFit {
   double support() const { return kernel_.t; }
 
  private:
-  /// Adds the 9 x 12 block of the derivative pass (fit/DerivativeSums) to the member sums.
-  void addDerivativeBlock(const double (&sums)[9][12], int used);
-  using Item = Eigen::Matrix<double, 9, 1>;  // 1, q, n, q.n, |q|^2
   Vec3 x_ = Vec3::Zero();
   WeightKernel kernel_{1.0};
   FitDerivatives order_ = FitDerivatives::None;
   bool scale_ = false;
   int count_ = 0;
-  Item s_;                         // sum w item
-  Eigen::Matrix<double, 9, 3> g_;  // sum grad_x w item^T
-  Item a_;                         // sum a item   (hess w = a I + b q q^T)
-  Eigen::Matrix<double, 9, 6> b_;  // sum b item (q q^T as xx, yy, zz, xy, xz, yz)
-  Item dt_;                        // sum dw/dt item
+  /// sum over the samples of item_i * factor_j (fit/DerivativeSums.hpp): items 1, q, n, q.n,
+  /// |q|^2; factors w, grad_x w (3), a and b q q^T (xx, yy, zz, xy, xz, yz) of hess_x w =
+  /// a I + b q q^T, dw/dt. Column 0 is the plain fit's sums.
+  double sums_[9][12] = {};
 };
 
 }  // namespace scalespace
