@@ -53,16 +53,23 @@ NeighborColumns randomNeighbors(std::size_t n, std::mt19937& rng) {
   return c;
 }
 
+/// A sphere through the neighbourhood of randomNeighbors (nearly the plane z = 0).
+AlgebraicSphere randomSphere(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  AlgebraicSphere s;
+  s.uc = 0.05 * u(rng);
+  s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
+  s.uq = 0.3 * u(rng);
+  return s;
+}
+
 void checkAgainstDirect(SimdKernel kernel) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
   const double invSr2 = 1 / (0.2 * 0.2), invSn2 = 1 / (0.5 * 0.5);
   for (std::size_t n = 0; n <= 37; ++n) {
     const NeighborColumns c = randomNeighbors(n, rng);
-    AlgebraicSphere s;
-    s.uc = 0.05 * u(rng);
-    s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
-    s.uq = 0.3 * u(rng);
+    const AlgebraicSphere s = randomSphere(rng);
     std::vector<double> previous(n), rho;
     for (double& p : previous) p = 0.5 + 0.5 * u(rng);
     SphereSums sums;
@@ -144,15 +151,11 @@ TEST(RobustReweighting, DegenerateSphereAndFarSamplesGiveZeroFactors) {
 // path and count.
 TEST(RobustReweighting, EmptyPreviousFactorsAreOnes) {
   std::mt19937 rng(29);
-  std::uniform_real_distribution<double> u(-1, 1);
   for (SimdKernel kernel :
        {SimdKernel::Portable, SimdKernel::Avx2Fma, SimdKernel::Avx512, SimdKernel::Auto}) {
     for (std::size_t n = 0; n <= 19; ++n) {
       const NeighborColumns c = randomNeighbors(n, rng);
-      AlgebraicSphere s;
-      s.uc = 0.05 * u(rng);
-      s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
-      s.uq = 0.3 * u(rng);
+      const AlgebraicSphere s = randomSphere(rng);
       std::vector<double> rhoOnes, rhoEmpty;
       SphereSums a, b;
       const double changeOnes =
@@ -170,16 +173,12 @@ TEST(RobustReweighting, EmptyPreviousFactorsAreOnes) {
 // path, the same sums without their count, and no change measured.
 TEST(RobustReweighting, PartialOutputsEqualTheFullPass) {
   std::mt19937 rng(31);
-  std::uniform_real_distribution<double> u(-1, 1);
   const double inf = std::numeric_limits<double>::infinity();
   for (SimdKernel kernel :
        {SimdKernel::Portable, SimdKernel::Avx2Fma, SimdKernel::Avx512, SimdKernel::Auto}) {
     for (std::size_t n = 0; n <= 19; ++n) {
       const NeighborColumns c = randomNeighbors(n, rng);
-      AlgebraicSphere s;
-      s.uc = 0.05 * u(rng);
-      s.ul = Vec3(0.1 * u(rng), 0.1 * u(rng), 1);
-      s.uq = 0.3 * u(rng);
+      const AlgebraicSphere s = randomSphere(rng);
       std::vector<double> previous(n, 0.5), rhoAll, rhoSums, rhoFactors;
       SphereSums all, sums, factors;
       reweight(s, 25, 4, c, previous, rhoAll, all, kernel, ReweightOutput::All);

@@ -2,17 +2,8 @@
 
 #include <algorithm>
 
+#include "scalespace/fit/SimdIntrinsics.hpp"
 #include "scalespace/fit/WeightKernel.hpp"
-
-#ifdef SCALESPACE_HAVE_AVX2_TARGET
-// GCC 12's AVX-512 intrinsics trip -Wuninitialized inside the header (GCC bug 105593; see
-// fit/RobustReweighting.cpp).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <immintrin.h>
-#endif
 
 namespace scalespace {
 

@@ -1,19 +1,11 @@
 #include "scalespace/fit/OrientedSphereFit.hpp"
 
 #include <cmath>
+#include <type_traits>
 
 #include "scalespace/fit/DerivativeSums.hpp"
 #include "scalespace/fit/Jet.hpp"
-
-#ifdef SCALESPACE_HAVE_AVX2_TARGET
-// GCC 12's AVX-512 intrinsics trip -Wuninitialized inside the header (GCC bug 105593; see
-// fit/RobustReweighting.cpp).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <immintrin.h>
-#endif
+#include "scalespace/fit/SimdIntrinsics.hpp"
 
 namespace scalespace {
 namespace {
@@ -89,9 +81,9 @@ bool solvePlain(const double* sums, double t, AlgebraicSphere& sphere) {
   return true;
 }
 
-/// What finish() reads from the W3 solve: Eq. 1.7-1.9 with the first and second derivatives of
-/// u_c and u_q and the first derivatives of u_l.
-struct SecondOrderTerms {
+/// What finish() reads from a W2 or W3 solve: Eq. 1.7-1.9 with the first derivatives of u_c,
+/// u_q and u_l, and for W3 the second derivatives of u_c.
+struct SphereJets {
   bool ok = false;
   double uc = 0, uq = 0;
   Vec3 ul = Vec3::Zero();
@@ -99,9 +91,9 @@ struct SecondOrderTerms {
   Mat3 jacobianUl = Mat3::Zero(), hessianUc = Mat3::Zero();
 };
 
-SecondOrderTerms secondOrderPortable(const Jet2* items, double degenerate) {
-  const auto u = solveSphere<Jet2>(items, degenerate);
-  SecondOrderTerms r;
+template <class S>
+SphereJets jetsOf(const SphereTerms<S>& u) {
+  SphereJets r;
   if (!u.ok) return r;
   r.ok = true;
   r.uc = u.uc.v;
@@ -112,7 +104,7 @@ SecondOrderTerms secondOrderPortable(const Jet2* items, double degenerate) {
   }
   r.gradUc = u.uc.g;
   r.gradUq = u.uq.g;
-  r.hessianUc = u.uc.hessian();
+  if constexpr (std::is_same_v<S, Jet2>) r.hessianUc = u.uc.hessian();
   return r;
 }
 
@@ -176,7 +168,7 @@ SCALESPACE_TARGET_AVX512 inline Jet2x inverse(const Jet2x& b) {
 }
 
 /// solveSphere<Jet2> (the same operations in the same order; fused multiply-adds round once).
-SCALESPACE_TARGET_AVX512 SecondOrderTerms secondOrderAvx512(const Jet2* items, double degenerate) {
+SCALESPACE_TARGET_AVX512 SphereJets secondOrderAvx512(const Jet2* items, double degenerate) {
   Jet2x it[9];
   for (int k = 0; k < 9; ++k)
     it[k] = {_mm256_setr_pd(items[k].v, items[k].g.x(), items[k].g.y(), items[k].g.z()),
@@ -188,7 +180,7 @@ SCALESPACE_TARGET_AVX512 SecondOrderTerms secondOrderAvx512(const Jet2* items, d
   const Jet2x pp = add(add(mul(sp[0], sp[0]), mul(sp[1], sp[1])), mul(sp[2], sp[2]));
   const Jet2x num = sub(mul(s0, it[7]), pn);  // Eq. 1.7 numerator
   const Jet2x den = sub(mul(s0, it[8]), pp);
-  SecondOrderTerms r;
+  SphereJets r;
   if (!(_mm256_cvtsd_f64(den.vg) > degenerate)) return r;
   const Jet2x uq = scale(0.5, mul(num, inverse(den)));  // Eq. 1.7
   const Jet2x invS0 = inverse(s0);
@@ -284,6 +276,7 @@ void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double*
 }
 
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel kernel) const {
+  (void)kernel;  // only the AVX-512 build of the W3 solve reads it
   OrientedSphereFitResult res;
   res.neighbors = count_;
   double s[9];  // sum w item
@@ -296,34 +289,27 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel k
   if (order_ == FitDerivatives::None) {
     if (!solvePlain(s, kernel_.t, sphere)) return res;
     res.gradient = sphere.ul;
-  } else if (order_ == FitDerivatives::First) {
-    Jet1 items[9];
-    for (int k = 0; k < 9; ++k) items[k] = {s[k], Vec3(sums_[k][1], sums_[k][2], sums_[k][3])};
-    const auto u = solveSphere<Jet1>(items, degenerate);
-    if (!u.ok) return res;
-    sphere.uc = u.uc.v;
-    sphere.uq = u.uq.v;
-    for (int k = 0; k < 3; ++k) {
-      sphere.ul[k] = u.ul[k].v;
-      res.jacobianUl.row(k) = u.ul[k].g.transpose();
-    }
-    res.gradUc = u.uc.g;
-    res.gradUq = u.uq.g;
   } else {
-    Jet2 items[9];
-    for (int k = 0; k < 9; ++k) {
-      // hess_x of the sum: a I + b qq^T (add(): xx, yy, zz, xy, xz, yz)
-      items[k].v = s[k];
-      items[k].g = Vec3(sums_[k][1], sums_[k][2], sums_[k][3]);
-      for (int e = 0; e < 6; ++e) items[k].h[e] = sums_[k][5 + e] + (e < 3 ? sums_[k][4] : 0.0);
-    }
+    SphereJets u;
+    if (order_ == FitDerivatives::First) {
+      Jet1 items[9];
+      for (int k = 0; k < 9; ++k) items[k] = {s[k], Vec3(sums_[k][1], sums_[k][2], sums_[k][3])};
+      u = jetsOf(solveSphere<Jet1>(items, degenerate));
+    } else {
+      Jet2 items[9];
+      for (int k = 0; k < 9; ++k) {
+        // hess_x of the sum: a I + b qq^T (add(): xx, yy, zz, xy, xz, yz)
+        items[k].v = s[k];
+        items[k].g = Vec3(sums_[k][1], sums_[k][2], sums_[k][3]);
+        for (int e = 0; e < 6; ++e) items[k].h[e] = sums_[k][5 + e] + (e < 3 ? sums_[k][4] : 0.0);
+      }
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-    const SecondOrderTerms u = useAvx512(kernel) ? secondOrderAvx512(items, degenerate)
-                                                 : secondOrderPortable(items, degenerate);
+      u = useAvx512(kernel) ? secondOrderAvx512(items, degenerate)
+                            : jetsOf(solveSphere<Jet2>(items, degenerate));
 #else
-    (void)kernel;
-    const SecondOrderTerms u = secondOrderPortable(items, degenerate);
+      u = jetsOf(solveSphere<Jet2>(items, degenerate));
 #endif
+    }
     if (!u.ok) return res;
     sphere.uc = u.uc;
     sphere.uq = u.uq;
@@ -332,8 +318,9 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel k
     res.gradUc = u.gradUc;
     res.gradUq = u.gradUq;
     // Eq. 1.36 at x = 0: the terms in x vanish, leaving hess u_c + J + J^T + 2 u_q I.
-    res.hessianW3 = u.hessianUc + res.jacobianUl + res.jacobianUl.transpose() +
-                    2 * sphere.uq * Mat3::Identity();
+    if (order_ == FitDerivatives::Second)
+      res.hessianW3 = u.hessianUc + res.jacobianUl + res.jacobianUl.transpose() +
+                      2 * sphere.uq * Mat3::Identity();
   }
   if (order_ >= FitDerivatives::First) {
     // Eq. 1.33 at x = 0: grad u_c + u_l; Eq. 1.34 at x = 0: J + 2 u_q I.

@@ -5,17 +5,7 @@
 #include <limits>
 
 #include "scalespace/fit/FastExp.hpp"
-
-#ifdef SCALESPACE_HAVE_AVX2_TARGET
-// GCC 12's AVX-512 intrinsics fill unused operands with a self-initialised _mm512_undefined_pd(),
-// which -Wuninitialized reports at every inlined use (GCC bug 105593). The warning
-// points into the header, so it is silenced for this file's intrinsics only.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <immintrin.h>
-#endif
+#include "scalespace/fit/SimdIntrinsics.hpp"
 
 namespace scalespace {
 
