@@ -21,10 +21,6 @@ void NeighborColumns::reserve(std::size_t n) {
   for (auto* v : {&qx, &qy, &qz, &nx, &ny, &nz, &d2, &weight}) v->resize(n);
 }
 
-void SampleColumns::resize(std::size_t n) {
-  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz}) v->resize(n);
-}
-
 namespace {
 
 /// Raw pointers to the columns: stores through the output vectors could alias the vectors

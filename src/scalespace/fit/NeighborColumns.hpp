@@ -59,13 +59,13 @@ class NeighborColumns {
 struct SampleColumns {
   Column px, py, pz, nx, ny, nz;
   std::size_t size() const { return px.size(); }
-  void resize(std::size_t n);
 };
 
 /// Replaces `out` by the samples with |p - y|^2 < t^2 (the spatial index's radius test), in
-/// their order in `samples`, as offsets q = p - y with their normals, |q|^2 and kernel weights
-/// (r - 1)^2, r = |q|^2 / t^2 (Eq. 1.6). `kernel`: fit/SimdKernel.hpp (the AVX-512 version
-/// compresses eight candidates at a time; |q|^2 may differ from the portable one in the last bit).
+/// their order in `samples` (which must have normals: the APSS fits' samples), as offsets q = p - y
+/// with their normals, |q|^2 and kernel weights (r - 1)^2, r = |q|^2 / t^2 (Eq. 1.6). `kernel`:
+/// fit/SimdKernel.hpp (the AVX-512 version compresses eight candidates at a time; |q|^2 may differ
+/// from the portable one in the last bit).
 void gatherWithin(const SampleColumns& samples, const Vec3& y, double t, NeighborColumns& out,
                   SimdKernel kernel = SimdKernel::Auto);
 
