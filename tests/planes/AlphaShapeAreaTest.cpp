@@ -135,18 +135,24 @@ TEST(PlaneFit, TiltedPlaneExact) {
 }
 
 TEST(AlphaShape, AreaAtLeastAgreesWithTheFullShape) {
-  // Early answers (bounding box, convex hull, a certified patch) must equal the full shape's.
+  // Early answers (bounding box, convex hull, a thinned or a certified patch) must equal the full
+  // shape's.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
-  std::vector<std::vector<Vec2>> sets(3);
+  std::vector<std::vector<Vec2>> sets(5);
   for (int i = 0; i < 4000; ++i) sets[0].emplace_back(20 * u(rng), u(rng));  // long strip
   for (int i = 0; i < 3000; ++i) {  // L shape: its hull is much larger than its area
     const Vec2 p(u(rng), 6 * u(rng));
     sets[1].push_back(i % 2 ? p : Vec2(p.y(), p.x()));
   }
-  for (int i = 0; i < 40; ++i) sets[2].emplace_back(u(rng), u(rng));  // small: no patch
+  for (int i = 0; i < 40; ++i) sets[2].emplace_back(u(rng), u(rng));    // small: no patch
+  for (int i = 0; i < 8000; ++i) sets[3].emplace_back(u(rng), u(rng));  // dense: thinned patch
+  for (int i = 0; i < 4000; ++i) {  // annulus: its middle is a hole, so no patch there
+    const double a = 6.283185307179586 * u(rng), r = 1 + 0.1 * u(rng);
+    sets[4].emplace_back(r * std::cos(a), r * std::sin(a));
+  }
   for (const auto& pts : sets)
-    for (double radius : {0.03, 0.1, 0.5, 3.0}) {
+    for (double radius : {0.03, 0.07, 0.1, 0.5, 3.0}) {
       const double alpha = radius * radius;
       const double area = alphaShape2(pts, alpha).area;
       for (double f : {0.3, 0.97, 1.03, 3.0}) {
