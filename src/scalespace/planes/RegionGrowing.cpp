@@ -41,44 +41,67 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
       graph.order.size() == n && graph.localNeighbors.size() == graph.neighbors.size();
   const std::vector<Index>& adjacency = local ? graph.localNeighbors : graph.neighbors;
   auto pointOf = [&](Index v) { return local ? graph.order[v] : v; };
-  // What the walk reads of a neighbour, its label and normal, in one 32-byte slot: the walk is
-  // bound by these reads (two cache misses per edge with separate arrays).
+  // What the walk reads of a free neighbour, its label and normal, in one 32-byte slot (two
+  // cache misses per edge with separate arrays).
   struct alignas(32) Vertex {
     double normal[3];
     int label;  // -1 free, -2 invalid (joins no region), else the region
   };
   std::vector<Vertex> vertex(n);
-  tbb::parallel_for(std::size_t(0), n, [&](std::size_t v) {
-    const Index i = pointOf(Index(v));
-    const Vec3& normal = scale.normals[i];
-    vertex[v] = {{normal.x(), normal.y(), normal.z()}, scale.valid[i] ? -1 : -2};
+  // One bit per vertex, set once it is taken (labelled or invalid): the walk tests it before
+  // reading the slot. Most tests are of taken vertices (a vertex has ~10 in-edges and is
+  // labelled through one; most seeds were reached by an earlier region), and the bits of 1M
+  // vertices (125 KB) stay in cache where their slots (32 MB) do not.
+  std::vector<std::uint64_t> taken((n + 63) / 64, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, taken.size()), [&](const auto& r) {
+    for (std::size_t w = r.begin(); w != r.end(); ++w) {
+      std::uint64_t bits = 0;
+      for (std::size_t v = 64 * w; v < std::min(n, 64 * w + 64); ++v) {
+        const Index i = pointOf(Index(v));
+        const Vec3& normal = scale.normals[i];
+        vertex[v] = {{normal.x(), normal.y(), normal.z()}, scale.valid[i] ? -1 : -2};
+        if (!scale.valid[i]) bits |= std::uint64_t(1) << (v - 64 * w);
+      }
+      taken[w] = bits;
+    }
+  });
+  auto isTaken = [&](Index v) { return (taken[v >> 6] >> (v & 63)) & 1; };
+  auto take = [&](Index v, int id) {
+    vertex[v].label = id;
+    taken[v >> 6] |= std::uint64_t(1) << (v & 63);
+  };
+  // The seeds as vertices, mapped in one parallel pass (a random read each) before the walk.
+  std::vector<Index> seeds(order.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 4096), [&](const auto& r) {
+    for (std::size_t s = r.begin(); s != r.end(); ++s)
+      seeds[s] = local ? graph.rank[order[s].index] : order[s].index;
   });
 
   // The walk labels the regions; their point lists are then filled in one pass over the points
   // in index order, which gives the increasing lists without sorting each region.
   std::vector<Index> frontier;
   std::vector<std::size_t> regionSize;
-  for (const KeyedIndex& item : order) {
-    const Index seed = local ? graph.rank[item.index] : item.index;
-    if (vertex[seed].label != -1) continue;
+  for (const Index seed : seeds) {
+    if (isTaken(seed)) continue;
     const int id = int(regionSize.size());
     const double* seedNormal = vertex[seed].normal;
     const double sx = seedNormal[0], sy = seedNormal[1], sz = seedNormal[2];
     std::size_t size = 1;
-    vertex[seed].label = id;
+    take(seed, id);
     frontier.assign(1, seed);
     while (!frontier.empty()) {
       const Index p = frontier.back();
       frontier.pop_back();
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
-        Vertex& q = vertex[adjacency[e]];
-        if (q.label != -1) continue;
+        const Index v = adjacency[e];
+        if (isTaken(v)) continue;
+        const double* normal = vertex[v].normal;
         // Against the seed's normal, not the neighbour's: the region stays planar (Sec. 2.3.1).
         // (Vec3::dot's order of operations, so the regions are those of the Vec3 version.)
-        if (!(q.normal[0] * sx + q.normal[1] * sy + q.normal[2] * sz >= cosTheta)) continue;
-        q.label = id;
+        if (!(normal[0] * sx + normal[1] * sy + normal[2] * sz >= cosTheta)) continue;
+        take(v, id);
         ++size;
-        frontier.push_back(adjacency[e]);
+        frontier.push_back(v);
       }
     }
     regionSize.push_back(size);
