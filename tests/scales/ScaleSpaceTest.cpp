@@ -190,5 +190,29 @@ TEST(ScaleSpace, NeedsNormalsAndCanBeCancelled) {
   EXPECT_THROW(computeScaleSpace(cloud, smallOptions(3)), OptionError);
 }
 
+// The next pyramid level is drawn in a task while a scale projects: a cancelled projection or a
+// failing sink must wait for it before unwinding (the ASan build would catch a task outliving
+// the frame), and the stack runs again afterwards with the same result.
+TEST(ScaleSpace, StopsCleanlyWhileTheNextLevelIsPrepared) {
+  const PointCloud cloud = test::sphereCloud(3000, 1.0);
+  const ScaleStack reference = computeScaleSpace(cloud, smallOptions(6));
+  for (std::size_t failAt : {0u, 2u, 5u}) {
+    const auto failing = [&](std::size_t j, const ScaleLayer&, const ScaleStats&) {
+      if (j == failAt) throw Error("the sink failed at scale " + std::to_string(j));
+    };
+    EXPECT_THROW(runScaleSpace(cloud, smallOptions(6), failing), Error) << failAt;
+  }
+  for (double stopAt : {0.1, 0.5, 0.9}) {
+    const auto cancel = [&](double f, std::string_view) { return f < stopAt; };
+    EXPECT_THROW(computeScaleSpace(cloud, smallOptions(6), cancel), Cancelled) << stopAt;
+  }
+  const ScaleStack again = computeScaleSpace(cloud, smallOptions(6));
+  ASSERT_EQ(again.layers.size(), reference.layers.size());
+  for (std::size_t j = 0; j < again.layers.size(); ++j) {
+    EXPECT_EQ(again.summary.stats[j].samples, reference.summary.stats[j].samples);
+    EXPECT_EQ(again.layers[j].normal, reference.layers[j].normal) << j;
+  }
+}
+
 }  // namespace
 }  // namespace scalespace
