@@ -118,6 +118,20 @@ TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
     EXPECT_TRUE(b.projection.empty() && b.dirMax.empty() && b.tau.empty() && b.neighbors.empty());
     EXPECT_EQ(all.summary.stats[j].validPoints, some.summary.stats[j].validPoints);
   }
+  // In processing order too: the same five arrays, permuted, and nothing else.
+  o.layerOrder = LayerOrder::Processing;
+  const ScaleStack processing = computeScaleSpace(cloud, o);
+  for (std::size_t j = 0; j < all.layers.size(); ++j) {
+    const ScaleLayer &a = all.layers[j], &p = processing.layers[j];
+    ASSERT_EQ(p.inputIndex.size(), cloud.size());
+    EXPECT_TRUE(p.projection.empty() && p.dirMin.empty() && p.fitness.empty());
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      const std::size_t i = p.inputIndex[k];
+      EXPECT_EQ(p.kMax[k], a.kMax[i]);
+      EXPECT_EQ(p.valid[k], a.valid[i]);
+      EXPECT_EQ(p.normal[3 * k + 2], a.normal[3 * i + 2]);
+    }
+  }
 }
 
 TEST(ScaleSpace, ProcessingOrderLayersAreTheInputOrderLayersPermuted) {

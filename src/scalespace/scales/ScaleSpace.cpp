@@ -29,18 +29,30 @@ void put3(std::vector<float>& v, std::size_t i, const Vec3& x) {
   v[3 * i + 2] = float(x.z());
 }
 
+/// Sizes the arrays of the layer that `contents` holds, for n points; the others are left empty.
+void sizeLayer(ScaleLayer& layer, std::size_t n, LayerContents contents) {
+  if (contents == LayerContents::All) return layer.resize(n);
+  layer = ScaleLayer{};
+  layer.normal.assign(3 * n, 0.0f);
+  for (auto* v : {&layer.meanCurvature, &layer.kMax, &layer.kMin}) v->assign(n, 0.0f);
+  layer.valid.assign(n, 0);
+}
+
 /// Stores the fit of point i in the layer, with `projection` (the fit's, or the last valid one
-/// when the fit is invalid).
-void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, ScaleLayer& layer) {
-  layer.neighbors[i] = std::uint16_t(std::clamp(f.neighbors, 0, 65535));
+/// when the fit is invalid); only what `contents` holds (planes read five of the fourteen
+/// arrays: the other stores were 2.5 GB of memory traffic per 50 scales of 1M points).
+void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, LayerContents contents,
+               ScaleLayer& layer) {
   layer.valid[i] = f.valid ? 1 : 0;
-  put3(layer.projection, i, projection);
   put3(layer.normal, i, f.normal);
-  put3(layer.dirMax, i, f.dirMax);
-  put3(layer.dirMin, i, f.dirMin);
   layer.meanCurvature[i] = float(f.meanCurvature);
   layer.kMax[i] = float(f.kMax);
   layer.kMin[i] = float(f.kMin);
+  if (contents != LayerContents::All) return;
+  layer.neighbors[i] = std::uint16_t(std::clamp(f.neighbors, 0, 65535));
+  put3(layer.projection, i, projection);
+  put3(layer.dirMax, i, f.dirMax);
+  put3(layer.dirMin, i, f.dirMin);
   layer.tau[i] = float(f.tau);
   layer.kappa[i] = float(f.kappa);
   layer.fitness[i] = float(f.fitness);
@@ -206,16 +218,9 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   const bool inputOrder = options.layerOrder == LayerOrder::Input;
   const std::vector<Index> rank = inputOrder ? invertPermutation(order) : std::vector<Index>{};
   ScaleLayer spatial, layer;  // this scale in processing order, and in input order
-  spatial.resize(n);
-  if (inputOrder) layer.resize(n);
+  sizeLayer(spatial, n, options.layerContents);
+  if (inputOrder) sizeLayer(layer, n, options.layerContents);
   if (!inputOrder) spatial.inputIndex = order;
-  if (inputOrder && options.layerContents == LayerContents::NormalAndCurvatures) {
-    for (auto* v : {&layer.projection, &layer.dirMax, &layer.dirMin}) *v = {};
-    for (auto* v :
-         {&layer.tau, &layer.kappa, &layer.fitness, &layer.anisotropy, &layer.geometricVariation})
-      *v = {};
-    layer.neighbors = {};
-  }
   tbb::enumerable_thread_specific<FitWorkspace> workspaces;
   std::vector<std::uint32_t> neighborCount(n);
   std::vector<std::uint8_t> mlsSteps(n);
@@ -262,7 +267,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
           neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
           mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
           if (f.valid) current[k] = f.projection;  // else keep the last one
-          recordFit(f, current[k], k, spatial);
+          recordFit(f, current[k], k, options.layerContents, spatial);
         });
       };
       const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
