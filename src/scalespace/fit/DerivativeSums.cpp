@@ -81,6 +81,7 @@ SCALESPACE_TARGET_AVX512 void accumulateAvx512(const DerivativeChunk& c, int m,
                                                DerivativeSums& sums) {
   __m512d lo[9];
   __m256d hi[9];
+  SCALESPACE_UNROLLED_ZERO
   for (int i = 0; i < 9; ++i) lo[i] = _mm512_setzero_pd(), hi[i] = _mm256_setzero_pd();
   for (int k = 0; k < m; ++k) {
     const __m512d f0 = _mm512_loadu_pd(&c.factors[k][0]);

@@ -86,6 +86,7 @@ SCALESPACE_TARGET_AVX2 double reweightAvx2(const AlgebraicSphere& s, double invS
   const __m256d sr = _mm256_set1_pd(invSr2), sn = _mm256_set1_pd(invSn2);
   const __m256d signMask = _mm256_set1_pd(-0.0);
   __m256d acc[9];
+  SCALESPACE_UNROLLED_ZERO
   for (__m256d& v : acc) v = _mm256_setzero_pd();
   __m256d change = _mm256_setzero_pd();
   __m256i used = _mm256_setzero_si256();
@@ -234,6 +235,7 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
   const __m512d ulx = splat8(s.ul.x()), uly = splat8(s.ul.y()), ulz = splat8(s.ul.z());
   const __m512d sr = splat8(invSr2), sn = splat8(invSn2);
   __m512d acc[9];
+  SCALESPACE_UNROLLED_ZERO
   for (__m512d& v : acc) v = _mm512_setzero_pd();
   __m512d change = _mm512_setzero_pd();
   int used = 0;
@@ -287,6 +289,7 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
 
 SCALESPACE_TARGET_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c, SphereSums& out) {
   __m512d acc[9];
+  SCALESPACE_UNROLLED_ZERO
   for (__m512d& v : acc) v = _mm512_setzero_pd();
   int used = 0;
   const std::size_t n = c.size();

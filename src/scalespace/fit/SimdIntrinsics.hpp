@@ -14,3 +14,12 @@
 #endif
 #include <immintrin.h>
 #endif
+
+// Put before a loop that zeroes an array of accumulator registers: unrolled, it becomes a few
+// register clears, where GCC otherwise turns the loop into a memset of the array in memory (a
+// `rep stos`, 3.4% of the robust pass's profile).
+#if defined(__GNUC__) && !defined(__clang__)
+#define SCALESPACE_UNROLLED_ZERO _Pragma("GCC unroll 16")
+#else
+#define SCALESPACE_UNROLLED_ZERO
+#endif
