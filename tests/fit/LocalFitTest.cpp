@@ -341,3 +341,50 @@ TEST(LocalFit, FirstStepHintGivesTheSameFit) {
     }
   }
 }
+
+// Eight points' first MLS steps side by side (fitAtBatch): each point's fit is fitAt's up to
+// rounding, for every batch size, with points off the surface (several MLS steps, some lanes
+// done before others), a point without neighbours (invalid) and the robust and plain fits.
+TEST(LocalFit, BatchedFitsEqualFitAt) {
+  const auto c = sampleCloud(SurfaceShape::Saddle, Vec3::Zero(), 1.0, 3000, 7);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 23; ++i) points.emplace_back(u(rng), u(rng), i % 3 == 0 ? u(rng) : 0.0);
+  points[5] = Vec3(40, 40, 40);  // no neighbour
+  for (bool robust : {true, false}) {
+    FitOptions o;
+    o.mls = true;
+    o.mlsMaxSteps = 6;
+    o.robust = robust;
+    FitWorkspace ws;
+    for (std::size_t count = 1; count <= kFitBatch; ++count) {
+      for (std::size_t first = 0; first + count <= points.size(); first += count) {
+        LocalFit batch[kFitBatch];
+        fitAtBatch(&points[first], count, 0.25, c->samples(), o, ws, batch);
+        for (std::size_t l = 0; l < count; ++l) {
+          SCOPED_TRACE(testing::Message()
+                       << "robust " << robust << " batch of " << count << ", point " << first + l);
+          expectSameFit(batch[l], fitAt(points[first + l], 0.25, c->samples(), o, ws));
+        }
+      }
+    }
+  }
+  // The steps differ between lanes: some points need several, and the far one is invalid.
+  FitOptions o;
+  o.mls = true;
+  o.robust = true;
+  FitWorkspace ws;
+  // Point 1 starts on its MLS surface: one step.
+  points[1] = fitAt(points[1], 0.25, c->samples(), o, ws).projection;
+  LocalFit batch[kFitBatch];
+  fitAtBatch(points.data(), kFitBatch, 0.25, c->samples(), o, ws, batch);
+  EXPECT_FALSE(batch[5].valid);
+  EXPECT_EQ(batch[1].mlsSteps, 1);
+  int fewest = 100, most = 0;
+  for (const LocalFit& f : batch)
+    if (f.valid) fewest = std::min(fewest, f.mlsSteps), most = std::max(most, f.mlsSteps);
+  EXPECT_GT(most, fewest);
+  EXPECT_THROW(fitAtBatch(points.data(), kFitBatch + 1, 0.25, c->samples(), o, ws, batch),
+               OptionError);
+}

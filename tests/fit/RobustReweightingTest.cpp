@@ -6,7 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 
+#include "scalespace/fit/OrientedSphereFit.hpp"
 #include "scalespace/fit/RobustReweighting.hpp"
 
 using namespace scalespace;
@@ -194,6 +196,89 @@ TEST(RobustReweighting, PartialOutputsEqualTheFullPass) {
       }
       EXPECT_EQ(sums.used, 0);
       EXPECT_EQ(factors.used, 0);
+    }
+  }
+}
+
+// Fits side by side (InterleavedColumns): entry k of fit l at [8 k + l], zeros past its count.
+TEST(RobustReweighting, InterleavedColumnsHoldEachFitInItsLane) {
+  std::mt19937 rng(41);
+  for (int count = 1; count <= InterleavedColumns::kLanes; ++count) {
+    std::vector<NeighborColumns> fits;
+    for (int l = 0; l < count; ++l)
+      fits.push_back(randomNeighbors(std::size_t(7 * l + 3 * count) % 38, rng));
+    const NeighborColumns* pointers[InterleavedColumns::kLanes];
+    for (int l = 0; l < count; ++l) pointers[l] = &fits[std::size_t(l)];
+    InterleavedColumns c;
+    c.assign(pointers, count);
+    ASSERT_EQ(c.fits, count);
+    std::size_t longest = 0;
+    for (const auto& f : fits) longest = std::max(longest, f.size());
+    ASSERT_EQ(c.length, longest);
+    for (int l = 0; l < InterleavedColumns::kLanes; ++l) {
+      const std::size_t n = l < count ? fits[std::size_t(l)].size() : 0;
+      EXPECT_EQ(std::size_t(c.count[l]), n);
+      for (std::size_t k = 0; k < c.length; ++k) {
+        const std::size_t o = 8 * k + std::size_t(l);
+        const bool in = k < n;
+        const NeighborColumns* f = in ? &fits[std::size_t(l)] : nullptr;
+        EXPECT_EQ(c.qx[o], in ? f->qx[k] : 0.0);
+        EXPECT_EQ(c.qz[o], in ? f->qz[k] : 0.0);
+        EXPECT_EQ(c.ny[o], in ? f->ny[k] : 0.0);
+        EXPECT_EQ(c.d2[o], in ? f->d2[k] : 0.0);
+        EXPECT_EQ(c.weight[o], in ? f->weight[k] : 0.0);
+      }
+    }
+  }
+}
+
+// The lanes make, fit by fit, what the single-fit passes make (kernel sums, then re-weightings
+// each followed by a solve), up to the order of the sums: valid and invalid fits (too few
+// neighbours, none, all at one position), with their factors.
+TEST(RobustReweighting, FitsInLanesEqualTheSingleFitPasses) {
+  std::mt19937 rng(43);
+  const double t = 1, invSr2 = 1 / (0.2 * 0.2), invSn2 = 1 / (0.5 * 0.5);
+  for (int count = 1; count <= InterleavedColumns::kLanes; ++count) {
+    std::vector<NeighborColumns> fits;
+    for (int l = 0; l < count; ++l)
+      fits.push_back(randomNeighbors(std::size_t(5 * l + 2 * count) % 41, rng));
+    if (count >= 3) {  // every neighbour at one position: degenerate
+      NeighborColumns same;
+      for (int k = 0; k < 12; ++k) same.push(Vec3(0.1, 0.2, 0), Vec3::UnitZ(), 0.9);
+      fits[2] = same;
+    }
+    const NeighborColumns* pointers[InterleavedColumns::kLanes];
+    for (int l = 0; l < count; ++l) pointers[l] = &fits[std::size_t(l)];
+    InterleavedColumns c;
+    c.assign(pointers, count);
+    for (int passes : {0, 1, 5}) {
+      LaneSphere out[InterleavedColumns::kLanes];
+      std::vector<double> factors[InterleavedColumns::kLanes];
+      robustSpheresInLanes(c, t, passes, 6, invSr2, invSn2, out, factors);
+      for (int l = 0; l < count; ++l) {
+        SCOPED_TRACE(testing::Message() << count << " fits, fit " << l << ", passes " << passes);
+        const NeighborColumns& f = fits[std::size_t(l)];
+        SphereSums sums;
+        kernelWeightedSums(f, sums, SimdKernel::Portable);
+        AlgebraicSphere sphere;
+        const bool valid = sphereFromSums(sums.s, sums.used, t, 6, sphere);
+        std::vector<double> rho, trial;
+        for (int it = 0; it < passes && valid; ++it) {
+          reweight(sphere, invSr2, invSn2, f, rho, trial, sums, SimdKernel::Portable);
+          AlgebraicSphere next;
+          if (!sphereFromSums(sums.s, sums.s[0] > 0 ? 1 : 0, t, 1, next)) break;
+          sphere = next;
+          std::swap(rho, trial);
+        }
+        ASSERT_EQ(out[l].valid, valid);
+        EXPECT_EQ(out[l].neighbors, sums.used);
+        if (!valid) continue;
+        EXPECT_NEAR(out[l].sphere.uc, sphere.uc, 1e-9);
+        EXPECT_NEAR(out[l].sphere.uq, sphere.uq, 1e-9 * (1 + std::abs(sphere.uq)));
+        EXPECT_LT((out[l].sphere.ul - sphere.ul).norm(), 1e-9);
+        ASSERT_EQ(factors[l].size(), rho.size());
+        for (std::size_t k = 0; k < rho.size(); ++k) EXPECT_NEAR(factors[l][k], rho[k], 1e-8);
+      }
     }
   }
 }

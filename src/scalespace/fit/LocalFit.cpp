@@ -238,16 +238,28 @@ LocalFit sphereQuantities(const OrientedSphereFitResult& res, const Vec3& y, dou
 }
 
 /// APSS estimators with optional MLS (Eq. 1.12): intermediate steps only need the projection,
-/// so derivatives are computed once, at the step that is reported.
+/// so derivatives are computed once, at the step that is reported. The steps start at x with
+/// number `firstStep` (fitAtBatch goes on alone from there); `given`, when set, is that step's
+/// robust sphere made already without derivatives, with its neighbours in ws.columns and its
+/// factors in ws.weights.
 LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
-                      const FitOptions& options, FitWorkspace& ws) {
+                      const FitOptions& options, FitWorkspace& ws,
+                      const OrientedSphereFitResult* given = nullptr, int firstStep = 1) {
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
   Vec3 y = x;
-  for (int step = 1;; ++step) {
-    gatherNeighbors(y, t, samples, ws);
-    const bool lastStep = step == maxSteps;
-    const bool speculative = step == 1 && options.expectFirstStepConverged;
-    OrientedSphereFitResult res = robustSphere(t, options, ws, lastStep || speculative);
+  for (int step = firstStep;; ++step) {
+    const bool lastStep = step >= maxSteps;
+    const bool isGiven = step == firstStep && given;
+    // A reported step's sphere comes with its derivatives.
+    bool reported = false;
+    OrientedSphereFitResult res;
+    if (isGiven) {
+      res = *given;
+    } else {
+      gatherNeighbors(y, t, samples, ws);
+      reported = lastStep || (step == 1 && options.expectFirstStepConverged);
+      res = robustSphere(t, options, ws, reported);
+    }
     if (res.valid && !lastStep) {
       const Vec3 projection = y + res.sphere.project(Vec3::Zero());
       if ((projection - y).norm() >= options.mlsTolerance * t) {
@@ -255,8 +267,8 @@ LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
         continue;
       }
       // Converged: this step is reported.
-      if (!speculative) res = reportedPass(t, options, ws, res.neighbors);
     }
+    if (res.valid && !reported) res = reportedPass(t, options, ws, res.neighbors);
     LocalFit fit;
     fit.neighbors = res.neighbors;
     if (res.valid) fit = sphereQuantities(res, y, t, options);
@@ -330,6 +342,71 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
     fit.meanCurvature = fit.kMax = fit.kMin = 8 * d / (t * t);
   }
   return fit;
+}
+
+void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSamples& samples,
+                const FitOptions& options, FitWorkspace& ws, LocalFit* out) {
+  if (count > kFitBatch) throw OptionError("fitAtBatch takes at most 8 points at once");
+  bool lanes = count > 1 && isAlgebraicSphere(options.estimator) && options.robust &&
+               options.robustIterations > 0 && !(options.robustTolerance > 0) &&
+               avx512Available() && t > 0 && std::isfinite(t) &&
+               samples.normals.size() == samples.positions.size();
+  for (std::size_t l = 0; l < count && lanes; ++l) lanes = xs[l].allFinite();
+  if (!lanes) {
+    for (std::size_t l = 0; l < count; ++l) out[l] = fitAt(xs[l], t, samples, options, ws);
+    return;
+  }
+  const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
+  const double invSr2 = 1 / ((kRobustSigmaR * t) * (kRobustSigmaR * t));
+  const double invSn2 = 1 / (kRobustSigmaN * kRobustSigmaN);
+  Vec3 y[kFitBatch];
+  std::size_t pending[kFitBatch];  // the points still projecting, in order
+  std::size_t left = count;
+  for (std::size_t l = 0; l < count; ++l) y[l] = xs[l], pending[l] = l;
+  // The MLS steps side by side while at least two points are left, one lane per point; a point
+  // that is done (invalid, converged or at the last step) is finished alone (its derivatives).
+  for (int step = 1; left >= 2; ++step) {
+    const NeighborColumns* fits[kFitBatch];
+    for (std::size_t s = 0; s < left; ++s) {
+      gatherNeighbors(y[pending[s]], t, samples, ws);
+      std::swap(ws.columns, ws.batchColumns[s]);
+      fits[s] = &ws.batchColumns[s];
+    }
+    ws.interleaved.assign(fits, int(left));
+    LaneSphere spheres[kFitBatch];
+    robustSpheresInLanes(ws.interleaved, t, options.robustIterations, options.minNeighbors, invSr2,
+                         invSn2, spheres, ws.batchFactors);
+    std::size_t kept = 0;
+    for (std::size_t s = 0; s < left; ++s) {
+      const std::size_t l = pending[s];
+      const AlgebraicSphere& sphere = spheres[s].sphere;
+      if (spheres[s].valid && step < maxSteps) {
+        const Vec3 projection = y[l] + sphere.project(Vec3::Zero());
+        if ((projection - y[l]).norm() >= options.mlsTolerance * t) {
+          y[l] = projection;
+          pending[kept++] = l;
+          continue;
+        }
+      }
+      std::swap(ws.columns, ws.batchColumns[s]);
+      std::swap(ws.weights, ws.batchFactors[s]);
+      OrientedSphereFitResult res;
+      res.valid = spheres[s].valid;
+      res.neighbors = spheres[s].neighbors;
+      res.sphere = sphere;
+      res.gradient = sphere.ul;
+      out[l] = fitSphereMls(y[l], t, samples, options, ws, &res, step);
+      if (!out[l].valid) markInvalid(out[l]);
+    }
+    // The lanes kept keep their order (s' <= s): their columns are gathered again next step.
+    left = kept;
+    if (left == 1) {
+      const std::size_t l = pending[0];
+      out[l] = fitSphereMls(y[l], t, samples, options, ws, nullptr, step + 1);
+      if (!out[l].valid) markInvalid(out[l]);
+      left = 0;
+    }
+  }
 }
 
 }  // namespace scalespace

@@ -104,10 +104,26 @@ struct FitWorkspace {
   std::vector<Neighbor> neighbors;
   NeighborColumns columns;                    // the neighbours of the current fit (p - x, n)
   std::vector<double> weights, trialWeights;  // robust re-weighting factors
+  /// fitAtBatch's neighbours and factors, point by point, and the neighbours interleaved.
+  NeighborColumns batchColumns[InterleavedColumns::kLanes];
+  std::vector<double> batchFactors[InterleavedColumns::kLanes];
+  InterleavedColumns interleaved;
 };
 
 /// Estimates the differential quantities at x with support radius t.
 LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const FitOptions& options,
                FitWorkspace& workspace);
+
+/// The most points fitAtBatch takes at once.
+constexpr std::size_t kFitBatch = InterleavedColumns::kLanes;
+
+/// fitAt at each of xs[0..count) (count <= kFitBatch) into out[0..count). For the robust APSS
+/// estimators (no robustTolerance) on CPUs with AVX-512, the first MLS step of every point is
+/// made at once, one point per lane (robustSpheresInLanes); each point then goes on alone as in
+/// fitAt (derivatives, further MLS steps). The results are fitAt's up to the last bits (the sums
+/// are made in another order); options.expectFirstStepConverged is not read (the first step's
+/// derivatives are made once it has converged).
+void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSamples& samples,
+                const FitOptions& options, FitWorkspace& workspace, LocalFit* out);
 
 }  // namespace scalespace

@@ -88,4 +88,20 @@ std::size_t fitGroupByBlocks(const std::vector<Vec3>& points, std::size_t g,
   return end - begin;
 }
 
+/// fitGroupByBlocks handing each block's points to fit(k, count) in runs of `maxRun` consecutive
+/// points (the last run of a block may be shorter).
+template <class Fit>
+std::size_t fitGroupInRuns(const std::vector<Vec3>& points, std::size_t g,
+                           const SurfaceSamples& samples, double t, double slack,
+                           NeighborhoodCache& cache, std::size_t maxRun, Fit&& fit) {
+  const std::size_t begin = g * kPrefetchGroup;
+  const std::size_t end = std::min(points.size(), begin + kPrefetchGroup);
+  for (std::size_t k = begin; k < end;) {
+    const std::size_t blockEnd = prefetchBlock(points, k, end, samples, t, slack, cache);
+    for (; k < blockEnd; k += std::min(maxRun, blockEnd - k))
+      fit(k, std::min(maxRun, blockEnd - k));
+  }
+  return end - begin;
+}
+
 }  // namespace scalespace

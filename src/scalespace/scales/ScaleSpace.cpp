@@ -19,6 +19,9 @@
 namespace scalespace {
 namespace {
 
+/// The shortest run of a block that fitAtBatch takes (shorter runs are fitted point by point).
+constexpr std::size_t kMinBatch = 4;
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -259,16 +262,30 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
       // Neighbour-query reuse (fit/NeighborhoodCache): the radius-t queries of all MLS steps of a
       // block of Morton-ordered points are answered by one index query, unless a step moves a
       // point more than kMlsSlack t out of the block.
+      auto record = [&](std::size_t k, const LocalFit& f) {
+        neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
+        mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
+        if (f.valid) current[k] = f.projection;  // else keep the last one
+        recordFit(f, current[k], k, options.layerContents, spatial);
+      };
+      // A block's points go through fitAtBatch eight at a time (their first MLS steps side by
+      // side); a run of fewer than kMinBatch points (the blocks of the finest scales) one by one,
+      // where a lane kernel would run mostly empty.
       auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
         FitOptions pointFit = fit;
-        return fitGroupByBlocks(current, g, samples, t, kMlsSlack, ws.cache, [&](std::size_t k) {
-          pointFit.expectFirstStepConverged = j > 0 && mlsSteps[k] == 1;
-          const LocalFit f = fitAt(current[k], t, samples, pointFit, ws);
-          neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
-          mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
-          if (f.valid) current[k] = f.projection;  // else keep the last one
-          recordFit(f, current[k], k, options.layerContents, spatial);
-        });
+        return fitGroupInRuns(current, g, samples, t, kMlsSlack, ws.cache, kFitBatch,
+                              [&](std::size_t k, std::size_t count) {
+                                if (count < kMinBatch) {
+                                  for (std::size_t i = k; i < k + count; ++i) {
+                                    pointFit.expectFirstStepConverged = j > 0 && mlsSteps[i] == 1;
+                                    record(i, fitAt(current[i], t, samples, pointFit, ws));
+                                  }
+                                  return;
+                                }
+                                LocalFit fits[kFitBatch];
+                                fitAtBatch(&current[k], count, t, samples, fit, ws, fits);
+                                for (std::size_t i = 0; i < count; ++i) record(k + i, fits[i]);
+                              });
       };
       const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 8),
