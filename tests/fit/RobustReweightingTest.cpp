@@ -252,32 +252,35 @@ TEST(RobustReweighting, FitsInLanesEqualTheSingleFitPasses) {
     InterleavedColumns c;
     c.assign(pointers, count);
     for (int passes : {0, 1, 5}) {
-      LaneSphere out[InterleavedColumns::kLanes];
-      std::vector<double> factors[InterleavedColumns::kLanes];
-      robustSpheresInLanes(c, t, passes, 6, invSr2, invSn2, out, factors);
-      for (int l = 0; l < count; ++l) {
-        SCOPED_TRACE(testing::Message() << count << " fits, fit " << l << ", passes " << passes);
-        const NeighborColumns& f = fits[std::size_t(l)];
-        SphereSums sums;
-        kernelWeightedSums(f, sums, SimdKernel::Portable);
-        AlgebraicSphere sphere;
-        const bool valid = sphereFromSums(sums.s, sums.used, t, 6, sphere);
-        std::vector<double> rho, trial;
-        for (int it = 0; it < passes && valid; ++it) {
-          reweight(sphere, invSr2, invSn2, f, rho, trial, sums, SimdKernel::Portable);
-          AlgebraicSphere next;
-          if (!sphereFromSums(sums.s, sums.s[0] > 0 ? 1 : 0, t, 1, next)) break;
-          sphere = next;
-          std::swap(rho, trial);
+      for (SimdKernel kernel : {SimdKernel::Portable, SimdKernel::Auto}) {
+        LaneSphere out[InterleavedColumns::kLanes];
+        std::vector<double> factors[InterleavedColumns::kLanes];
+        robustSpheresInLanes(c, t, passes, 6, invSr2, invSn2, out, factors, kernel);
+        for (int l = 0; l < count; ++l) {
+          SCOPED_TRACE(testing::Message() << count << " fits, fit " << l << ", passes " << passes
+                                          << ", kernel " << int(kernel));
+          const NeighborColumns& f = fits[std::size_t(l)];
+          SphereSums sums;
+          kernelWeightedSums(f, sums, SimdKernel::Portable);
+          AlgebraicSphere sphere;
+          const bool valid = sphereFromSums(sums.s, sums.used, t, 6, sphere);
+          std::vector<double> rho, trial;
+          for (int it = 0; it < passes && valid; ++it) {
+            reweight(sphere, invSr2, invSn2, f, rho, trial, sums, SimdKernel::Portable);
+            AlgebraicSphere next;
+            if (!sphereFromSums(sums.s, sums.s[0] > 0 ? 1 : 0, t, 1, next)) break;
+            sphere = next;
+            std::swap(rho, trial);
+          }
+          ASSERT_EQ(out[l].valid, valid);
+          EXPECT_EQ(out[l].neighbors, sums.used);
+          if (!valid) continue;
+          EXPECT_NEAR(out[l].sphere.uc, sphere.uc, 1e-9);
+          EXPECT_NEAR(out[l].sphere.uq, sphere.uq, 1e-9 * (1 + std::abs(sphere.uq)));
+          EXPECT_LT((out[l].sphere.ul - sphere.ul).norm(), 1e-9);
+          ASSERT_EQ(factors[l].size(), rho.size());
+          for (std::size_t k = 0; k < rho.size(); ++k) EXPECT_NEAR(factors[l][k], rho[k], 1e-8);
         }
-        ASSERT_EQ(out[l].valid, valid);
-        EXPECT_EQ(out[l].neighbors, sums.used);
-        if (!valid) continue;
-        EXPECT_NEAR(out[l].sphere.uc, sphere.uc, 1e-9);
-        EXPECT_NEAR(out[l].sphere.uq, sphere.uq, 1e-9 * (1 + std::abs(sphere.uq)));
-        EXPECT_LT((out[l].sphere.ul - sphere.ul).norm(), 1e-9);
-        ASSERT_EQ(factors[l].size(), rho.size());
-        for (std::size_t k = 0; k < rho.size(); ++k) EXPECT_NEAR(factors[l][k], rho[k], 1e-8);
       }
     }
   }

@@ -648,15 +648,16 @@ void robustSpheresOneByOne(const InterleavedColumns& c, double t, int passes, in
 
 void robustSpheresInLanes(const InterleavedColumns& columns, double t, int passes, int minNeighbors,
                           double invSr2, double invSn2, LaneSphere* out,
-                          std::vector<double>* factors) {
+                          std::vector<double>* factors, SimdKernel kernel) {
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-  if (avx512Available()) {
+  if (useAvx512(kernel)) {
     // Per-thread scratch: the interleaved factors of the current and the trial pass.
     thread_local std::vector<double> current, trial;
     return robustSpheresAvx512(columns, t, passes, minNeighbors, invSr2, invSn2, out, factors,
                                current, trial);
   }
 #endif
+  (void)kernel;
   robustSpheresOneByOne(columns, t, passes, minNeighbors, invSr2, invSn2, out, factors);
 }
 

@@ -73,9 +73,9 @@ struct LaneSphere {
 /// lockstep: no horizontal sums, eight solves in one, and eight independent chains where one fit
 /// waits on its own pass and solve (fit/LocalFit uses it for blocks of nearby points). The sums
 /// are made in another order than reweight's, so results differ from it in the last bits.
-/// Needs avx512Available().
+/// Without AVX-512 (or with SimdKernel::Portable) the fits are made one after the other.
 void robustSpheresInLanes(const InterleavedColumns& columns, double t, int passes, int minNeighbors,
                           double invSr2, double invSn2, LaneSphere* out,
-                          std::vector<double>* factors);
+                          std::vector<double>* factors, SimdKernel kernel = SimdKernel::Auto);
 
 }  // namespace scalespace
