@@ -73,23 +73,10 @@ std::size_t prefetchBlock(const std::vector<Vec3>& points, std::size_t k, std::s
                           const SurfaceSamples& samples, double t, double slack,
                           NeighborhoodCache& cache);
 
-/// Calls fit(k) for every point of group g (points [g kPrefetchGroup, ...)), block by block, each
-/// block's samples prefetched into `cache` first. Returns the number of points of the group.
-template <class Fit>
-std::size_t fitGroupByBlocks(const std::vector<Vec3>& points, std::size_t g,
-                             const SurfaceSamples& samples, double t, double slack,
-                             NeighborhoodCache& cache, Fit&& fit) {
-  const std::size_t begin = g * kPrefetchGroup;
-  const std::size_t end = std::min(points.size(), begin + kPrefetchGroup);
-  for (std::size_t k = begin; k < end;) {
-    const std::size_t blockEnd = prefetchBlock(points, k, end, samples, t, slack, cache);
-    for (; k < blockEnd; ++k) fit(k);
-  }
-  return end - begin;
-}
-
-/// fitGroupByBlocks handing each block's points to fit(k, count) in runs of `maxRun` consecutive
-/// points (the last run of a block may be shorter).
+/// Calls fit(k, count) for the points of group g (points [g kPrefetchGroup, ...)), block by
+/// block, each block's samples prefetched into `cache` first, in runs of `maxRun` consecutive
+/// points (count <= maxRun; the last run of a block may be shorter). Returns the number of points
+/// of the group.
 template <class Fit>
 std::size_t fitGroupInRuns(const std::vector<Vec3>& points, std::size_t g,
                            const SurfaceSamples& samples, double t, double slack,
@@ -102,6 +89,15 @@ std::size_t fitGroupInRuns(const std::vector<Vec3>& points, std::size_t g,
       fit(k, std::min(maxRun, blockEnd - k));
   }
   return end - begin;
+}
+
+/// fitGroupInRuns one point at a time: fit(k) for every point of group g.
+template <class Fit>
+std::size_t fitGroupByBlocks(const std::vector<Vec3>& points, std::size_t g,
+                             const SurfaceSamples& samples, double t, double slack,
+                             NeighborhoodCache& cache, Fit&& fit) {
+  return fitGroupInRuns(points, g, samples, t, slack, cache, 1,
+                        [&](std::size_t k, std::size_t) { fit(k); });
 }
 
 }  // namespace scalespace
