@@ -273,6 +273,7 @@ LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
     fit.neighbors = res.neighbors;
     if (res.valid) fit = sphereQuantities(res, y, t, options);
     fit.mlsSteps = step;
+    if (!fit.valid) markInvalid(fit);  // (mlsSteps 0 too, as for every invalid fit)
     return fit;
   }
 }
@@ -312,9 +313,7 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
   }
   if (!x.allFinite()) return LocalFit{};
   if (isAlgebraicSphere(options.estimator)) {
-    LocalFit fit = fitSphereMls(x, t, samples, options, workspace);
-    if (!fit.valid) markInvalid(fit);
-    return fit;
+    return fitSphereMls(x, t, samples, options, workspace);
   }
   Vec3 y = x;
   LocalFit fit;
@@ -396,14 +395,12 @@ void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSample
       res.sphere = sphere;
       res.gradient = sphere.ul;
       out[l] = fitSphereMls(y[l], t, samples, options, ws, &res, step);
-      if (!out[l].valid) markInvalid(out[l]);
     }
     // The lanes kept keep their order (s' <= s): their columns are gathered again next step.
     left = kept;
     if (left == 1) {
       const std::size_t l = pending[0];
       out[l] = fitSphereMls(y[l], t, samples, options, ws, nullptr, step + 1);
-      if (!out[l].valid) markInvalid(out[l]);
       left = 0;
     }
   }

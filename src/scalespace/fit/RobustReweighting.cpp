@@ -223,6 +223,30 @@ SCALESPACE_TARGET_AVX512 inline int accumulate8(__m512d* acc, __m512d w, __m512d
   return __builtin_popcount(_mm512_cmp_pd_mask(w, _mm512_setzero_pd(), _CMP_GT_OQ));
 }
 
+/// An algebraic sphere per lane (the same one in every lane for a single fit's pass).
+struct Spheres8 {
+  __m512d uc, uq, ulx, uly, ulz;
+};
+
+/// The re-weighting factor (factorOf) of eight neighbours against the lanes' spheres, before any
+/// lane mask; twoUq = 2 u_q.
+SCALESPACE_TARGET_AVX512 inline __m512d factors8(const Spheres8& s, __m512d twoUq, __m512d qx,
+                                                 __m512d qy, __m512d qz, __m512d nx, __m512d ny,
+                                                 __m512d nz, __m512d d2, __m512d sr, __m512d sn) {
+  const __m512d gx = _mm512_fmadd_pd(twoUq, qx, s.ulx), gy = _mm512_fmadd_pd(twoUq, qy, s.uly),
+                gz = _mm512_fmadd_pd(twoUq, qz, s.ulz);
+  const __m512d inv =
+      inverseSqrt8(_mm512_fmadd_pd(gx, gx, _mm512_fmadd_pd(gy, gy, _mm512_mul_pd(gz, gz))));
+  const __m512d f = _mm512_fmadd_pd(
+      s.uq, d2,
+      _mm512_fmadd_pd(s.ulx, qx, _mm512_fmadd_pd(s.uly, qy, _mm512_fmadd_pd(s.ulz, qz, s.uc))));
+  const __m512d r = _mm512_mul_pd(f, inv);
+  const __m512d dx = _mm512_fnmadd_pd(gx, inv, nx), dy = _mm512_fnmadd_pd(gy, inv, ny),
+                dz = _mm512_fnmadd_pd(gz, inv, nz);
+  const __m512d dn = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
+  return expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn)));
+}
+
 /// The AVX2 pass on eight lanes. Measured on this machine's Zen 5 (30 neighbours): 86 ns per pass
 /// against 190 ns for the AVX2 one, whose body (~120 instructions for 4 neighbours, accumulators
 /// spilled: 16 registers) is latency-bound; here 32 registers hold everything and the last group's
@@ -234,8 +258,9 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
                                                double invSn2, const NeighborColumns& c,
                                                const std::vector<double>& previous,
                                                std::vector<double>& rho, SphereSums& next) {
-  const __m512d uc = splat8(s.uc), uq = splat8(s.uq), two_uq = splat8(2 * s.uq);
-  const __m512d ulx = splat8(s.ul.x()), uly = splat8(s.ul.y()), ulz = splat8(s.ul.z());
+  const Spheres8 sphere{splat8(s.uc), splat8(s.uq), splat8(s.ul.x()), splat8(s.ul.y()),
+                        splat8(s.ul.z())};
+  const __m512d twoUq = splat8(2 * s.uq);
   const __m512d sr = splat8(invSr2), sn = splat8(invSn2);
   __m512d acc[9];
   SCALESPACE_UNROLLED_ZERO
@@ -258,18 +283,8 @@ SCALESPACE_TARGET_AVX512 double reweightAvx512(const AlgebraicSphere& s, double 
     const __m512d nx = _mm512_maskz_loadu_pd(m, nxs + k), ny = _mm512_maskz_loadu_pd(m, nys + k),
                   nz = _mm512_maskz_loadu_pd(m, nzs + k);
     const __m512d d2 = _mm512_maskz_loadu_pd(m, d2s + k);
-    const __m512d gx = _mm512_fmadd_pd(two_uq, qx, ulx), gy = _mm512_fmadd_pd(two_uq, qy, uly),
-                  gz = _mm512_fmadd_pd(two_uq, qz, ulz);
-    const __m512d inv =
-        inverseSqrt8(_mm512_fmadd_pd(gx, gx, _mm512_fmadd_pd(gy, gy, _mm512_mul_pd(gz, gz))));
-    const __m512d f = _mm512_fmadd_pd(
-        uq, d2, _mm512_fmadd_pd(ulx, qx, _mm512_fmadd_pd(uly, qy, _mm512_fmadd_pd(ulz, qz, uc))));
-    const __m512d r = _mm512_mul_pd(f, inv);
-    const __m512d dx = _mm512_fnmadd_pd(gx, inv, nx), dy = _mm512_fnmadd_pd(gy, inv, ny),
-                  dz = _mm512_fnmadd_pd(gz, inv, nz);
-    const __m512d dn = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
-    const __m512d rh = _mm512_maskz_mov_pd(
-        m, expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn))));
+    const __m512d rh =
+        _mm512_maskz_mov_pd(m, factors8(sphere, twoUq, qx, qy, qz, nx, ny, nz, d2, sr, sn));
     _mm512_mask_storeu_pd(out + k, m, rh);
     if (kTrack)
       change = _mm512_max_pd(
@@ -312,11 +327,6 @@ SCALESPACE_TARGET_AVX512 void kernelWeightedSumsAvx512(const NeighborColumns& c,
   out.s[8] += _mm512_reduce_add_pd(acc[8]);
   out.used += used;
 }
-
-/// A sphere per lane.
-struct Spheres8 {
-  __m512d uc, uq, ulx, uly, ulz;
-};
 
 /// sphereFromSums on eight lanes (solveSphere<double>'s operations in its order, no fused
 /// multiply-adds, so that a lane solves its sums as the scalar code does): the lanes where it
@@ -404,7 +414,6 @@ SCALESPACE_TARGET_AVX512 void robustSpheresAvx512(const InterleavedColumns& c, d
     out[l].neighbors = int(counted[l]);
     factors[l].clear();
   }
-  __mmask8 reweighted = 0;  // lanes whose factors in `current` belong to their sphere
   current.resize(8 * n);
   trial.resize(8 * n);
   const __m512d sr = splat8(invSr2), sn = splat8(invSn2);
@@ -424,33 +433,21 @@ SCALESPACE_TARGET_AVX512 void robustSpheresAvx512(const InterleavedColumns& c, d
       const __m512d nx = _mm512_loadu_pd(nxs + o), ny = _mm512_loadu_pd(nys + o),
                     nz = _mm512_loadu_pd(nzs + o);
       const __m512d d2 = _mm512_loadu_pd(d2s + o);
-      const __m512d gx = _mm512_fmadd_pd(twoUq, qx, kept.ulx),
-                    gy = _mm512_fmadd_pd(twoUq, qy, kept.uly),
-                    gz = _mm512_fmadd_pd(twoUq, qz, kept.ulz);
-      const __m512d inv =
-          inverseSqrt8(_mm512_fmadd_pd(gx, gx, _mm512_fmadd_pd(gy, gy, _mm512_mul_pd(gz, gz))));
-      const __m512d f = _mm512_fmadd_pd(
-          kept.uq, d2,
-          _mm512_fmadd_pd(kept.ulx, qx,
-                          _mm512_fmadd_pd(kept.uly, qy, _mm512_fmadd_pd(kept.ulz, qz, kept.uc))));
-      const __m512d r = _mm512_mul_pd(f, inv);
-      const __m512d dx = _mm512_fnmadd_pd(gx, inv, nx), dy = _mm512_fnmadd_pd(gy, inv, ny),
-                    dz = _mm512_fnmadd_pd(gz, inv, nz);
-      const __m512d dn = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
       const __m512d kw = _mm512_loadu_pd(ws + o);
       // Past a fit's count the factor is 0, as in reweight's masked lanes.
       const __mmask8 live = _mm512_cmpgt_epi64_mask(counts, _mm512_set1_epi64(std::int64_t(k)));
-      const __m512d rh = _mm512_maskz_mov_pd(
-          live, expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn))));
+      const __m512d rh =
+          _mm512_maskz_mov_pd(live, factors8(kept, twoUq, qx, qy, qz, nx, ny, nz, d2, sr, sn));
       _mm512_storeu_pd(rhoOut + o, rh);
       accumulate8(acc, _mm512_mul_pd(kw, rh), qx, qy, qz, nx, ny, nz, d2);
     }
     Spheres8 next;
     // Without the count (no tolerance), s0 > 0 exactly when a sample has weight (robustSphere).
     const __mmask8 solved = solve8(acc, splat8(1.0), t, 1, next) & active;
-    // A lane whose solve failed stops with its previous sphere and factors.
+    // A lane whose solve failed stops with its previous sphere and factors (none before the
+    // first re-weighting: every factor 1).
     for (int l = 0; l < c.fits; ++l)
-      if (((active & ~solved) >> l) & 1 && ((reweighted >> l) & 1))
+      if (((active & ~solved) >> l) & 1 && it > 0)
         deinterleave(current.data(), l, std::size_t(c.count[l]), factors[l]);
     active = solved;
     kept.uc = _mm512_mask_mov_pd(kept.uc, solved, next.uc);
@@ -459,10 +456,10 @@ SCALESPACE_TARGET_AVX512 void robustSpheresAvx512(const InterleavedColumns& c, d
     kept.uly = _mm512_mask_mov_pd(kept.uly, solved, next.uly);
     kept.ulz = _mm512_mask_mov_pd(kept.ulz, solved, next.ulz);
     std::swap(current, trial);
-    reweighted |= solved;
   }
+  // A lane still active has solved every pass: its factors are the last pass's.
   for (int l = 0; l < c.fits; ++l)
-    if ((active >> l) & 1 && ((reweighted >> l) & 1))
+    if ((active >> l) & 1 && passes > 0)
       deinterleave(current.data(), l, std::size_t(c.count[l]), factors[l]);
   alignas(64) double uc[8], uq[8], ulx[8], uly[8], ulz[8];
   _mm512_store_pd(uc, kept.uc);
