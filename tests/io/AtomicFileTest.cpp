@@ -33,16 +33,25 @@ TEST(AtomicFile, ThrowingWriterLeavesTargetUntouchedAndNoTemporary) {
   EXPECT_EQ(dir.entryCount(), 1u);
 }
 
-TEST(AtomicFile, MissingFolderIsAFileErrorNamingThePath) {
+TEST(AtomicFile, MissingFoldersAreCreated) {
   ScratchDir dir;
   const std::string path = dir.file("no/such/folder/out.txt");
+  writeFileAtomically(path, [](std::ostream& out) { out << "x"; });
+  EXPECT_EQ(test::readText(path), "x");
+}
+
+TEST(AtomicFile, AFileInPlaceOfAFolderIsAFileErrorNamingThePath) {
+  ScratchDir dir;
+  writeFileAtomically(dir.file("plain"), [](std::ostream& out) { out << "keep"; });
+  const std::string path = dir.file("plain/out.txt");
   try {
     writeFileAtomically(path, [](std::ostream& out) { out << "x"; });
     FAIL() << "expected FileError";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
   }
-  EXPECT_EQ(dir.entryCount(), 0u);
+  EXPECT_EQ(test::readText(dir.file("plain")), "keep");
+  EXPECT_EQ(dir.entryCount(), 1u);
 }
 
 TEST(AtomicFile, RenameOntoAFolderFailsCleanly) {

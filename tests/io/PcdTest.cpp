@@ -148,7 +148,7 @@ TEST(Pcd, HeaderErrors) {
   expectError("VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 0\nDATA ascii\n",
               "same number of entries");
   expectError("ply\n", "start with VERSION");
-  expectError(head + "WIDTH 1\nDATA ascii\n1 nan 3\n", "--drop-invalid");
+  expectError(head + "WIDTH 1\nDATA ascii\n1 nan 3\n", "ReadOptions::dropNonFinite");
 }
 
 TEST(Pcd, EmptyCloud) {

@@ -72,7 +72,7 @@ TEST(Xyz, ErrorsNameFileAndLine) {
   expectError("1 2 3\n4 5 abc\n", "e.xyz: line 2");
   expectError("1 2\n", "at least 3 columns");
   expectError("a b c\n1 2 3\n", "names no 'x'");
-  expectError("x y z\n1 nan 3\n", "--drop-invalid");
+  expectError("x y z\n1 nan 3\n", "ReadOptions::dropNonFinite");
   expectError("1,,3\n", "is not a number");
 }
 

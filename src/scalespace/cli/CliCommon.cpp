@@ -2,6 +2,9 @@
 
 #include <tbb/global_control.h>
 
+#include <unistd.h>
+
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 
@@ -12,8 +15,15 @@
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/planes/PlaneExport.hpp"
+#include "scalespace/scales/ScaleStackIO.hpp"
 
 namespace scalespace::cli {
+
+namespace {
+// 100M points take ~10 GB through a fit; beyond, a typo (an extra zero) more likely than intent.
+constexpr std::size_t kMaxMeshSamples = 100'000'000;
+}  // namespace
 
 void addInputOptions(CLI::App& command, InputOptions& input) {
   command
@@ -23,11 +33,23 @@ void addInputOptions(CLI::App& command, InputOptions& input) {
       ->check(CLI::ExistingFile);
   command.add_flag("--drop-invalid", input.dropInvalid,
                    "skip points with NaN/Inf coordinates instead of stopping with an error");
+  command
+      .add_option("--sample", input.meshSamples,
+                  "OFF/OBJ meshes: N points sampled uniformly by area, with interpolated normals "
+                  "(default: the mesh vertices)")
+      ->check(CLI::Range(std::size_t(1), kMaxMeshSamples));
 }
 
 PointCloud loadCloud(const InputOptions& input, bool quiet) {
   ReadOptions options;
   options.dropNonFinite = input.dropInvalid;
+  options.meshSamples = input.meshSamples;
+  if (input.meshSamples > 0) {
+    const CloudFormat format = formatFromPath(input.path);
+    if (format != CloudFormat::Off && format != CloudFormat::Obj)
+      throw OptionError("--sample applies to meshes (.off .obj); " + input.path + " is a " +
+                        formatName(format) + " point cloud");
+  }
   ReadReport report;
   PointCloud cloud = readCloud(input.path, options, &report);
   if (cloud.empty())
@@ -50,12 +72,81 @@ void ensureNormals(PointCloud& cloud, bool quiet) {
   cloud.setNormals(std::move(est.normals));
 }
 
-void checkOutputPath(const std::string& input, const std::string& output) {
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+bool isWithin(const std::filesystem::path& inner, const std::filesystem::path& outer) {
+  const auto o = outer.begin(), oe = outer.end();
+  auto i = inner.begin();
+  for (auto it = o; it != oe; ++it, ++i)
+    if (i == inner.end() || *i != *it) return false;
+  return true;
+}
+
+}  // namespace
+
+void checkOutput(const std::string& output, OutputKind kind,
+                 const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (fs::exists(output, ec) && fs::equivalent(input, output, ec))
-    throw OptionError("output " + output + " is the input file: choose another output name " +
-                      "(inputs are never overwritten)");
+  if (output.empty()) throw OptionError("the output path is empty");
+  const fs::path out = fs::weakly_canonical(fs::absolute(output, ec), ec);
+  for (const std::string& input : inputs) {
+    if (input.empty()) continue;
+    const fs::path in = fs::weakly_canonical(fs::absolute(input, ec), ec);
+    if (in == out || (fs::exists(output, ec) && fs::equivalent(input, output, ec)))
+      throw OptionError("output " + output + " is the input " + input +
+                        ": choose another output name (inputs are never overwritten)");
+    if (isWithin(in, out))
+      throw OptionError("output " + output + " holds the input " + input +
+                        ": choose another output (inputs are never overwritten)");
+  }
+  const std::string ext = lowerExtension(output);
+  const bool isFolder = kind == OutputKind::Stack || kind == OutputKind::PlanesResult;
+  switch (kind) {
+    case OutputKind::Cloud:
+      if (formatFromPath(output) == CloudFormat::Off || formatFromPath(output) == CloudFormat::Obj)
+        throw OptionError("output " + output +
+                          ": OFF and OBJ are meshes and cannot hold a point cloud; write .ply, "
+                          ".xyz, .txt, .csv, .pts, .las or .pcd");
+      break;
+    case OutputKind::Png:
+      if (ext != ".png")
+        throw OptionError("output " + output + ": images are written as PNG; name it *.png");
+      break;
+    case OutputKind::Csv:
+      if (ext != ".csv")
+        throw OptionError("output " + output + ": this output is CSV text; name it *.csv");
+      break;
+    case OutputKind::Stack:
+      if (fs::exists(output, ec) && !isScaleStack(output))
+        throw FileError(output, "",
+                        "exists and is not a scale stack (no scalespace manifest.json): refusing "
+                        "to replace it",
+                        "choose another -o, e.g. NAME.stack");
+      break;
+    case OutputKind::PlanesResult:
+      checkPlaneResultDestination(output);
+      break;
+  }
+  if (!isFolder && fs::is_directory(output, ec))
+    throw FileError(output, "", "is a folder", "give the path of a file to write");
+  // The nearest existing folder above the output must take new files.
+  fs::path parent = out.parent_path();
+  while (!parent.empty() && !fs::exists(parent, ec) && parent != parent.root_path())
+    parent = parent.parent_path();
+  if (parent.empty()) parent = ".";
+  if (!fs::is_directory(parent, ec))
+    throw FileError(output, "", parent.string() + " is not a folder",
+                    "choose an output inside a folder");
+  if (::access(parent.c_str(), W_OK) != 0)
+    throw FileError(output, "", "the folder " + parent.string() + " is not writable",
+                    "choose another output folder or check its permissions");
 }
 
 std::string summaryPathFor(const std::string& output) {

@@ -5,6 +5,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "scalespace/core/PointCloud.hpp"
 
@@ -13,9 +14,10 @@ namespace scalespace::cli {
 struct InputOptions {
   std::string path;
   bool dropInvalid = false;  // skip points with NaN/Inf coordinates instead of failing
+  std::size_t meshSamples = 0;  // OFF/OBJ: sample this many points by area (0 = the vertices)
 };
 
-/// Adds the positional IN argument and --drop-invalid to `command`.
+/// Adds the positional IN argument, --drop-invalid and --sample to `command`.
 void addInputOptions(CLI::App& command, InputOptions& input);
 
 /// Reads the cloud; throws if it has no points (nothing to analyse).
@@ -25,8 +27,22 @@ PointCloud loadCloud(const InputOptions& input, bool quiet);
 /// stderr unless quiet. The APSS fits need oriented normals.
 void ensureNormals(PointCloud& cloud, bool quiet);
 
-/// Throws OptionError when `output` names the same file as `input` (we never overwrite inputs).
-void checkOutputPath(const std::string& input, const std::string& output);
+/// What a command writes, for checkOutput.
+enum class OutputKind {
+  Cloud,        // a point cloud in a writable format (.ply .xyz .txt .csv .pts .las .pcd)
+  Png,          // an image (.png)
+  Csv,          // a table (.csv)
+  Stack,        // a scale stack folder: replaces only an earlier stack
+  PlanesResult  // the planes' folder: new, empty, or an earlier result
+};
+
+/// Checks an output before any work, so that a long run never fails at its end: the output is
+/// none of `inputs` and holds none of them, its extension suits `kind`, an existing path may be
+/// replaced (a file where a file goes; a folder only as OutputKind allows), and the nearest
+/// existing folder above it is writable (missing folders are created when writing). Throws
+/// OptionError or FileError naming the path.
+void checkOutput(const std::string& output, OutputKind kind,
+                 const std::vector<std::string>& inputs);
 
 /// OUT.ply -> OUT.json
 std::string summaryPathFor(const std::string& output);

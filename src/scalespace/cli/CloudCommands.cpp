@@ -30,10 +30,17 @@ void addInfoCommand(CLI::App& app) {
   cmd->add_option("file", *path, "point cloud or scale stack (NAME.stack)")->required();
   cmd->callback([path] {
     if (printStackInfo(*path, std::cout)) return;
+    // `info` describes what is there: points with NaN/Inf coordinates are counted, not fatal.
+    ReadOptions read;
+    read.dropNonFinite = true;
     ReadReport report;
-    const PointCloud cloud = readCloud(*path, {}, &report);
+    const PointCloud cloud = readCloud(*path, read, &report);
     std::printf("file        %s\nformat      %s\npoints      %zu\n", path->c_str(),
                 report.format.c_str(), cloud.size());
+    if (report.droppedNonFinite > 0)
+      std::printf("invalid     %zu more points with NaN/Inf coordinates (not counted above; "
+                  "other commands stop on them unless given --drop-invalid)\n",
+                  report.droppedNonFinite);
     if (!cloud.empty()) {
       Vec3 lo, hi;
       cloud.bounds(lo, hi);
@@ -43,7 +50,19 @@ void addInfoCommand(CLI::App& app) {
                   lo.y(), hi.y(), lo.z(), hi.z());
       std::printf("diagonal    %.6g\n", (hi - lo).norm());
     }
-    std::printf("normals     %s\n", cloud.hasNormals() ? "yes (nx ny nz)" : "no");
+    if (cloud.hasNormals()) {
+      const std::size_t bad = std::size_t(std::count_if(
+          cloud.normals().begin(), cloud.normals().end(),
+          [](const Vec3& n) { return !n.allFinite() || n.squaredNorm() < 1e-12; }));
+      std::printf("normals     yes (nx ny nz)");
+      if (bad > 0)
+        std::printf(", %zu of %zu NaN/Inf or zero (fits around them are invalid; `scalespace "
+                    "normals` re-estimates them)",
+                    bad, cloud.size());
+      std::printf("\n");
+    } else {
+      std::printf("normals     no\n");
+    }
     std::printf("attributes  %zu\n", cloud.attributes().size());
     for (const AttributeColumn& a : cloud.attributes()) {
       double mn = 0, mx = 0;
@@ -89,6 +108,7 @@ void addGenerateCommand(CLI::App& app) {
     const auto start = Clock::now();
     if (args->options.pointCount == 0) throw OptionError("--points must be >= 1");
     if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
+    checkOutput(args->output, OutputKind::Cloud, {});
     PointCloud cloud;
     if (!generateScene(args->shape, args->options, cloud)) {
       SurfaceSampleOptions o;
@@ -187,7 +207,7 @@ void addNormalsCommand(CLI::App& app) {
   cmd->callback([args] {
     const auto start = Clock::now();
     ThreadScope threads(args->threads);
-    checkOutputPath(args->input.path, args->output);
+    checkOutput(args->output, OutputKind::Cloud, {args->input.path});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     estimateAndOrient(cloud, args->normals, makeProgressBar(args->quiet), args->quiet);
     writeCloud(cloud, args->output, WriteOptions{args->ascii});
@@ -229,7 +249,7 @@ void addCurvatureCommand(CLI::App& app) {
     if ((args->scale > 0) == (args->scaleK > 0))
       throw OptionError("give exactly one of --scale T (> 0) or --scale-k K (> 0)");
     ThreadScope threads(args->threads);
-    checkOutputPath(args->input.path, args->output);
+    checkOutput(args->output, OutputKind::Cloud, {args->input.path});
     CurvatureOptions options;
     options.fit.estimator = parseEstimator(args->estimator);
     options.fit.mls = args->mls;

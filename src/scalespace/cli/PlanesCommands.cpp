@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -74,7 +75,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
     const auto start = std::chrono::steady_clock::now();
-    checkOutputPath(args->input.path, args->output);
+    checkOutput(args->output, OutputKind::Png, {args->input.path});
     RenderOptions options;
     parseSize(args->size, options.width, options.height);
     options.view = args->view;
@@ -184,7 +185,13 @@ void addSegmentCommand(CLI::App& app) {
     PlaneModel model = readPlaneModel(args->directory, &recorded);
     InputOptions input;
     input.path = args->input.empty() ? recorded : args->input;
-    checkOutputPath(input.path, args->output);
+    std::error_code ec;
+    if (args->input.empty() && !std::filesystem::is_regular_file(recorded, ec))
+      throw FileError(recorded, "",
+                      "the cloud the planes in " + args->directory +
+                          " were computed on is not there",
+                      "pass it with --input IN");
+    checkOutput(args->output, OutputKind::Cloud, {input.path, args->directory});
     PointCloud cloud = loadCloud(input, args->quiet);
     if (cloud.size() != model.membership.pointCount)
       throw FileError(input.path, "",
@@ -291,6 +298,7 @@ void addPlanesCommand(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     ThreadScope threads(args->threads);
     if (args->scales < 2) throw OptionError("--scales must be >= 2 (persistence needs levels)");
+    checkOutput(args->output, OutputKind::PlanesResult, {args->input.path, args->stack});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     if (args->stack.empty()) ensureNormals(cloud, args->quiet);
     ScaleSpaceOptions stack;
@@ -309,7 +317,10 @@ void addPlanesCommand(CLI::App& app) {
           detectPlanesFromStack(cloud, reader, options, makeProgressBar(args->quiet));
     }
     const PlaneModel model = makePlaneModel(result.detection);
-    writePlaneModel(model, cloud.origin(), args->input.path, args->output);
+    // The absolute path, so that `segment` finds the cloud from any working folder.
+    std::error_code ec;
+    const std::string inputPath = std::filesystem::absolute(args->input.path, ec).string();
+    writePlaneModel(model, cloud.origin(), ec ? args->input.path : inputPath, args->output);
     if (!args->quiet) {
       const auto& t = result.detection.timings;
       // With a stack computed here, segmentation and filtering ran during it (StackPlanes.hpp).

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <memory>
 
@@ -16,12 +17,30 @@ struct BarState {
   std::chrono::steady_clock::time_point lastLine = stageStart;
 };
 
+volatile std::sig_atomic_t interrupted = 0;
+
+extern "C" void onInterrupt(int signal) {
+  interrupted = signal;
+  // A second Ctrl-C ends the program at once, as without a handler.
+  std::signal(signal, SIG_DFL);
+}
+
 }  // namespace
 
+void cancelOnInterrupt() {
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, onInterrupt);
+}
+
 ProgressCallback makeProgressBar(bool quiet) {
-  if (quiet) return {};
+  // Even when quiet, the callback is what lets an interrupt cancel cleanly: the library unwinds
+  // and removes its temporary outputs (a killed run would leave NAME.stack.tmp-PID behind).
+  if (quiet) return [](double, std::string_view) { return interrupted == 0; };
   auto state = std::make_shared<BarState>();
   return [state](double fraction, std::string_view stage) {
+    if (interrupted != 0) {
+      if (state->terminal && state->lastPercent >= 0) std::fputc('\n', stderr);
+      return false;
+    }
     const auto now = std::chrono::steady_clock::now();
     if (state->stage != stage) {
       if (state->terminal && state->lastPercent >= 0) std::fputc('\n', stderr);

@@ -8,8 +8,14 @@
 
 namespace scalespace::cli {
 
-/// A callback for library calls. Never cancels. `quiet` suppresses everything.
+/// A callback for library calls; it cancels (returns false) once cancelOnInterrupt's signals came.
+/// `quiet` suppresses the drawing.
 ProgressCallback makeProgressBar(bool quiet = false);
+
+/// Makes SIGINT, SIGTERM and SIGHUP cancel the running library call through the progress
+/// callbacks (the command then exits 130 and leaves no temporary output); a second signal ends
+/// the program at once.
+void cancelOnInterrupt();
 
 /// Prints "<what> done in 1.23 s" on stderr (the final line of a long command).
 void reportDone(const std::string& what, std::chrono::steady_clock::time_point start,

@@ -16,6 +16,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/scales/ScaleStackIO.hpp"
 
@@ -116,7 +117,7 @@ void addScalesCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
     const auto start = std::chrono::steady_clock::now();
-    checkOutputPath(args->input.path, args->output);
+    checkOutput(args->output, OutputKind::Stack, {args->input.path});
     ScaleSpaceOptions options = args->options;
     options.series.spacing = parseScaleSpacing(args->spacing);
     options.estimator = parseEstimator(args->estimator);
@@ -256,11 +257,9 @@ void addExportCommand(CLI::App& app) {
     if (*scale) {
       if (args->output.empty()) throw OptionError("export --scale needs -o OUT.ply");
       if (args->scale < 0) throw OptionError("--scale must be >= 0");
+      checkOutput(args->output, OutputKind::Cloud, {args->stack, args->input.path});
       std::optional<PointCloud> cloud;
-      if (*input) {
-        checkOutputPath(args->input.path, args->output);
-        cloud = loadCloud(args->input, args->quiet);
-      }
+      if (*input) cloud = loadCloud(args->input, args->quiet);
       exportScale(reader, std::size_t(args->scale), args->output, cloud ? &*cloud : nullptr,
                   args->input.path, args->stack);
       if (!args->quiet)
@@ -270,18 +269,10 @@ void addExportCommand(CLI::App& app) {
       if (args->output.empty()) {
         exportPoint(reader, std::size_t(args->point), std::cout);
       } else {
-        const std::string tmp = args->output + ".tmp";
-        {
-          std::ofstream out(tmp);
-          if (!out)
-            throw FileError(args->output, "", "cannot create",
-                            "check the directory and permissions");
+        checkOutput(args->output, OutputKind::Csv, {args->stack});
+        writeFileAtomically(args->output, [&](std::ostream& out) {
           exportPoint(reader, std::size_t(args->point), out);
-          out.flush();
-          if (!out) throw FileError(args->output, "", "write failed", "check free disk space");
-        }
-        if (std::rename(tmp.c_str(), args->output.c_str()) != 0)
-          throw FileError(args->output, "", "cannot move the finished file into place");
+        });
       }
     }
   });

@@ -5,11 +5,13 @@
 #include <exception>
 
 #include "scalespace/cli/CloudCommands.hpp"
+#include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 
 int main(int argc, char** argv) {
   scalespace::retainFreedMemory();  // per-scale arrays reuse memory (core/MemoryReuse.hpp)
+  scalespace::cli::cancelOnInterrupt();
   CLI::App app{"scalespace " SCALESPACE_VERSION
                ": multi-scale analysis of 3D point clouds (normals, curvatures, scale spaces)"};
   app.require_subcommand(1);

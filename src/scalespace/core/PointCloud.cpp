@@ -86,15 +86,40 @@ void PointCloud::setNormals(std::vector<Vec3> normals) {
   normals_ = std::move(normals);
 }
 
+PointCloud::PointCloud(const PointCloud& other)
+    : positions_(other.positions_), normals_(other.normals_), origin_(other.origin_) {
+  attributes_.reserve(other.attributes_.size());
+  for (const auto& a : other.attributes_) attributes_.push_back(std::make_unique<AttributeColumn>(*a));
+}
+
+PointCloud& PointCloud::operator=(const PointCloud& other) {
+  if (this != &other) *this = PointCloud(other);
+  return *this;
+}
+
+void PointCloud::setAttributes(std::vector<AttributeColumn> columns) {
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c].values.size() != size())
+      throw Error("PointCloud::setAttributes: column '" + columns[c].name + "' has " +
+                  std::to_string(columns[c].values.size()) + " values for " +
+                  std::to_string(size()) + " points");
+    for (std::size_t d = 0; d < c; ++d)
+      if (columns[d].name == columns[c].name)
+        throw Error("PointCloud::setAttributes: two columns are named '" + columns[c].name + "'");
+  }
+  attributes_.clear();
+  for (auto& c : columns) attributes_.push_back(std::make_unique<AttributeColumn>(std::move(c)));
+}
+
 const AttributeColumn* PointCloud::findAttribute(const std::string& name) const {
   for (const auto& a : attributes_)
-    if (a.name == name) return &a;
+    if (a->name == name) return a.get();
   return nullptr;
 }
 
 AttributeColumn* PointCloud::findAttribute(const std::string& name) {
   for (auto& a : attributes_)
-    if (a.name == name) return &a;
+    if (a->name == name) return a.get();
   return nullptr;
 }
 
@@ -104,13 +129,14 @@ AttributeColumn& PointCloud::addAttribute(const std::string& name, ScalarType ty
     existing->values.resize(size(), fill);
     return *existing;
   }
-  attributes_.push_back(AttributeColumn{name, type, std::vector<double>(size(), fill)});
-  return attributes_.back();
+  attributes_.push_back(std::make_unique<AttributeColumn>(
+      AttributeColumn{name, type, std::vector<double>(size(), fill)}));
+  return *attributes_.back();
 }
 
 bool PointCloud::removeAttribute(const std::string& name) {
   auto it = std::find_if(attributes_.begin(), attributes_.end(),
-                         [&](const AttributeColumn& a) { return a.name == name; });
+                         [&](const auto& a) { return a->name == name; });
   if (it == attributes_.end()) return false;
   attributes_.erase(it);
   return true;
@@ -127,8 +153,8 @@ PointCloud PointCloud::subset(const std::vector<Index>& indices) const {
     out.setNormals(std::move(nrm));
   }
   for (const auto& a : attributes_) {
-    AttributeColumn& c = out.addAttribute(a.name, a.type);
-    for (std::size_t k = 0; k < indices.size(); ++k) c.values[k] = a.values[indices[k]];
+    AttributeColumn& c = out.addAttribute(a->name, a->type);
+    for (std::size_t k = 0; k < indices.size(); ++k) c.values[k] = a->values[indices[k]];
   }
   return out;
 }
@@ -151,7 +177,7 @@ double PointCloud::boundingBoxDiagonal() const {
 
 void PointCloud::resizeColumns() {
   if (!normals_.empty()) normals_.resize(positions_.size(), Vec3::UnitZ());
-  for (auto& a : attributes_) a.values.resize(positions_.size(), 0.0);
+  for (auto& a : attributes_) a->values.resize(positions_.size(), 0.0);
 }
 
 }  // namespace scalespace

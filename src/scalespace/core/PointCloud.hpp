@@ -5,6 +5,8 @@
 // around 1e6 where fits lose digits. The origin is an integer (rounded bounding-box centre), so
 // p - origin and (p - origin) + origin are exact in double precision: no loss on a round trip.
 // Readers call setAbsolutePositions(); writers use absolutePosition(i).
+#include <iterator>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,8 +29,58 @@ struct AttributeColumn {
   std::vector<double> values;  // one per point
 };
 
+/// Read-only view of a cloud's columns, in order (what writers iterate). Each column lives in its
+/// own allocation, so a column's address never changes while it exists: see PointCloud.
+class AttributeColumns {
+ public:
+  using Storage = std::vector<std::unique_ptr<AttributeColumn>>;
+  class const_iterator {
+   public:
+    using iterator_category = std::random_access_iterator_tag;
+    using value_type = AttributeColumn;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const AttributeColumn*;
+    using reference = const AttributeColumn&;
+    explicit const_iterator(Storage::const_iterator it) : it_(it) {}
+    reference operator*() const { return **it_; }
+    pointer operator->() const { return it_->get(); }
+    const_iterator& operator++() {
+      ++it_;
+      return *this;
+    }
+    difference_type operator-(const const_iterator& o) const { return it_ - o.it_; }
+    bool operator==(const const_iterator& o) const { return it_ == o.it_; }
+    bool operator!=(const const_iterator& o) const { return it_ != o.it_; }
+
+   private:
+    Storage::const_iterator it_;
+  };
+
+  explicit AttributeColumns(const Storage& columns) : columns_(&columns) {}
+  std::size_t size() const { return columns_->size(); }
+  bool empty() const { return columns_->empty(); }
+  const AttributeColumn& operator[](std::size_t i) const { return *(*columns_)[i]; }
+  const AttributeColumn& front() const { return *columns_->front(); }
+  const AttributeColumn& back() const { return *columns_->back(); }
+  const_iterator begin() const { return const_iterator(columns_->begin()); }
+  const_iterator end() const { return const_iterator(columns_->end()); }
+
+ private:
+  const Storage* columns_;
+};
+
+/// Columns are created and changed through addAttribute / findAttribute, whose references and
+/// pointers stay valid until that column is removed (removeAttribute, setAttributes) or the cloud
+/// is destroyed or assigned: adding more columns never moves the existing ones. (A vector of
+/// columns did move them, and a caller holding references across addAttribute read freed memory.)
 class PointCloud {
  public:
+  PointCloud() = default;
+  PointCloud(const PointCloud& other);
+  PointCloud& operator=(const PointCloud& other);
+  PointCloud(PointCloud&&) noexcept = default;
+  PointCloud& operator=(PointCloud&&) noexcept = default;
+
   std::size_t size() const { return positions_.size(); }
   bool empty() const { return positions_.empty(); }
 
@@ -49,12 +101,14 @@ class PointCloud {
   /// Sets normals (size must equal size()); pass an empty vector to remove them.
   void setNormals(std::vector<Vec3> normals);
 
-  const std::vector<AttributeColumn>& attributes() const { return attributes_; }
-  std::vector<AttributeColumn>& attributes() { return attributes_; }
+  AttributeColumns attributes() const { return AttributeColumns(attributes_); }
+  /// Replaces every column (each of size() values, names unique; Error otherwise).
+  void setAttributes(std::vector<AttributeColumn> columns);
   const AttributeColumn* findAttribute(const std::string& name) const;
   AttributeColumn* findAttribute(const std::string& name);
   /// Adds a column of size() values (initialised to `fill`), or returns the existing column of that
-  /// name after converting it to `type` and resizing it.
+  /// name after converting it to `type` and resizing it. The reference stays valid when more
+  /// columns are added (see the class comment).
   AttributeColumn& addAttribute(const std::string& name, ScalarType type, double fill = 0.0);
   bool removeAttribute(const std::string& name);
 
@@ -69,7 +123,7 @@ class PointCloud {
   void resizeColumns();
   std::vector<Vec3> positions_;
   std::vector<Vec3> normals_;
-  std::vector<AttributeColumn> attributes_;
+  AttributeColumns::Storage attributes_;
   Vec3 origin_ = Vec3::Zero();
 };
 

@@ -35,6 +35,14 @@ void syncFile(const std::string& path) {
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   namespace fs = std::filesystem;
+  // Missing folders are created, as the stack and planes writers create theirs: one rule for
+  // every output.
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code created;
+  if (!parent.empty()) fs::create_directories(parent, created);
+  if (created)
+    throw FileError(path, "", "cannot create the folder " + parent.string() + ": " +
+                                  created.message());
   const std::string temporary = temporaryPathFor(path);
   std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
   if (!out)

@@ -21,7 +21,7 @@ void CloudBuilder::rejectNonFinite(const std::string& where) const {
   throw FileError(file_, where,
                   "point " + std::to_string(positions_.size() + dropped_ + 1) +
                       " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
-                  "pass --drop-invalid (ReadOptions::dropNonFinite) to skip such points");
+                  "skip such points with ReadOptions::dropNonFinite");
 }
 
 PointCloud CloudBuilder::finish(ReadReport* report, const std::string& formatDescription) {
@@ -31,7 +31,7 @@ PointCloud CloudBuilder::finish(ReadReport* report, const std::string& formatDes
   // Normals are kept as read, even when some are zero or NaN: the cloud then "has normals" and
   // callers that need valid ones check them (or re-estimate them, e.g. the CLI's --normals).
   if (withNormals_) cloud.setNormals(std::move(normals_));
-  cloud.attributes() = std::move(columns_);
+  cloud.setAttributes(std::move(columns_));
   if (report) {
     report->droppedNonFinite = dropped_;
     report->format = formatDescription;

@@ -28,7 +28,7 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
       throw FileError(file, lineWhere(mesh.vertexLines[v]),
                       "vertex " + std::to_string(v + 1) +
                           " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
-                      "pass --drop-invalid (ReadOptions::dropNonFinite) to skip its faces");
+                      "skip its faces with ReadOptions::dropNonFinite");
     bad[v] = true;
     ++dropped;
   }

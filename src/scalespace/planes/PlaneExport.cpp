@@ -254,9 +254,35 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
   return model;
 }
 
+bool isPlaneResult(const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) return false;
+  std::ifstream in(fs::path(directory) / "membership.bin", std::ios::binary);
+  char magic[4] = {};
+  return in.read(magic, 4) && std::string(magic, 4) == "SSPM" &&
+         fs::is_regular_file(fs::path(directory) / "components.json", ec);
+}
+
+void checkPlaneResultDestination(const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(directory, ec)) return;
+  if (!fs::is_directory(directory, ec))
+    throw FileError(directory, "", "exists and is not a folder",
+                    "choose another output folder for the planes");
+  // Our five files replace theirs: only ever in an empty folder or an earlier result.
+  if (!fs::is_empty(directory, ec) && !isPlaneResult(directory))
+    throw FileError(directory, "",
+                    "is a folder that holds other files and no planes result: refusing to write "
+                    "into it",
+                    "choose a new or empty output folder");
+}
+
 void writePlaneModel(const PlaneModel& model, const Vec3& origin, const std::string& input,
                      const std::string& directory) {
   namespace fs = std::filesystem;
+  checkPlaneResultDestination(directory);
   std::error_code ec;
   fs::create_directories(directory, ec);
   if (ec) throw FileError(directory, "", "cannot create the directory: " + ec.message());

@@ -37,8 +37,15 @@ PointMembership readMembership(const std::string& path);
 /// receives the path of the cloud the model was computed on. Throws FileError naming the file.
 PlaneModel readPlaneModel(const std::string& directory, std::string* input = nullptr);
 
+/// True if `directory` holds a result of writePlaneModel (membership.bin with its magic and
+/// components.json).
+bool isPlaneResult(const std::string& directory);
+/// FileError unless `directory` is absent, an empty folder or an earlier planes result: the only
+/// places writePlaneModel writes into (it never mixes its files with a user's).
+void checkPlaneResultDestination(const std::string& directory);
+
 /// Writes components.json, components.csv, outlines.obj, persistence.svg and membership.bin
-/// into `directory` (created if needed).
+/// into `directory` (created if needed; checkPlaneResultDestination first).
 void writePlaneModel(const PlaneModel& model, const Vec3& origin, const std::string& input,
                      const std::string& directory);
 

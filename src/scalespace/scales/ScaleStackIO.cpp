@@ -504,6 +504,12 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
   d.clamped.assign(kCompactFiles, 0);
   d.bufs.resize(kCompactFiles);
   std::error_code ec;
+  // finish() replaces what is at `path`: only ever a stack this program wrote.
+  if (fs::exists(d.finalPath, ec) && !isScaleStack(d.finalPath.string()))
+    throw FileError(d.finalPath.string(), "",
+                    "exists and is not a scale stack (no scalespace manifest.json): refusing to "
+                    "replace it",
+                    "choose another output path for the stack, e.g. NAME.stack");
   fs::remove_all(d.tmpPath, ec);
   if (!fs::create_directories(d.tmpPath, ec) || ec)
     throw FileError(d.tmpPath.string(), "",
@@ -1093,7 +1099,15 @@ void ScaleStackReader::checkInput(const PointCloud& cloud, const std::string& cl
 
 bool isScaleStack(const std::string& path) {
   std::error_code ec;
-  return fs::is_directory(path, ec) && fs::exists(fs::path(path) / kManifest, ec);
+  if (!fs::is_directory(path, ec)) return false;
+  // Recognised by its manifest's format tag, not by the name: a folder is only ever replaced when
+  // this program wrote it (a user's folder that happens to hold a manifest.json is not a stack).
+  std::ifstream in(fs::path(path) / kManifest);
+  if (!in) return false;
+  const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!manifest.is_object()) return false;
+  const auto format = manifest.find("format");
+  return format != manifest.end() && *format == "scalespace-stack";
 }
 
 }  // namespace scalespace

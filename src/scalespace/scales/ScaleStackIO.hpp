@@ -132,7 +132,8 @@ class ScaleStackReader {
   std::unique_ptr<Impl> impl_;
 };
 
-/// True if `path` is a directory with a manifest.json of a scale stack.
+/// True if `path` is a directory whose manifest.json says it is a scale stack (format
+/// "scalespace-stack"): the only kind of existing path a stack writer replaces.
 bool isScaleStack(const std::string& path);
 
 }  // namespace scalespace
