@@ -170,6 +170,9 @@ NormalOrientationOptions orientationFrom(const NormalArgs& a, const PointCloud& 
 void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCallback& progress,
                        bool quiet) {
   if (a.k < 3) throw OptionError("--k must be >= 3");
+  if (a.k >= cloud.size())
+    throw OptionError("--k " + std::to_string(a.k) + " must be smaller than the number of points (" +
+                      std::to_string(cloud.size()) + ")");
   const NormalOrientationOptions orientation = orientationFrom(a, cloud);
   const auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationOptions eo;
@@ -257,7 +260,12 @@ void addCurvatureCommand(CLI::App& app) {
     options.scale = args->scale;
     options.scaleK = args->scaleK;
 
+    validateCurvatureOptions(options);  // before the read
     PointCloud cloud = loadCloud(args->input, args->quiet);
+    if (std::size_t(options.scaleK) >= cloud.size())
+      throw OptionError("--scale-k " + std::to_string(options.scaleK) +
+                        " must be smaller than the number of points (" +
+                        std::to_string(cloud.size()) + ")");
     const auto progress = makeProgressBar(args->quiet);
     const bool hadNormals = cloud.hasNormals();
     if (!hadNormals) {

@@ -84,6 +84,9 @@ void addRenderCommand(CLI::App& app) {
     options.colorAttribute = args->color;
     options.labelAttribute = args->labels;
     options.pointRadius = args->radius;
+    if (args->radius > kMaxPointRadius && !args->quiet)
+      std::fprintf(stderr, "warning: --point-radius %d is drawn as %d pixels (the largest)\n",
+                   args->radius, kMaxPointRadius);
     options.shading = !args->noShading;
     const PointCloud cloud = loadCloud(args->input, args->quiet);
     writePng(renderPoints(cloud, options), args->output);
@@ -181,6 +184,8 @@ void addSegmentCommand(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     if (!*pers && !*scale && !*brush && !*similar)
       throw OptionError("segment needs one of --min-persistence, --scale, --brush, --similar");
+    validate(args->coverageOptions);  // before any reading
+    validate(args->similarity);
     std::string recorded;
     PlaneModel model = readPlaneModel(args->directory, &recorded);
     InputOptions input;
@@ -298,6 +303,7 @@ void addPlanesCommand(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     ThreadScope threads(args->threads);
     if (args->scales < 2) throw OptionError("--scales must be >= 2 (persistence needs levels)");
+    validateScaleCount(args->scales);
     checkOutput(args->output, OutputKind::PlanesResult, {args->input.path, args->stack});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     if (args->stack.empty()) ensureNormals(cloud, args->quiet);

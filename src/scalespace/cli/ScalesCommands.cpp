@@ -122,7 +122,7 @@ void addScalesCommand(CLI::App& app) {
     options.series.spacing = parseScaleSpacing(args->spacing);
     options.estimator = parseEstimator(args->estimator);
     // Validate the series options before the (possibly long) read.
-    if (options.series.count < 1) throw OptionError("--scales must be >= 1");
+    validateScaleCount(options.series.count);
     if (options.alpha < 0) throw OptionError("--alpha must be >= 0");
     StackWriteOptions write;
     write.encoding = parseStackEncoding(args->encoding);

@@ -2,12 +2,44 @@
 // itself on the CLI11 app; this file only dispatches and turns exceptions into one-line errors.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstring>
+#include <string>
+#include <utility>
 #include <exception>
 
 #include "scalespace/cli/CloudCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
+
+namespace {
+
+// The library's messages name its option fields (a Python or C++ caller has no flags); a CLI user
+// reads the flags that set them.
+const std::pair<const char*, const char*> kFlagOfOption[] = {
+    {"ReadOptions::dropNonFinite", "--drop-invalid"},
+    {"NormalEstimationOptions::k", "--k"},
+    {"NormalOrientationOptions::k", "--k"},
+    {"CurvatureOptions::scaleK", "--scale-k"},
+    {"CurvatureOptions::scale", "--scale"},
+    {"ScaleSeriesOptions::count", "--scales"},
+    {"CoverageOptions::maxDistanceFraction", "--coverage-distance"},
+    {"CoverageOptions::maxAngleDegrees", "--coverage-angle"},
+    {"SimilarityOptions::birthTolerance", "--birth-tolerance"},
+    {"deathTolerance", "--death-tolerance"},
+    {"SimilarityOptions::maxAreaDifference", "--area-tolerance"},
+    {"SimilarityOptions::maxAngleDegrees", "--angle"},
+};
+
+std::string withFlags(std::string message) {
+  for (const auto& [option, flag] : kFlagOfOption)
+    for (std::size_t at = message.find(option); at != std::string::npos;
+         at = message.find(option, at + std::strlen(flag)))
+      message.replace(at, std::strlen(option), flag);
+  return message;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   scalespace::retainFreedMemory();  // per-scale arrays reuse memory (core/MemoryReuse.hpp)
@@ -34,10 +66,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "scalespace: %s\n", e.what());
     return 130;
   } catch (const scalespace::OptionError& e) {
-    std::fprintf(stderr, "scalespace: error: %s\n", e.what());
+    std::fprintf(stderr, "scalespace: error: %s\n", withFlags(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "scalespace: error: %s\n", e.what());
+    std::fprintf(stderr, "scalespace: error: %s\n", withFlags(e.what()).c_str());
     return 1;
   }
   return 0;

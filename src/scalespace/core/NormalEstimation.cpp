@@ -63,8 +63,9 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
   if (!(options.radius >= 0.0) || !std::isfinite(options.radius))
     throw OptionError("normal estimation radius must be finite and >= 0 (0 = use k), got " +
                       std::to_string(options.radius));
-  if (options.radius == 0.0 && options.k < 3)
-    throw OptionError("normal estimation needs k >= 3 neighbours, got " +
+  if (options.radius == 0.0 && (options.k < 3 || options.k > kMaxNeighborCount))
+    throw OptionError("NormalEstimationOptions::k must be in [3, " +
+                      std::to_string(kMaxNeighborCount) + "] neighbours, got " +
                       std::to_string(options.k));
   if (index.size() != points.size())
     throw OptionError("estimateNormals: the index holds " + std::to_string(index.size()) +

@@ -270,7 +270,10 @@ NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vect
       throw OptionError("orientNormals: the viewpoint must have finite coordinates");
     return orientByViewpoint(points, normals, valid, options, progress);
   }
-  if (options.k < 1) throw OptionError("orientNormals: k must be >= 1 (default 10)");
+  if (options.k < 1 || options.k > kMaxNeighborCount)
+    throw OptionError("NormalOrientationOptions::k must be in [1, " +
+                      std::to_string(kMaxNeighborCount) + "] (default 10), got " +
+                      std::to_string(options.k));
   if (index.size() != points.size())
     throw OptionError("orientNormals: the index holds " + std::to_string(index.size()) +
                       " points but " + std::to_string(points.size()) + " were given");

@@ -8,6 +8,11 @@
 
 namespace scalespace {
 
+/// The most neighbours an option may ask a k-NN query for. A query keeps its k best sorted, so its
+/// cost grows like k^2: 10^5 neighbours of 2*10^4 points ran for over ten minutes. Fits and normals
+/// use 10-100; a larger k is better expressed as a radius.
+constexpr std::size_t kMaxNeighborCount = 1000;
+
 struct Neighbor {
   Index index;    // index into the positions the index was built on
   double distSq;  // squared Euclidean distance to the query

@@ -25,14 +25,28 @@ bool needsNormals(EstimatorKind kind) {
   return kind == EstimatorKind::W1 || kind == EstimatorKind::W2 || kind == EstimatorKind::W3;
 }
 
-void validate(const PointCloud& cloud, const CurvatureOptions& options) {
+}  // namespace
+
+void validateCurvatureOptions(const CurvatureOptions& options) {
   if ((options.scale > 0) == (options.scaleK > 0))
     throw OptionError(
-        "give exactly one of a scale t > 0 (--scale) or a neighbour count (--scale-k)");
+        "give exactly one of a scale t > 0 (CurvatureOptions::scale) or a neighbour count "
+        "(CurvatureOptions::scaleK)");
   if (!(std::isfinite(options.scale) && options.scale >= 0))
-    throw OptionError("--scale must be a finite positive distance");
-  if (options.scaleK < 0) throw OptionError("--scale-k must be positive");
-  if (options.fit.minNeighbors < 1) throw OptionError("minimum neighbour count must be >= 1");
+    throw OptionError("CurvatureOptions::scale must be a finite positive distance");
+  if (options.scaleK < 0 || std::size_t(options.scaleK) > kMaxNeighborCount)
+    throw OptionError("CurvatureOptions::scaleK must be in [1, " +
+                      std::to_string(kMaxNeighborCount) + "], got " +
+                      std::to_string(options.scaleK));
+  if (options.fit.minNeighbors < 1)
+    throw OptionError("FitOptions::minNeighbors must be >= 1, got " +
+                      std::to_string(options.fit.minNeighbors));
+}
+
+namespace {
+
+void validate(const PointCloud& cloud, const CurvatureOptions& options) {
+  validateCurvatureOptions(options);
   if (needsNormals(options.fit.estimator) && !cloud.hasNormals())
     throw Error(std::string("the ") + estimatorName(options.fit.estimator) +
                 " estimator needs oriented normals: estimate them first (scalespace normals)");

@@ -31,6 +31,10 @@ struct CurvatureSummary {
   double fitSeconds = 0;     // neighbour queries and fits of all points (results handed over)
 };
 
+/// OptionError naming the field unless exactly one of scale (finite, > 0) and scaleK (in
+/// [1, kMaxNeighborCount]) is given and minNeighbors >= 1; what every entry point checks first.
+void validateCurvatureOptions(const CurvatureOptions& options);
+
 /// Names of the columns written by computeCurvatureColumns, in order.
 const std::vector<std::string>& curvatureColumnNames();
 

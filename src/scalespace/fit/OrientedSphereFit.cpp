@@ -275,6 +275,26 @@ void OrientedSphereFit::addColumns(const NeighborColumns& columns, const double*
         Vec3(columns.nx[k], columns.ny[k], columns.nz[k]), extraWeight[k]);
 }
 
+namespace {
+
+/// Neighbours (nearly) on one line leave the sphere free to turn about that line: the solve then
+/// succeeds on rounding noise and reports curvatures in the thousands. The first-derivative sums
+/// hold M = sum c q q^T (rows and columns 1-3, c = 4 (1 - r) / t^2 >= 0), the neighbours' second
+/// moment about the fit point; with eigenvalues l1 >= l2 >= l3, the sum of its 2 x 2 principal
+/// minors over trace^2 is about l2 / l1, the squared width/length ratio of the neighbourhood (1/4
+/// for a disc). Below kLineRatio (a strip 1/1000 as wide as it is long) the fit is degenerate.
+constexpr double kLineRatio = 1e-6;
+
+bool neighboursOnALine(const double (&sums)[9][12]) {
+  const auto m = [&](int i, int j) { return sums[1 + i][1 + j]; };
+  const double trace = m(0, 0) + m(1, 1) + m(2, 2);
+  const double minors = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0) + m(0, 0) * m(2, 2) -
+                        m(0, 2) * m(2, 0) + m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1);
+  return !(minors > kLineRatio * trace * trace);
+}
+
+}  // namespace
+
 OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel kernel) const {
   (void)kernel;  // only the AVX-512 build of the W3 solve reads it
   OrientedSphereFitResult res;
@@ -339,7 +359,8 @@ OrientedSphereFitResult OrientedSphereFit::finish(int minNeighbors, SimdKernel k
   }
   res.sphere = sphere;
   res.valid = sphere.isValid() && res.gradient.allFinite() && res.hessianW2.allFinite() &&
-              res.hessianW3.allFinite() && res.gradient.squaredNorm() > 0;
+              res.hessianW3.allFinite() && res.gradient.squaredNorm() > 0 &&
+              (order_ == FitDerivatives::None || !neighboursOnALine(sums_));
   return res;
 }
 

@@ -119,6 +119,7 @@ std::vector<BrushMatch> rankByBrush(const PlaneModel& model, const std::vector<I
 
 std::vector<int> findSimilar(const PlaneModel& model, int query, const std::vector<Index>& domain,
                              const SimilarityOptions& options) {
+  validate(options);
   if (query < 0 || query >= int(model.components.size()))
     throw OptionError("--similar " + std::to_string(query) + ": no such component (0.." +
                       std::to_string(int(model.components.size()) - 1) + ")");
@@ -137,10 +138,30 @@ std::vector<int> findSimilar(const PlaneModel& model, int query, const std::vect
   return out;
 }
 
+void validate(const SimilarityOptions& options) {
+  if (options.birthTolerance < 0 || options.deathTolerance < 0)
+    throw OptionError("SimilarityOptions::birthTolerance and deathTolerance must be >= 0 levels");
+  if (!(std::isfinite(options.maxAreaDifference) && options.maxAreaDifference >= 0))
+    throw OptionError("SimilarityOptions::maxAreaDifference must be a finite fraction >= 0");
+  if (!(options.maxAngleDegrees >= 0 && options.maxAngleDegrees <= 90))
+    throw OptionError("SimilarityOptions::maxAngleDegrees must be in [0, 90], got " +
+                      std::to_string(options.maxAngleDegrees));
+}
+
+void validate(const CoverageOptions& options) {
+  if (!(std::isfinite(options.maxDistanceFraction) && options.maxDistanceFraction >= 0))
+    throw OptionError("CoverageOptions::maxDistanceFraction must be a finite fraction >= 0, got " +
+                      std::to_string(options.maxDistanceFraction));
+  if (!(options.maxAngleDegrees >= 0 && options.maxAngleDegrees <= 90))
+    throw OptionError("CoverageOptions::maxAngleDegrees must be in [0, 90], got " +
+                      std::to_string(options.maxAngleDegrees));
+}
+
 std::vector<int> extendCoverage(const PlaneModel& model, const std::vector<int>& labels,
                                 const std::vector<Vec3>& positions,
                                 const std::vector<Vec3>& normals, const KnnGraph& knn,
                                 const CoverageOptions& options) {
+  validate(options);
   const std::size_t n = positions.size();
   if (labels.size() != n || normals.size() != n || knn.size() != n)
     throw OptionError("coverage: labels, positions, normals and graph differ in size");

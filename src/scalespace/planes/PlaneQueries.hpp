@@ -55,6 +55,8 @@ struct SimilarityOptions {
   double maxAreaDifference = 1;  // |a(C) - a(Q)| <= this * a(Q)
   double maxAngleDegrees = 90;   // angle between the (unoriented) plane normals
 };
+/// OptionError naming the field unless the tolerances are >= 0 (finite) and the angle in [0, 90].
+void validate(const SimilarityOptions& options);
 
 /// Components holding a point of `domain` that match component `query` (itself included when in
 /// the domain), by increasing id.
@@ -66,6 +68,9 @@ struct CoverageOptions {
   double maxDistanceFraction = 0.2;  // of the bounding-box diagonal, point to component plane
   double maxAngleDegrees = 45;       // point normal vs. plane normal (unoriented)
 };
+/// OptionError naming the field unless maxDistanceFraction is finite and >= 0 and
+/// maxAngleDegrees is in [0, 90] (normals are compared unoriented).
+void validate(const CoverageOptions& options);
 
 /// Extends `labels` (component ids, -1 unlabelled): an unlabelled point next (in the k-NN graph)
 /// to a point of component C joins C if it is close to C's plane with a compatible normal; this

@@ -131,7 +131,8 @@ Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
                      spanY > 0 ? usable * options.height / spanY : 1e300);
   const double centreX = 0.5 * (minX + maxX), centreY = 0.5 * (minY + maxY);
 
-  int radius = options.pointRadius;
+  // Each point fills (2r + 1)^2 pixels: beyond kMaxPointRadius a typo would take minutes.
+  int radius = std::min(options.pointRadius, kMaxPointRadius);
   if (radius < 0) {
     // Half the mean spacing of the points over the framed area, so a dense surface looks closed.
     const double area = std::max(1.0, spanX * scale) * std::max(1.0, spanY * scale);

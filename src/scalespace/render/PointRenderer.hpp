@@ -9,6 +9,8 @@
 
 namespace scalespace {
 
+constexpr int kMaxPointRadius = 32;
+
 struct RenderOptions {
   int width = 1024;
   int height = 768;
@@ -26,7 +28,8 @@ struct RenderOptions {
   std::vector<Rgb> colors;
   std::string labelAttribute;
   std::string colorAttribute;
-  /// Splat radius in pixels; negative = automatic from the point density on screen.
+  /// Splat radius in pixels; negative = automatic from the point density on screen. Larger than
+  /// kMaxPointRadius draws with kMaxPointRadius.
   int pointRadius = -1;
   /// Headlight shading |n . view| when the cloud has normals.
   bool shading = true;

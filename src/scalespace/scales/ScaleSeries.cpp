@@ -22,9 +22,14 @@ ScaleSpacing parseScaleSpacing(const std::string& name) {
   throw OptionError("--spacing must be 'log' or 'linear', got '" + name + "'");
 }
 
+void validateScaleCount(int count) {
+  if (count < 1 || count > kMaxScaleCount)
+    throw OptionError("ScaleSeriesOptions::count must be in [1, " + std::to_string(kMaxScaleCount) +
+                      "] (number of scales M), got " + std::to_string(count));
+}
+
 std::vector<double> scaleSeries(double tMin, double tMax, int count, ScaleSpacing spacing) {
-  if (count < 1)
-    throw OptionError("--scales must be >= 1 (number of scales M), got " + std::to_string(count));
+  validateScaleCount(count);
   if (!std::isfinite(tMin) || !std::isfinite(tMax) || !(tMin > 0))
     throw OptionError("--tmin must be finite and > 0 and --tmax finite, got tmin=" +
                       std::to_string(tMin) + " tmax=" + std::to_string(tMax));

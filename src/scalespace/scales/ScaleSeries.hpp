@@ -19,6 +19,13 @@ enum class ScaleSpacing {
 const char* scaleSpacingName(ScaleSpacing spacing);
 ScaleSpacing parseScaleSpacing(const std::string& name);
 
+/// The most scales a series may have: a stack holds every point at every scale (19 bytes each), and
+/// 10^5 scales of even a small cloud ran without bound. The thesis uses 50.
+constexpr int kMaxScaleCount = 1000;
+/// OptionError naming ScaleSeriesOptions::count unless 1 <= count <= kMaxScaleCount: callers check
+/// before their long work (reading, normals) what scaleSeries checks again.
+void validateScaleCount(int count);
+
 struct ScaleSeriesOptions {
   int count = 50;  // M (Chapters 2-3 use 50 scales)
   ScaleSpacing spacing = ScaleSpacing::Log;
