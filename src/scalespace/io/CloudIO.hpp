@@ -4,8 +4,10 @@
 //   .ply                     PLY ascii / binary_little_endian / binary_big_endian  (read, write)
 //   .xyz .txt .csv .pts      text columns "x y z [nx ny nz] [more]"               (read, write)
 //   .off .obj                triangle meshes: vertices or area-uniform samples     (read)
-//   .las                     LAS 1.0-1.4 uncompressed, point formats 0-3 and 6-8   (read,
-//   write 1.2) .pcd                     PCD v0.7 ascii / binary / binary_compressed (read, write)
+//   .las                     LAS 1.0-1.4 uncompressed, point formats 0-3 and 6-8   (read, write)
+//                            written as LAS 1.2, or as LAS 1.4 with "extra bytes" holding the
+//                            normals and the columns LAS records have no field for
+//   .pcd                     PCD v0.7 ascii / binary / binary_compressed           (read, write)
 //   .laz                     rejected with a FileError: no LAZ library is packaged in Debian
 //
 // Every reader is strict: malformed input throws FileError naming the file, the line or byte, what

@@ -1,4 +1,7 @@
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/ByteReader.hpp"
@@ -33,6 +36,197 @@ std::size_t lasRecordSize(int format) {
   }
 }
 
+// LAS 1.4 R15: a VLR header is 54 bytes (Sec. 2.5), an Extra Bytes descriptor 192 (Sec. 4.3).
+constexpr std::size_t kVlrHeaderSize = 54;
+constexpr std::size_t kDescriptorSize = 192;
+
+const char* const kNormalNames[3] = {"nx", "ny", "nz"};
+
+/// One documented scalar of the extra bytes (data types 1-10) and where its value goes.
+struct ExtraBytesField {
+  std::string name;
+  std::size_t descriptor = 0;  // index in the VLR
+  std::size_t at = 0;          // offset inside the point record
+  int dataType = 0;
+  ScalarType stored = ScalarType::Float64;  // on file, for data types other than 7 and 8
+  ScalarType type = ScalarType::Float64;    // of the column: Float64 when scaled or 64-bit
+  double scale = 1.0, offset = 0.0;
+  bool scaled = false;
+  int normalAxis = -1;  // 0-2 for nx ny nz when they become the cloud's normals
+  std::size_t column = 0;
+};
+
+struct ExtraBytesLayout {
+  std::vector<ExtraBytesField> fields;
+  std::size_t skipped = 0;  // descriptors of type 0, 11-30 (deprecated arrays) or 31-255
+};
+
+struct ExtraBytesScalar {
+  std::size_t size;
+  ScalarType type;
+};
+
+/// Size on file and column type of the scalar data types 1-10 (R15 Sec. 4.3, "Values for
+/// data_type"); 64-bit integers (7, 8) have no ScalarType and are held as float64.
+ExtraBytesScalar extraBytesScalar(int dataType) {
+  static const ExtraBytesScalar kTypes[] = {{1, ScalarType::UInt8},   {1, ScalarType::Int8},
+                                            {2, ScalarType::UInt16},  {2, ScalarType::Int16},
+                                            {4, ScalarType::UInt32},  {4, ScalarType::Int32},
+                                            {8, ScalarType::Float64}, {8, ScalarType::Float64},
+                                            {4, ScalarType::Float32}, {8, ScalarType::Float64}};
+  return kTypes[dataType - 1];
+}
+
+double decodeExtraBytes(const char* bytes, const ExtraBytesField& field) {
+  double raw;
+  if (field.dataType == 7 || field.dataType == 8) {
+    std::uint64_t bits;
+    std::memcpy(&bits, bytes, 8);
+    raw = field.dataType == 7 ? double(bits) : double(std::int64_t(bits));
+  } else {
+    raw = decodeScalar(bytes, field.stored, false);
+  }
+  return field.scaled ? raw * field.scale + field.offset : raw;
+}
+
+struct VlrPayload {
+  std::string_view bytes;
+  std::size_t at = 0;  // byte offset in the file
+};
+
+/// The payload of the first Extra Bytes VLR (user "LASF_Spec", record 4); empty when none.
+/// VLRs are walked in sequence (R15 Sec. 2.5) between the header and the point data; one that
+/// runs past the offset to point data means the header's VLR count or a record length is wrong.
+VlrPayload findExtraBytesVlr(std::string_view data, const std::string& file, std::size_t headerSize,
+                             std::size_t pointOffset, std::uint32_t vlrCount) {
+  ByteReader in(data.substr(0, pointOffset), file);
+  in.seek(headerSize, "the first VLR");
+  VlrPayload found;  // at == 0 until found (a payload follows the header)
+  for (std::uint32_t v = 0; v < vlrCount; ++v) {
+    const std::size_t start = in.offset();
+    auto overrun = [&](const std::string& what) {
+      return FileError(file, byteWhere(start),
+                       "VLR " + std::to_string(v + 1) + " of " + std::to_string(vlrCount) + "'s " +
+                           what + " runs past the offset to point data (" +
+                           std::to_string(pointOffset) + ")",
+                       "the header's number of VLRs or a VLR's record length is wrong");
+    };
+    if (in.remaining() < kVlrHeaderSize) throw overrun("54-byte header");
+    in.skip(2, "a VLR's reserved field");
+    const std::string_view user(in.take(16, "a VLR's user id"), 16);
+    const std::uint16_t record = in.read<std::uint16_t>("a VLR's record id");
+    const std::size_t length = in.read<std::uint16_t>("a VLR's record length");
+    in.skip(32, "a VLR's description");
+    if (length > in.remaining()) throw overrun("payload of " + std::to_string(length) + " bytes");
+    const char* body = in.take(length, "a VLR's payload");
+    if (found.at == 0 && user.substr(0, user.find('\0')) == "LASF_Spec" && record == 4)
+      found = {std::string_view(body, length), start + kVlrHeaderSize};
+  }
+  return found;
+}
+
+/// Parses the descriptors (R15 Sec. 4.3) against the extra bytes of each record, which start at
+/// `standardLength`. Every descriptor advances the position by its size, so undocumented (type
+/// 0, size in `options`) and deprecated array (11-30) bytes are skipped without shifting the
+/// fields after them; a reserved type (31-255) has no known size, so it and the descriptors after
+/// it are skipped. Descriptors that need more bytes than the record holds make the VLR invalid
+/// (the spec's "extra bytes mismatch"): FileError.
+ExtraBytesLayout parseExtraBytes(const VlrPayload& vlr, std::size_t standardLength,
+                                 std::size_t recordLength, const std::string& file) {
+  ExtraBytesLayout layout;
+  if (vlr.bytes.size() % kDescriptorSize != 0)
+    throw FileError(file, byteWhere(vlr.at),
+                    "the Extra Bytes VLR holds " + std::to_string(vlr.bytes.size()) +
+                        " bytes, not a whole number of 192-byte descriptors");
+  const std::size_t count = vlr.bytes.size() / kDescriptorSize;
+  std::size_t at = standardLength;
+  for (std::size_t j = 0; j < count; ++j) {
+    ByteReader in(vlr.bytes.substr(j * kDescriptorSize, kDescriptorSize), file);
+    in.skip(2, "a descriptor's reserved field");
+    const int dataType = in.read<std::uint8_t>("a descriptor's data type");
+    const int options = in.read<std::uint8_t>("a descriptor's options");
+    const std::string_view rawName(in.take(32, "a descriptor's name"), 32);
+    ExtraBytesField field;
+    field.name = std::string(rawName.substr(0, rawName.find('\0')));
+    field.descriptor = j;
+    field.dataType = dataType;
+    std::size_t size;
+    if (dataType == 0) {
+      size = std::size_t(options);
+    } else if (dataType <= 10) {
+      size = extraBytesScalar(dataType).size;
+      field.stored = field.type = extraBytesScalar(dataType).type;
+    } else if (dataType <= 30) {
+      // Deprecated arrays: 11-20 two, 21-30 three values of data type (t - 11) % 10 + 1.
+      size = extraBytesScalar((dataType - 11) % 10 + 1).size * (dataType <= 20 ? 2 : 3);
+    } else {
+      layout.skipped += count - j;
+      break;
+    }
+    if (size > recordLength - at)
+      throw FileError(file, byteWhere(vlr.at + j * kDescriptorSize),
+                      "Extra Bytes descriptor " + std::to_string(j + 1) + " ('" + field.name +
+                          "') needs bytes " + std::to_string(at) + "-" +
+                          std::to_string(at + size - 1) + " of a point record that is " +
+                          std::to_string(recordLength) + " bytes long",
+                      "the Extra Bytes VLR does not match the point record length");
+    field.at = at;
+    at += size;
+    if (dataType == 0 || dataType > 10) {
+      ++layout.skipped;
+      continue;
+    }
+    // Bits 3 and 4 of `options`: multiply by `scale`, then add `offset` (fields at 112 and 136).
+    if (options & 0x18) {
+      in.seek(112, "a descriptor's scale");
+      const double scale = in.read<double>("a descriptor's scale");
+      in.seek(136, "a descriptor's offset");
+      const double offset = in.read<double>("a descriptor's offset");
+      field.scaled = true;
+      field.scale = options & 0x08 ? scale : 1.0;
+      field.offset = options & 0x10 ? offset : 0.0;
+      field.type = ScalarType::Float64;
+    }
+    layout.fields.push_back(std::move(field));
+  }
+  return layout;
+}
+
+/// A descriptor name as a column name: bytes that are not printable ASCII, spaces and commas
+/// become '_' (every writer rejects them), an empty name becomes extra_bytes_N, and a name already
+/// taken (by a standard attribute, the normals or an earlier field) gets _2, _3, ...
+std::string columnName(const std::string& raw, std::size_t index, std::vector<std::string>& taken) {
+  std::string name = raw.empty() ? "extra_bytes_" + std::to_string(index + 1) : raw;
+  for (char& c : name)
+    if (std::uint8_t(c) <= ' ' || std::uint8_t(c) > '~' || c == ',') c = '_';
+  std::string unique = name;
+  for (int k = 2; std::find(taken.begin(), taken.end(), unique) != taken.end(); ++k)
+    unique = name + "_" + std::to_string(k);
+  taken.push_back(unique);
+  return unique;
+}
+
+/// Declares the extra bytes' columns after the standard ones (`taken`). Float fields named nx ny
+/// nz (the first float field of each name, all three needed) become the normals, as in PLY.
+void addExtraColumns(ExtraBytesLayout& extras, CloudBuilder& builder,
+                     std::vector<std::string>& taken) {
+  ExtraBytesField* normal[3] = {nullptr, nullptr, nullptr};
+  for (ExtraBytesField& field : extras.fields)
+    for (int k = 0; k < 3; ++k)
+      if (!normal[k] && field.name == kNormalNames[k] && !isIntegerType(field.type))
+        normal[k] = &field;
+  if (normal[0] && normal[1] && normal[2]) {
+    builder.enableNormals();
+    for (int k = 0; k < 3; ++k) {
+      normal[k]->normalAxis = k;
+      taken.push_back(normal[k]->name);
+    }
+  }
+  for (ExtraBytesField& field : extras.fields)
+    if (field.normalAxis < 0)
+      field.column = builder.addColumn(columnName(field.name, field.descriptor, taken), field.type);
+}
+
 const char* const kLazFix =
     "decompress it first, e.g. `laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`";
 
@@ -55,7 +249,7 @@ PointCloud readLas(std::string_view data, const std::string& file, const ReadOpt
   in.seek(94, "the header size");
   const std::size_t headerSize = in.read<std::uint16_t>("the header size");
   const std::size_t pointOffset = in.read<std::uint32_t>("the offset to point data");
-  in.skip(4, "the number of VLRs");
+  const std::uint32_t vlrCount = in.read<std::uint32_t>("the number of VLRs");
   const int formatByte = in.read<std::uint8_t>("the point data format");
   const std::size_t recordLength = in.read<std::uint16_t>("the point record length");
   const std::uint64_t legacyCount = in.read<std::uint32_t>("the number of points");
@@ -123,20 +317,30 @@ PointCloud readLas(std::string_view data, const std::string& file, const ReadOpt
                         std::to_string(available),
                     "the file is truncated or its point count is wrong");
 
+  ExtraBytesLayout extras =
+      parseExtraBytes(findExtraBytesVlr(data, file, headerSize, pointOffset, vlrCount),
+                      lasRecordSize(format), recordLength, file);
+
   CloudBuilder builder(file, options);
+  std::vector<std::string> taken;  // column names, for the extra bytes' names to avoid
+  auto addStandard = [&](const char* name, ScalarType type) {
+    taken.push_back(name);
+    return builder.addColumn(name, type);
+  };
   const bool hasTime = format == 1 || format == 3 || format >= 6;
   const bool hasColour = format == 2 || format == 3 || format == 7 || format == 8;
-  const std::size_t intensity = builder.addColumn("intensity", ScalarType::UInt16);
-  const std::size_t classification = builder.addColumn("classification", ScalarType::UInt8);
-  const std::size_t returnNumber = builder.addColumn("return_number", ScalarType::UInt8);
-  const std::size_t returnCount = builder.addColumn("number_of_returns", ScalarType::UInt8);
-  const std::size_t time = hasTime ? builder.addColumn("gps_time", ScalarType::Float64) : 0;
-  const std::size_t red = hasColour ? builder.addColumn("red", ScalarType::UInt16) : 0;
+  const std::size_t intensity = addStandard("intensity", ScalarType::UInt16);
+  const std::size_t classification = addStandard("classification", ScalarType::UInt8);
+  const std::size_t returnNumber = addStandard("return_number", ScalarType::UInt8);
+  const std::size_t returnCount = addStandard("number_of_returns", ScalarType::UInt8);
+  const std::size_t time = hasTime ? addStandard("gps_time", ScalarType::Float64) : 0;
+  const std::size_t red = hasColour ? addStandard("red", ScalarType::UInt16) : 0;
   if (hasColour) {
-    builder.addColumn("green", ScalarType::UInt16);
-    builder.addColumn("blue", ScalarType::UInt16);
+    addStandard("green", ScalarType::UInt16);
+    addStandard("blue", ScalarType::UInt16);
   }
-  const std::size_t nir = format == 8 ? builder.addColumn("nir", ScalarType::UInt16) : 0;
+  const std::size_t nir = format == 8 ? addStandard("nir", ScalarType::UInt16) : 0;
+  addExtraColumns(extras, builder, taken);
   builder.reserve(std::size_t(count));
   std::vector<double> values(builder.columnCount());
 
@@ -172,10 +376,21 @@ PointCloud readLas(std::string_view data, const std::string& file, const ReadOpt
       for (std::size_t c = 0; c < 3; ++c) values[red + c] = record.read<std::uint16_t>("colour");
       if (format == 8) values[nir] = record.read<std::uint16_t>("nir");
     }
-    builder.addPoint(position, Vec3::Zero(), values.data(), [&] { return byteWhere(start); });
+    Vec3 normalValue = Vec3::Zero();
+    for (const ExtraBytesField& field : extras.fields) {
+      const double value = decodeExtraBytes(data.data() + start + field.at, field);
+      if (field.normalAxis >= 0)
+        normalValue[field.normalAxis] = value;
+      else
+        values[field.column] = value;
+    }
+    builder.addPoint(position, normalValue, values.data(), [&] { return byteWhere(start); });
   }
-  return builder.finish(report,
-                        "las 1." + std::to_string(minor) + " format " + std::to_string(format));
+  std::string description = "las 1." + std::to_string(minor) + " format " + std::to_string(format);
+  if (extras.skipped > 0)
+    description += ", " + std::to_string(extras.skipped) +
+                   " extra bytes fields skipped (undocumented, deprecated array or reserved type)";
+  return builder.finish(report, description);
 }
 
 }  // namespace scalespace
