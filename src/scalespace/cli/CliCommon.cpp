@@ -149,6 +149,10 @@ void checkOutput(const std::string& output, OutputKind kind,
                     "choose another output folder or check its permissions");
 }
 
+void printWarnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+}
+
 std::string summaryPathFor(const std::string& output) {
   return std::filesystem::path(output).replace_extension(".json").string();
 }

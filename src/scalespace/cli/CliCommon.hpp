@@ -44,6 +44,9 @@ enum class OutputKind {
 void checkOutput(const std::string& output, OutputKind kind,
                  const std::vector<std::string>& inputs);
 
+/// "warning: ..." lines on stderr, also with --quiet: they are about the results, not progress.
+void printWarnings(const std::vector<std::string>& warnings);
+
 /// OUT.ply -> OUT.json
 std::string summaryPathFor(const std::string& output);
 

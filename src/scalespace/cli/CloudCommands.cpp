@@ -303,7 +303,9 @@ void addCurvatureCommand(CLI::App& app) {
                              {"robust", options.fit.robust},
                              {"normals_estimated", !hadNormals},
                              {"threads", args->threads}}},
-                           {"seconds", {{"fits", summary.seconds}, {"total", total}}}};
+                           {"seconds", {{"fits", summary.seconds}, {"total", total}}},
+                           {"warnings", summary.warnings}};
+    printWarnings(summary.warnings);
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);
     if (!args->quiet)

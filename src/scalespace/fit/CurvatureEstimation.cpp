@@ -11,6 +11,7 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
 #include "scalespace/fit/NeighborhoodCache.hpp"
 
@@ -82,7 +83,7 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   std::vector<double> scales(n, options.scale);
   struct Counters {
     std::size_t invalid = 0;
-    double neighbors = 0;
+    double neighbors = 0, allNeighbors = 0;
     FitWorkspace workspace;
   };
   tbb::enumerable_thread_specific<Counters> counters;
@@ -98,6 +99,7 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
     }
     LocalFit fit;
     if (t > 0) fit = fitAt(positions[k], t, samples, options.fit, c.workspace);
+    c.allNeighbors += fit.neighbors;
     if (fit.valid)
       c.neighbors += fit.neighbors;
     else
@@ -126,12 +128,21 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   tracker.finish();
   summary.fitSeconds = secondsSince(fitStart);
 
+  double allNeighbors = 0;
   for (const Counters& c : counters) {
     summary.invalid += c.invalid;
     summary.meanNeighbors += c.neighbors;
+    allNeighbors += c.allNeighbors;
   }
   const std::size_t valid = n - summary.invalid;
   summary.meanNeighbors = valid ? summary.meanNeighbors / double(valid) : 0.0;
+  FitCounts counts;
+  counts.total = n;
+  counts.invalid = summary.invalid;
+  counts.largestScale = n ? *std::max_element(scales.begin(), scales.end()) : 0.0;
+  counts.meanNeighbors = n ? allNeighbors / double(n) : 0.0;
+  counts.minNeighbors = options.fit.minNeighbors;
+  summary.warnings = invalidFitWarnings(cloud, counts);
   std::nth_element(scales.begin(), scales.begin() + n / 2, scales.end());
   summary.medianScale = scales[n / 2];
   summary.seconds = secondsSince(start);

@@ -29,6 +29,8 @@ struct CurvatureSummary {
   double seconds = 0;        // everything below, and the output (index build included)
   double setupSeconds = 0;   // spatial order and index build
   double fitSeconds = 0;     // neighbour queries and fits of all points (results handed over)
+  /// When most fits are invalid: what and why (fit/FitDiagnosis.hpp), for the caller to show.
+  std::vector<std::string> warnings;
 };
 
 /// OptionError naming the field unless exactly one of scale (finite, > 0) and scaleK (in
