@@ -16,45 +16,16 @@
 
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "cli/CliTestSupport.hpp"
 
 namespace fs = std::filesystem;
 using namespace scalespace;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string err;
-};
-
-// Runs the CLI with `args`, capturing stderr.
-Result run(const std::string& args) {
-  static int counter = 0;
-  const fs::path errFile =
-      fs::temp_directory_path() /
-      ("scalespace_cli_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-  const std::string cmd =
-      std::string(SCALESPACE_CLI_PATH) + " " + args + " >/dev/null 2>" + errFile.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(errFile);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  fs::remove(errFile);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-class Cli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("scalespace_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+using test::Cli;
+using test::Result;
+using test::run;
 
 TEST_F(Cli, HelpAndVersionSucceed) {
   EXPECT_EQ(run("--help").code, 0);

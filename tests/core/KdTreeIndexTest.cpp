@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -91,6 +93,24 @@ TEST(KdTreeIndex, ManyDuplicatesTieBrokenByIndex) {
   EXPECT_EQ(out.size(), 600u);
   compareWithBruteForce(points, withDataPoints(testclouds::uniformCube(20, 6), points, 40),
                         {0.0, 1e-9, 0.1, 0.4}, {1, 10, 599, 600, 601, 2000});
+}
+
+TEST(KdTreeIndex, DuplicateGroupsOfEverySizeInAnyOrder) {
+  // Scans repeat points: groups of 1-12 copies of 150 positions, shuffled, with -0 beside +0; each
+  // group is one slot of the tree and must answer as the brute force does.
+  std::mt19937 rng(11);
+  const auto base = testclouds::uniformCube(150, 9);
+  std::vector<Vec3> points;
+  for (std::size_t g = 0; g < base.size(); ++g)
+    for (std::size_t c = 0; c < 1 + g % 12; ++c) points.push_back(base[g]);
+  points.push_back(Vec3(0.0, 0.25, 0.5));
+  points.push_back(Vec3(-0.0, 0.25, 0.5));
+  std::shuffle(points.begin(), points.end(), rng);
+  const auto queries = withDataPoints(testclouds::uniformCube(30, 10), points, 60);
+  for (std::size_t leaf : {1, 4, 16})
+    compareWithBruteForce(points, queries,
+                          {0.0, 1e-12, 0.05, 0.3}, {1, 2, 7, 13, 40, 900, 5000},
+                          KdTreeOptions{leaf});
 }
 
 TEST(KdTreeIndex, GridCoplanarAndColinearWithExactTies) {

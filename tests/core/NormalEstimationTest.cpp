@@ -138,6 +138,8 @@ TEST(NormalEstimation, OptionsAndCancellation) {
   NormalEstimationOptions bad;
   bad.k = 2;
   EXPECT_THROW(estimateNormals(points, bad), OptionError);
+  bad.k = kMaxNeighborCount + 1;  // k^2 per query: 10^5 ran for minutes
+  EXPECT_THROW(estimateNormals(points, bad), OptionError);
   bad.k = 10;
   bad.radius = -1;
   EXPECT_THROW(estimateNormals(points, bad), OptionError);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "scalespace/core/Error.hpp"
 #include "scalespace/core/PointCloud.hpp"
 
 using namespace scalespace;
@@ -43,4 +44,37 @@ TEST(PointCloud, RecentringNearTheLargestDoubleStaysFinite) {
     ASSERT_TRUE(cloud.positions()[i].allFinite());
     EXPECT_EQ(cloud.absolutePosition(i), abs[i]);
   }
+}
+
+TEST(PointCloud, ColumnReferencesSurviveAddingColumnsAndCopiesAreDeep) {
+  PointCloud cloud;
+  cloud.setAbsolutePositions({{0, 0, 0}, {1, 0, 0}});
+  AttributeColumn& first = cloud.addAttribute("first", ScalarType::Int32);
+  const double* data = first.values.data();
+  for (int c = 0; c < 100; ++c) cloud.addAttribute("c" + std::to_string(c), ScalarType::Float32);
+  first.values[1] = 7;  // would write freed memory if columns moved (ASan build)
+  EXPECT_EQ(&first, cloud.findAttribute("first"));
+  EXPECT_EQ(first.values.data(), data);
+  EXPECT_EQ(cloud.attributes().size(), 101u);
+  EXPECT_EQ(cloud.attributes().front().values[1], 7);
+  PointCloud copy = cloud;
+  copy.findAttribute("first")->values[1] = 8;
+  EXPECT_EQ(first.values[1], 7);
+  EXPECT_TRUE(cloud.removeAttribute("c50"));
+  EXPECT_EQ(&first, cloud.findAttribute("first"));
+  std::vector<std::string> names;
+  for (const AttributeColumn& a : copy.attributes()) names.push_back(a.name);
+  EXPECT_EQ(names.size(), 101u);
+  EXPECT_EQ(names[1], "c0");
+}
+
+TEST(PointCloud, SetAttributesChecksSizesAndNames) {
+  PointCloud cloud;
+  cloud.setAbsolutePositions({{0, 0, 0}, {1, 0, 0}});
+  EXPECT_THROW(cloud.setAttributes({AttributeColumn{"a", ScalarType::UInt8, {1}}}), Error);
+  EXPECT_THROW(cloud.setAttributes({AttributeColumn{"a", ScalarType::UInt8, {1, 2}},
+                                    AttributeColumn{"a", ScalarType::UInt8, {1, 2}}}),
+               Error);
+  cloud.setAttributes({AttributeColumn{"a", ScalarType::UInt8, {1, 2}}});
+  EXPECT_EQ(cloud.findAttribute("a")->values[1], 2);
 }

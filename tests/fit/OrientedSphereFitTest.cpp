@@ -202,3 +202,20 @@ TEST(OrientedSphereFit, Avx512SecondOrderSolveEqualsPortable) {
   EXPECT_FALSE(f.finish(6, SimdKernel::Avx512).valid);
   if (!avx512Available()) GTEST_SKIP() << "no AVX-512 on this CPU: the portable solve ran twice";
 }
+
+TEST(OrientedSphereFit, NeighboursOnALineAreADegenerateFit) {
+  // Points on a line leave the sphere free to turn about it: the fit must say invalid, not report
+  // curvatures made of rounding noise. A strip 1/20 as wide as it is long is still a surface.
+  for (double width : {0.0, 1e-5, 0.05}) {
+    TestCloud c;
+    for (int i = 0; i < 200; ++i)
+      for (int side : {-1, 1}) {
+        c.positions.push_back(Vec3(-1 + 0.01 * i, 0.5 * side * width * (i % 3), 0.3));
+        c.normals.push_back(Vec3(0, 0.2, 1).normalized());
+      }
+    for (FitDerivatives order : {FitDerivatives::First, FitDerivatives::Second}) {
+      const auto r = fitRaw(c, Vec3(0, 0, 0.3), 1.0, order);
+      EXPECT_EQ(r.valid, width > 0.01) << "width " << width;
+    }
+  }
+}

@@ -169,11 +169,41 @@ TEST(PlaneQueries, CoverageExtensionRecoversTheFaces) {
     if (labels[i] >= 0) {
       EXPECT_EQ(extended[i], labels[i]);  // labelled points keep their label
     }
-  // Thresholds that exclude every point change nothing.
-  CoverageOptions none;
-  none.maxDistanceFraction = -1;
-  EXPECT_EQ(extendCoverage(s.model, labels, s.cloud.positions(), s.cloud.normals(), s.knn, none),
-            labels);
+  // Thresholds out of range are refused (a negative distance used to pass silently).
+  for (double bad : {-1.0, std::nan("")}) {
+    CoverageOptions o;
+    o.maxDistanceFraction = bad;
+    EXPECT_THROW(
+        extendCoverage(s.model, labels, s.cloud.positions(), s.cloud.normals(), s.knn, o),
+        OptionError);
+    o = CoverageOptions();
+    o.maxAngleDegrees = bad;
+    EXPECT_THROW(validate(o), OptionError);
+  }
+  SimilarityOptions similar;
+  similar.birthTolerance = -1;
+  EXPECT_THROW(findSimilar(s.model, 0, {0}, similar), OptionError);
+}
+
+TEST(PlaneExport, WritesOnlyIntoANewOrEmptyFolderOrAnEarlierResult) {
+  const Scene s = stairs();
+  const auto dir = std::filesystem::temp_directory_path() / "scalespace_planes_destination";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "mine");
+  std::ofstream(dir / "mine" / "components.json") << "mine";
+  EXPECT_THROW(writePlaneModel(s.model, Vec3::Zero(), "in.ply", (dir / "mine").string()),
+               FileError);
+  EXPECT_EQ(std::filesystem::file_size(dir / "mine" / "components.json"), 4u);
+  std::ofstream(dir / "file") << "file";
+  EXPECT_THROW(writePlaneModel(s.model, Vec3::Zero(), "in.ply", (dir / "file").string()),
+               FileError);
+  writePlaneModel(s.model, Vec3::Zero(), "in.ply", (dir / "new").string());
+  EXPECT_TRUE(isPlaneResult((dir / "new").string()));
+  writePlaneModel(s.model, Vec3::Zero(), "again.ply", (dir / "new").string());  // replaced
+  std::string input;
+  readPlaneModel((dir / "new").string(), &input);
+  EXPECT_EQ(input, "again.ply");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(PlaneExport, ModelRoundTripAndFiles) {

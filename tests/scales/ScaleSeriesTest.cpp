@@ -46,6 +46,9 @@ TEST(ScaleSeries, MonotoneForManyScales) {
 
 TEST(ScaleSeries, RejectsInvalidOptions) {
   EXPECT_THROW(scaleSeries(1, 2, 0, ScaleSpacing::Log), OptionError);
+  EXPECT_THROW(scaleSeries(1, 2, kMaxScaleCount + 1, ScaleSpacing::Log), OptionError);
+  EXPECT_EQ(scaleSeries(1, 2, kMaxScaleCount, ScaleSpacing::Log).size(),
+            std::size_t(kMaxScaleCount));
   EXPECT_THROW(scaleSeries(0, 2, 5, ScaleSpacing::Log), OptionError);
   EXPECT_THROW(scaleSeries(-1, 2, 5, ScaleSpacing::Linear), OptionError);
   EXPECT_THROW(scaleSeries(3, 2, 5, ScaleSpacing::Log), OptionError);

@@ -146,6 +146,30 @@ TEST_F(StackFixture, LayersInProcessingOrderAreWrittenInInputOrder) {
   }
 }
 
+TEST_F(StackFixture, OnlyAStackIsEverReplaced) {
+  // A file, a user's folder (even one with a manifest.json of its own): refused before anything is
+  // written, and left as they were. A stack is replaced.
+  const std::string file = (dir.path / "notes.txt").string();
+  std::ofstream(file) << "keep";
+  const fs::path mine = dir.path / "mine";
+  fs::create_directories(mine);
+  std::ofstream(mine / "manifest.json") << "{\"format\": \"not ours\"}";
+  std::ofstream(mine / "data.bin") << "keep";
+  for (const std::string target : {file, mine.string()}) {
+    EXPECT_FALSE(isScaleStack(target));
+    EXPECT_THROW(writeScaleStack(target, cloud, options, stack, float32()), FileError) << target;
+    EXPECT_THROW(computeScaleStack(cloud, options, target), FileError) << target;
+  }
+  EXPECT_TRUE(fs::is_regular_file(file));
+  EXPECT_TRUE(fs::exists(mine / "data.bin"));
+  std::size_t entries = 0;
+  for (auto it = fs::directory_iterator(dir.path); it != fs::directory_iterator(); ++it) ++entries;
+  EXPECT_EQ(entries, 3u);  // sphere.stack, notes.txt, mine: no temporary left
+  EXPECT_TRUE(isScaleStack(path));
+  writeScaleStack(path, cloud, options, stack);  // replaces the float32 stack by a compact one
+  EXPECT_EQ(ScaleStackReader(path).info().encoding, StackEncoding::Compact);
+}
+
 TEST_F(StackFixture, HalfWrittenStackIsRejected) {
   fs::remove(fs::path(path) / "manifest.json");
   EXPECT_FALSE(isScaleStack(path));

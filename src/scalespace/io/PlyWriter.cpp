@@ -34,12 +34,42 @@ const char* plyTypeName(ScalarType type) {
   return "double";
 }
 
+/// A column as written: its PLY type and a factor applied to its values.
+struct PlyColumn {
+  const AttributeColumn* column;
+  ScalarType type;
+  double factor;
+};
+
+/// The attribute columns as written. 16-bit red/green/blue (LAS colours) become 8-bit: viewers
+/// (CloudCompare, MeshLab) read PLY colours as uchar and show ushort ones as black. Values that
+/// already fit in 8 bits (LAS files written by 8-bit software) are kept; others are scaled by
+/// 255/65535, which drops the low byte.
+std::vector<PlyColumn> plyColumns(const PointCloud& cloud) {
+  const AttributeColumn* rgb[3] = {cloud.findAttribute("red"), cloud.findAttribute("green"),
+                                   cloud.findAttribute("blue")};
+  bool sixteenBit = true, fitsInEightBits = true;
+  for (const AttributeColumn* c : rgb) {
+    sixteenBit = sixteenBit && c && c->type == ScalarType::UInt16;
+    if (c)
+      for (double v : c->values) fitsInEightBits = fitsInEightBits && v <= 255;
+  }
+  std::vector<PlyColumn> out;
+  for (const AttributeColumn& column : cloud.attributes()) {
+    const bool colour = sixteenBit && (&column == rgb[0] || &column == rgb[1] || &column == rgb[2]);
+    out.push_back(colour ? PlyColumn{&column, ScalarType::UInt8, fitsInEightBits ? 1.0 : 255.0 / 65535.0}
+                         : PlyColumn{&column, column.type, 1.0});
+  }
+  return out;
+}
+
 }  // namespace
 
 void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) {
   checkAttributeNames(cloud, "PLY", {"x", "y", "z"}, {"nx", "ny", "nz"});
   const ScalarType positionType = positionTypeFor(cloud);
   const bool normals = cloud.hasNormals();
+  const std::vector<PlyColumn> columns = plyColumns(cloud);
 
   out << "ply\nformat "
       << (encoding == PlyEncoding::Ascii                ? "ascii"
@@ -51,8 +81,8 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
     out << "property " << plyTypeName(positionType) << ' ' << name << '\n';
   if (normals)
     for (const char* name : {"nx", "ny", "nz"}) out << "property float " << name << '\n';
-  for (const auto& column : cloud.attributes())
-    out << "property " << plyTypeName(column.type) << ' ' << column.name << '\n';
+  for (const PlyColumn& c : columns)
+    out << "property " << plyTypeName(c.type) << ' ' << c.column->name << '\n';
   out << "end_header\n";
 
   if (encoding == PlyEncoding::Ascii) {
@@ -69,8 +99,8 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
           line += formatScalar(cloud.normals()[i][k], ScalarType::Float32);
           line += ' ';
         }
-      for (const auto& column : cloud.attributes()) {
-        line += formatScalar(column.values[i], column.type);
+      for (const PlyColumn& c : columns) {
+        line += formatScalar(c.column->values[i] * c.factor, c.type);
         line += ' ';
       }
       line.back() = '\n';
@@ -81,7 +111,7 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
 
   const bool big = encoding == PlyEncoding::BinaryBigEndian;
   std::size_t rowSize = 3 * scalarTypeSize(positionType) + (normals ? 12 : 0);
-  for (const auto& column : cloud.attributes()) rowSize += scalarTypeSize(column.type);
+  for (const PlyColumn& c : columns) rowSize += scalarTypeSize(c.type);
   std::vector<char> row(rowSize);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     char* at = row.data();
@@ -93,7 +123,7 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
     for (int k = 0; k < 3; ++k) put(p[k], positionType);
     if (normals)
       for (int k = 0; k < 3; ++k) put(cloud.normals()[i][k], ScalarType::Float32);
-    for (const auto& column : cloud.attributes()) put(column.values[i], column.type);
+    for (const PlyColumn& c : columns) put(c.column->values[i] * c.factor, c.type);
     out.write(row.data(), std::streamsize(row.size()));
   }
 }
