@@ -68,8 +68,8 @@ TEST_F(Cli, ScalesNeverReplacesWhatIsNotAStack) {
   EXPECT_EQ(readText(path("file.txt")), "keep\n");
   EXPECT_EQ(readText(path("mine/a.txt")), "keep\n");
   // A stack is replaced by a stack.
-  ASSERT_EQ(run("scales " + path("proj/scan.ply") + " -o " + path("s.stack") + " --scales 2 -q").code,
-            0);
+  ASSERT_EQ(
+      run("scales " + path("proj/scan.ply") + " -o " + path("s.stack") + " --scales 2 -q").code, 0);
   r = run("scales " + path("proj/scan.ply") + " -o " + path("s.stack") + " --scales 3 -q");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(readText(path("s.stack/manifest.json")).find("\"scale_count\": 3"), std::string::npos);
@@ -109,8 +109,10 @@ TEST_F(Cli, SegmentAnswersEveryQueryAtEveryLevel) {
     writeText(path("ids.txt"), "0 1 2 3 4 5 6 7 8 9 100 500 1999\n");
     std::vector<std::string> queries = {"--brush " + path("ids.txt"),
                                         "--similar 0 --within " + path("ids.txt"),
-                                        "--min-persistence 0", "--min-persistence 3",
-                                        "--scale 1e-9", "--scale 1e9"};
+                                        "--min-persistence 0",
+                                        "--min-persistence 3",
+                                        "--scale 1e-9",
+                                        "--scale 1e9"};
     for (double t : scales) queries.push_back("--scale " + std::to_string(t));
     for (const std::string& q : queries)
       for (const std::string extra : {"", " --extend-coverage"}) {
@@ -196,7 +198,8 @@ TEST_F(Cli, MostlyInvalidFitsAreReportedWithTheirCause) {
   Result r = run("curvature " + path("line.xyz") + " -o " + path("l.ply") + " --scale 0.2 -q");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("warning: 500 of 500 fits"), std::string::npos) << r.err;
-  EXPECT_EQ(readCloud(path("l.ply")).findAttribute("fit_valid")->values, std::vector<double>(500, 0));
+  EXPECT_EQ(readCloud(path("l.ply")).findAttribute("fit_valid")->values,
+            std::vector<double>(500, 0));
   // NaN normals and a scale larger than the cloud: said on stderr and in the JSON.
   ASSERT_EQ(run("generate sphere -n 3000 -q -o " + path("s.xyz")).code, 0);
   PointCloud s = readCloud(path("s.xyz"));
@@ -239,9 +242,9 @@ TEST_F(Cli, OutputsAreCheckedBeforeTheInputIsRead) {
   EXPECT_EQ(readText(path("file.txt")), "keep\n");
   // Missing folders are created, for files as for folders.
   ASSERT_EQ(run("generate sphere -n 500 -q -o " + path("a/b/s.ply")).code, 0);
-  EXPECT_EQ(run("curvature " + path("a/b/s.ply") + " -o " + path("c/d/k.ply") + " --scale 0.5 -q")
-                .code,
-            0);
+  EXPECT_EQ(
+      run("curvature " + path("a/b/s.ply") + " -o " + path("c/d/k.ply") + " --scale 0.5 -q").code,
+      0);
   EXPECT_TRUE(fs::exists(path("c/d/k.ply")) && fs::exists(path("c/d/k.json")));
 }
 

@@ -14,9 +14,9 @@
 #include <sstream>
 #include <string>
 
+#include "cli/CliTestSupport.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/io/CloudIO.hpp"
-#include "cli/CliTestSupport.hpp"
 
 namespace fs = std::filesystem;
 using namespace scalespace;

@@ -33,12 +33,12 @@ inline std::string readAndRemove(const fs::path& file) {
 // Runs the CLI with `args`, capturing stdout and stderr.
 inline Result run(const std::string& args) {
   static int counter = 0;
-  const std::string stem = "scalespace_cli_" + std::to_string(::getpid()) + "_" +
-                           std::to_string(counter++);
+  const std::string stem =
+      "scalespace_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const fs::path errFile = fs::temp_directory_path() / (stem + ".err");
   const fs::path outFile = fs::temp_directory_path() / (stem + ".out");
-  const std::string cmd = std::string(SCALESPACE_CLI_PATH) + " " + args + " >" +
-                          outFile.string() + " 2>" + errFile.string();
+  const std::string cmd = std::string(SCALESPACE_CLI_PATH) + " " + args + " >" + outFile.string() +
+                          " 2>" + errFile.string();
   const int status = std::system(cmd.c_str());
   Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAndRemove(errFile), {}};
   r.out = readAndRemove(outFile);

@@ -1,9 +1,8 @@
 #include <gtest/gtest.h>
-
-#include <cmath>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -108,8 +107,7 @@ TEST(KdTreeIndex, DuplicateGroupsOfEverySizeInAnyOrder) {
   std::shuffle(points.begin(), points.end(), rng);
   const auto queries = withDataPoints(testclouds::uniformCube(30, 10), points, 60);
   for (std::size_t leaf : {1, 4, 16})
-    compareWithBruteForce(points, queries,
-                          {0.0, 1e-12, 0.05, 0.3}, {1, 2, 7, 13, 40, 900, 5000},
+    compareWithBruteForce(points, queries, {0.0, 1e-12, 0.05, 0.3}, {1, 2, 7, 13, 40, 900, 5000},
                           KdTreeOptions{leaf});
 }
 

@@ -173,9 +173,8 @@ TEST(PlaneQueries, CoverageExtensionRecoversTheFaces) {
   for (double bad : {-1.0, std::nan("")}) {
     CoverageOptions o;
     o.maxDistanceFraction = bad;
-    EXPECT_THROW(
-        extendCoverage(s.model, labels, s.cloud.positions(), s.cloud.normals(), s.knn, o),
-        OptionError);
+    EXPECT_THROW(extendCoverage(s.model, labels, s.cloud.positions(), s.cloud.normals(), s.knn, o),
+                 OptionError);
     o = CoverageOptions();
     o.maxAngleDegrees = bad;
     EXPECT_THROW(validate(o), OptionError);

@@ -1,7 +1,6 @@
 #include "scalespace/cli/CliCommon.hpp"
 
 #include <tbb/global_control.h>
-
 #include <unistd.h>
 
 #include <cctype>

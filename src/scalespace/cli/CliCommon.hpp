@@ -13,7 +13,7 @@ namespace scalespace::cli {
 
 struct InputOptions {
   std::string path;
-  bool dropInvalid = false;  // skip points with NaN/Inf coordinates instead of failing
+  bool dropInvalid = false;     // skip points with NaN/Inf coordinates instead of failing
   std::size_t meshSamples = 0;  // OFF/OBJ: sample this many points by area (0 = the vertices)
 };
 

@@ -38,9 +38,10 @@ void addInfoCommand(CLI::App& app) {
     std::printf("file        %s\nformat      %s\npoints      %zu\n", path->c_str(),
                 report.format.c_str(), cloud.size());
     if (report.droppedNonFinite > 0)
-      std::printf("invalid     %zu more points with NaN/Inf coordinates (not counted above; "
-                  "other commands stop on them unless given --drop-invalid)\n",
-                  report.droppedNonFinite);
+      std::printf(
+          "invalid     %zu more points with NaN/Inf coordinates (not counted above; "
+          "other commands stop on them unless given --drop-invalid)\n",
+          report.droppedNonFinite);
     if (!cloud.empty()) {
       Vec3 lo, hi;
       cloud.bounds(lo, hi);
@@ -51,14 +52,15 @@ void addInfoCommand(CLI::App& app) {
       std::printf("diagonal    %.6g\n", (hi - lo).norm());
     }
     if (cloud.hasNormals()) {
-      const std::size_t bad = std::size_t(std::count_if(
-          cloud.normals().begin(), cloud.normals().end(),
-          [](const Vec3& n) { return !n.allFinite() || n.squaredNorm() < 1e-12; }));
+      const std::size_t bad = std::size_t(
+          std::count_if(cloud.normals().begin(), cloud.normals().end(),
+                        [](const Vec3& n) { return !n.allFinite() || n.squaredNorm() < 1e-12; }));
       std::printf("normals     yes (nx ny nz)");
       if (bad > 0)
-        std::printf(", %zu of %zu NaN/Inf or zero (fits around them are invalid; `scalespace "
-                    "normals` re-estimates them)",
-                    bad, cloud.size());
+        std::printf(
+            ", %zu of %zu NaN/Inf or zero (fits around them are invalid; `scalespace "
+            "normals` re-estimates them)",
+            bad, cloud.size());
       std::printf("\n");
     } else {
       std::printf("normals     no\n");
@@ -171,7 +173,8 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
                        bool quiet) {
   if (a.k < 3) throw OptionError("--k must be >= 3");
   if (a.k >= cloud.size())
-    throw OptionError("--k " + std::to_string(a.k) + " must be smaller than the number of points (" +
+    throw OptionError("--k " + std::to_string(a.k) +
+                      " must be smaller than the number of points (" +
                       std::to_string(cloud.size()) + ")");
   const NormalOrientationOptions orientation = orientationFrom(a, cloud);
   const auto index = makeSpatialIndex(cloud.positions());

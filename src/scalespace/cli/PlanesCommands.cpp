@@ -192,10 +192,10 @@ void addSegmentCommand(CLI::App& app) {
     input.path = args->input.empty() ? recorded : args->input;
     std::error_code ec;
     if (args->input.empty() && !std::filesystem::is_regular_file(recorded, ec))
-      throw FileError(recorded, "",
-                      "the cloud the planes in " + args->directory +
-                          " were computed on is not there",
-                      "pass it with --input IN");
+      throw FileError(
+          recorded, "",
+          "the cloud the planes in " + args->directory + " were computed on is not there",
+          "pass it with --input IN");
     checkOutput(args->output, OutputKind::Cloud, {input.path, args->directory});
     PointCloud cloud = loadCloud(input, args->quiet);
     if (cloud.size() != model.membership.pointCount)

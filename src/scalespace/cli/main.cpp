@@ -3,9 +3,9 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <string>
 #include <utility>
-#include <exception>
 
 #include "scalespace/cli/CloudCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <utility>
 #include <nanoflann.hpp>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/RadixSort.hpp"
@@ -68,7 +68,8 @@ struct RadiusCollector {
   double worstDist() const { return bound; }
   bool addPoint(double, Index slot) {
     const double d2 = (slots[slot] - q).squaredNorm();
-    if (d2 < r2) groups.forEach(slot, [&](Index i) {
+    if (d2 < r2)
+      groups.forEach(slot, [&](Index i) {
         out->push_back({i, d2});
         return true;
       });

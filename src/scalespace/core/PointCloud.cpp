@@ -89,7 +89,8 @@ void PointCloud::setNormals(std::vector<Vec3> normals) {
 PointCloud::PointCloud(const PointCloud& other)
     : positions_(other.positions_), normals_(other.normals_), origin_(other.origin_) {
   attributes_.reserve(other.attributes_.size());
-  for (const auto& a : other.attributes_) attributes_.push_back(std::make_unique<AttributeColumn>(*a));
+  for (const auto& a : other.attributes_)
+    attributes_.push_back(std::make_unique<AttributeColumn>(*a));
 }
 
 PointCloud& PointCloud::operator=(const PointCloud& other) {

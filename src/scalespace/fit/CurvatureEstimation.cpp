@@ -11,8 +11,8 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
-#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
+#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/fit/NeighborhoodCache.hpp"
 
 namespace scalespace {

@@ -11,11 +11,11 @@
 namespace scalespace {
 
 struct FitCounts {
-  std::size_t total = 0;    // fits made
-  std::size_t invalid = 0;  // of which invalid
-  double largestScale = 0;  // the largest t used (per-point or per-scale)
-  double meanNeighbors = 0; // mean neighbours per fit, over every fit
-  int minNeighbors = 6;     // FitOptions::minNeighbors of the run
+  std::size_t total = 0;     // fits made
+  std::size_t invalid = 0;   // of which invalid
+  double largestScale = 0;   // the largest t used (per-point or per-scale)
+  double meanNeighbors = 0;  // mean neighbours per fit, over every fit
+  int minNeighbors = 6;      // FitOptions::minNeighbors of the run
 };
 
 /// Points whose normal is NaN/Inf or of (near) zero length: 0 for a cloud without normals.

@@ -41,8 +41,8 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
   std::error_code created;
   if (!parent.empty()) fs::create_directories(parent, created);
   if (created)
-    throw FileError(path, "", "cannot create the folder " + parent.string() + ": " +
-                                  created.message());
+    throw FileError(path, "",
+                    "cannot create the folder " + parent.string() + ": " + created.message());
   const std::string temporary = temporaryPathFor(path);
   std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
   if (!out)

@@ -10,8 +10,8 @@
 namespace scalespace {
 
 /// Calls `write` with a binary stream on a temporary file `<path>.tmp-<pid>-<random>`, then renames
-/// it to `path`. Missing parent folders are created first. Exceptions thrown by `write` (e.g. Cancelled) propagate after the cleanup; I/O
-/// failures throw FileError naming `path`.
+/// it to `path`. Missing parent folders are created first. Exceptions thrown by `write` (e.g.
+/// Cancelled) propagate after the cleanup; I/O failures throw FileError naming `path`.
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace scalespace

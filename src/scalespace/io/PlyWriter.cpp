@@ -57,8 +57,9 @@ std::vector<PlyColumn> plyColumns(const PointCloud& cloud) {
   std::vector<PlyColumn> out;
   for (const AttributeColumn& column : cloud.attributes()) {
     const bool colour = sixteenBit && (&column == rgb[0] || &column == rgb[1] || &column == rgb[2]);
-    out.push_back(colour ? PlyColumn{&column, ScalarType::UInt8, fitsInEightBits ? 1.0 : 255.0 / 65535.0}
-                         : PlyColumn{&column, column.type, 1.0});
+    out.push_back(
+        colour ? PlyColumn{&column, ScalarType::UInt8, fitsInEightBits ? 1.0 : 255.0 / 65535.0}
+               : PlyColumn{&column, column.type, 1.0});
   }
   return out;
 }
