@@ -108,12 +108,19 @@ void checkOutput(const std::string& output, OutputKind kind,
   const std::string ext = lowerExtension(output);
   const bool isFolder = kind == OutputKind::Stack || kind == OutputKind::PlanesResult;
   switch (kind) {
-    case OutputKind::Cloud:
-      if (formatFromPath(output) == CloudFormat::Off || formatFromPath(output) == CloudFormat::Obj)
+    case OutputKind::Cloud: {
+      const char* const writable = "write .ply, .xyz, .txt, .csv, .pts, .las or .pcd";
+      CloudFormat format;
+      try {
+        format = formatFromPath(output);
+      } catch (const Error&) {
+        throw OptionError("output " + output + ": not a point cloud extension; " + writable);
+      }
+      if (format == CloudFormat::Off || format == CloudFormat::Obj)
         throw OptionError("output " + output +
-                          ": OFF and OBJ are meshes and cannot hold a point cloud; write .ply, "
-                          ".xyz, .txt, .csv, .pts, .las or .pcd");
+                          ": OFF and OBJ are meshes and cannot hold a point cloud; " + writable);
       break;
+    }
     case OutputKind::Png:
       if (ext != ".png")
         throw OptionError("output " + output + ": images are written as PNG; name it *.png");
