@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -133,7 +134,16 @@ TEST_F(Cli, SegmentAnswersEveryQueryAtEveryLevel) {
 
 TEST_F(Cli, SegmentNamesInputWhenTheRecordedCloudIsGone) {
   ASSERT_EQ(run("generate box -n 2000 -q -o " + path("box.ply")).code, 0);
-  ASSERT_EQ(run("planes " + path("box.ply") + " -o " + path("p") + " --scales 4 -q").code, 0);
+  // Planes run from the cloud's folder with a relative path; segment run from elsewhere.
+  const std::string cli = SCALESPACE_CLI_PATH;
+  ASSERT_EQ(
+      std::system(
+          ("cd " + dir_.string() + " && " + cli + " planes box.ply -o p --scales 4 -q").c_str()),
+      0);
+  ASSERT_EQ(std::system(("cd / && " + cli + " segment " + path("p") +
+                         " --min-persistence 1 -q -o " + path("from_root.ply"))
+                            .c_str()),
+            0);
   fs::rename(path("box.ply"), path("moved.ply"));
   Result r = run("segment " + path("p") + " --min-persistence 1 -o " + path("x.ply"));
   EXPECT_EQ(r.code, 1);

@@ -155,7 +155,7 @@ TEST_F(StackFixture, OnlyAStackIsEverReplaced) {
   fs::create_directories(mine);
   std::ofstream(mine / "manifest.json") << "{\"format\": \"not ours\"}";
   std::ofstream(mine / "data.bin") << "keep";
-  for (const std::string target : {file, mine.string()}) {
+  for (const std::string& target : {file, mine.string()}) {
     EXPECT_FALSE(isScaleStack(target));
     EXPECT_THROW(writeScaleStack(target, cloud, options, stack, float32()), FileError) << target;
     EXPECT_THROW(computeScaleStack(cloud, options, target), FileError) << target;
