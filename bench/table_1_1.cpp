@@ -1,5 +1,5 @@
-// Table 1.1 of the thesis (Sec. 1.4.3) with the NOTES.md reading of its protocol, and the cost of
-// one fit per estimator.
+// Table 1.1 of the thesis (Sec. 1.4.3) with the reading of its protocol in docs/THESIS_NOTES.md
+// (Table 1.1 protocol), and the cost of one fit per estimator.
 //
 //   table_1_1 [--points N] [--speed-only] [--no-speed]
 //

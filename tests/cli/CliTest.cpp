@@ -68,7 +68,7 @@ TEST_F(Cli, CurvatureOfASphereKeepsRowsAndNamesColumns) {
   EXPECT_EQ(tail, expected);
   ASSERT_TRUE(out.hasNormals());
 
-  // Unit sphere with outward normals: H = k1 = k2 = +1 (NOTES.md sign convention).
+  // Unit sphere with outward normals: H = k1 = k2 = +1 (docs/THESIS_NOTES.md, sign convention).
   const auto* h = out.findAttribute("curv_mean");
   const auto* valid = out.findAttribute("fit_valid");
   for (std::size_t i = 0; i < out.size(); i += 101) {

@@ -105,7 +105,7 @@ TEST(OrientedSphereFit, FitsASphereExactly) {
   ASSERT_TRUE(r.valid);
   EXPECT_NEAR(r.sphere.radius(), 1, 1e-10);
   EXPECT_NEAR((r.sphere.center() - (Vec3(0, 0, -1) - Vec3(0.01, 0.02, 0.03))).norm(), 0, 1e-10);
-  EXPECT_NEAR(r.sphere.kappa(), 1, 1e-10);  // positive with outward normals (NOTES.md)
+  EXPECT_NEAR(r.sphere.kappa(), 1, 1e-10);  // positive with outward normals (docs/THESIS_NOTES.md)
   EXPECT_GT(r.sphere.uq, 0);
   // Projection (Eq. 1.10) lands on the sphere.
   const Vec3 proj = r.sphere.project(Vec3::Zero()) + Vec3(0.01, 0.02, 0.03);

@@ -3,7 +3,7 @@
 // of Table 1.1 (bench/table_1_1.cpp) and of `scalespace generate`.
 //
 // Every shape is placed so that the origin lies on it with outward normal +z and principal
-// directions along x and y (the NOTES.md reading of the Sec. 1.4.3 protocol):
+// directions along x and y (the docs/THESIS_NOTES.md reading of the Sec. 1.4.3 protocol):
 //   sphere     radius 1, centre (0, 0, -1)                       kappa = (1, 1) everywhere
 //   cylinder   radius 1, axis y through (0, 0, -1)               kappa = (1, 0)
 //   saddle     z = -(2 x^2 - y^2) / 2 (normal up)                kappa = (2, -1) at the origin
@@ -12,7 +12,7 @@
 //   ellipsoid  semi-axes (1.5, 1, 0.75), centre (0, 0, -0.75)    kappa = (0.75, 1/3) at the origin
 // Each is the zero set of an implicit F that grows outwards; normals, curvatures and directions
 // at any point come from the shape operator P^T hess F P / |grad F| (Eq. 1.28), with the
-// convention of NOTES.md: outward normals, a sphere of radius r has H = kappa = +1/r.
+// convention of docs/THESIS_NOTES.md: outward normals, a sphere of radius r has H = kappa = +1/r.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -53,8 +53,9 @@ std::vector<SurfacePoint> sampleInBall(SurfaceShape shape, const Vec3& centre, d
 
 /// Adds isotropic Gaussian noise of standard deviation sigma to every coordinate (Sec. 1.4.3).
 void addPositionNoise(std::vector<Vec3>& positions, double sigma, std::uint64_t seed);
-/// Table 1.1 normal noise (NOTES.md reading): rotates each normal about the fixed unit `axis` by
-/// the angle |N(0, sigmaDegrees)| (a Gaussian truncated to positive angles).
+/// Table 1.1 normal noise (docs/THESIS_NOTES.md, Table 1.1 protocol): rotates each normal about
+/// the fixed unit `axis` by the angle |N(0, sigmaDegrees)| (a Gaussian truncated to positive
+/// angles).
 void addNormalRotationNoise(std::vector<Vec3>& normals, double sigmaDegrees, const Vec3& axis,
                             std::uint64_t seed);
 

@@ -105,8 +105,8 @@ struct KnnCollector {
       if (!less(n, out->back())) return false;
       out->pop_back();
     }
-    // Insertion from the back. Measured against a max-heap (std::push_heap/pop_heap, sorted at
-    // the end) on 1M points: the heap was 2-3x slower for k = 40 and ~1.5x for k = 10.
+    // Insertion from the back: cheaper than a max-heap (std::push_heap/pop_heap, sorted at the
+    // end) for the small k of the fits (kNN rows of bench/bench_spatial_index.cpp).
     out->push_back(n);
     std::size_t i = out->size() - 1;
     while (i > 0 && less(n, (*out)[i - 1])) {
@@ -174,7 +174,7 @@ std::vector<Index> firstOfDuplicates(const std::vector<Vec3>& points) {
 
 // Exact duplicates (scans repeat points: overlapping strips, zero returns, pasted tiles) become
 // one slot whose members are listed in `members`: a kd-tree over N copies of a point has no split
-// that separates them, so every query would visit all N (10k identical points took seconds).
+// that separates them, so every query would visit all N.
 struct KdTreeIndex::Tree {
   std::vector<Vec3> slots;      // distinct finite points, in the tree's leaf order after the build
   std::vector<Index> original;  // slot -> index in the caller's vector (no duplicates)

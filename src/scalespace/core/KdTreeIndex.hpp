@@ -12,9 +12,8 @@
 namespace scalespace {
 
 struct KdTreeOptions {
-  /// Maximum points per leaf. On 1M points (bench/bench_spatial_index.cpp, 2 shared cores)
-  /// leaf sizes 10 to 32 were within run-to-run noise of each other for radius-40, 10-NN and
-  /// 40-NN queries; 4 and 64 were slower. Larger leaves build faster.
+  /// Maximum points per leaf: in the middle of the range of leaf sizes whose queries are fastest
+  /// (leaf-size rows of bench/bench_spatial_index.cpp). Larger leaves build faster.
   std::size_t leafSize = 16;
 };
 

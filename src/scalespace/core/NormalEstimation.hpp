@@ -32,8 +32,8 @@ struct NormalEstimationResult {
 };
 
 /// Estimates one normal per point of `points` using `index` (built on the same points).
-/// Reorder the points with spatialOrder() first: on 1M points in random order this is about 2 to
-/// 3 times faster (bench/bench_spatial_index.cpp).
+/// Reorder the points with spatialOrder() first: on points in random order this is much faster
+/// (bench/bench_spatial_index.cpp measures both orders).
 /// Parallel and deterministic (each point is computed independently). Throws OptionError for
 /// k < 3 (radius == 0) or a negative/non-finite radius, Cancelled if `progress` returns false.
 NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const SpatialIndex& index,

@@ -1,8 +1,9 @@
 #pragma once
 // The algebraic sphere f_u(y) = u_c + u_l . y + u_q |y|^2 (Eq. 1.3), with y measured from the
-// sphere's frame origin (the evaluation point x of the fit, NOTES.md). Sign convention: fitted to
-// outward normals, grad f points outwards, u_q = 1/(2r) > 0 on a sphere of radius r, and the
-// curvature 2 u_q / sqrt(Delta) (Eq. 1.32) is +1/r.
+// sphere's frame origin: the evaluation point x of the fit (docs/THESIS_NOTES.md, frame centred at
+// the evaluation point). Sign convention (same file): fitted to outward normals, grad f points
+// outwards, u_q = 1/(2r) > 0 on a sphere of radius r, and the curvature 2 u_q / sqrt(Delta)
+// (Eq. 1.32) is +1/r.
 #include <cmath>
 
 #include "scalespace/core/Types.hpp"
@@ -19,7 +20,7 @@ struct AlgebraicSphere {
   Vec3 gradient(const Vec3& y) const { return ul + 2 * uq * y; }
   /// Discriminant / Pratt norm Delta = |u_l|^2 - 4 u_q u_c (Eq. 1.11).
   double discriminant() const { return ul.squaredNorm() - 4 * uq * uc; }
-  /// A surface exists only for Delta > 0 with finite parameters (NOTES.md, Eq. 1.11).
+  /// A surface exists only for Delta > 0 with finite parameters (Eq. 1.11; docs/THESIS_NOTES.md).
   bool isValid() const {
     const double d = discriminant();
     return std::isfinite(uc) && std::isfinite(uq) && ul.allFinite() && std::isfinite(d) && d > 0;

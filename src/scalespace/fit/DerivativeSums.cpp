@@ -56,8 +56,8 @@ int addColumnsOneByOne(const NeighborColumns& c, const double* e, const Vec3& x,
 }
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-// 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by.
-// Measured with bench/fig_1_10 (100k points x 50 scales, 1 thread): projection 8.7 s -> 7.1 s.
+// 9 accumulators hold a 9 x 4 block of the sums in registers while the samples stream by, so the
+// sums are not loaded and stored for every sample (bench/fig_1_10 --mode timing --threads 1).
 SCALESPACE_TARGET_AVX2 void accumulateAvx2(const DerivativeChunk& c, int m, DerivativeSums& sums) {
   for (int jb = 0; jb < 12; jb += 4) {
     __m256d acc[9];
@@ -190,10 +190,9 @@ SCALESPACE_TARGET_AVX512 inline int formSamples8(__m512d qx, __m512d qy, __m512d
   return __builtin_popcount(live);
 }
 
-/// addDerivativeColumns with eight samples formed at a time, read straight from the columns.
-/// Measured (forming eight packed samples at a time, before the columns): the robust 200k Stairs
-/// stack with one thread took 22.8-23.1 s against 23.8-24.0 s forming one sample at a time (runs
-/// interleaved); forming was ~2/3 of the pass in perf, the accumulation the rest.
+/// addDerivativeColumns with eight samples formed at a time, read straight from the columns:
+/// forming the samples, more than accumulating them, is what this pass spends its time on, and
+/// eight at a time beats one at a time (robust stack: bench/bench_planes --scene stairs).
 SCALESPACE_TARGET_AVX512 int addColumnsAvx512(const NeighborColumns& c, const double* e,
                                               const Vec3& x, const WeightKernel& kernel,
                                               DerivativeSums& sums) {

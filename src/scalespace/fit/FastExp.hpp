@@ -1,9 +1,9 @@
 #pragma once
 // exp(-x) for x >= 0, for the robust re-weighting factors (fit/LocalFit.cpp): they are evaluated
-// for every neighbour at every re-weighting pass, and libm's exp took a quarter of the multi-scale
-// projection's time. Relative error below 1e-8 (tested against std::exp), which is far below what
-// a weight needs; deterministic (no table, no rounding-mode dependence), so results stay
-// identical for any thread count.
+// for every neighbour at every re-weighting pass, and libm's exp was a large share of the robust
+// multi-scale projection's time (bench/fig_1_10 --mode timing --robust 1). Relative error below
+// 1e-8 (tested against std::exp), which is far below what a weight needs; deterministic (no
+// table, no rounding-mode dependence), so results stay identical for any thread count.
 #include <cmath>
 #include <cstdint>
 #include <cstring>

@@ -49,7 +49,7 @@ struct FitOptions {
   /// saves a pass over the neighbours; when it does not, the derivatives are wasted. Drivers set
   /// it for points that converged at once in a similar fit (scales/: the previous scale).
   bool expectFirstStepConverged = false;
-  /// Fits with fewer neighbours are invalid (NOTES.md: < 6).
+  /// Fits with fewer neighbours are invalid (docs/THESIS_NOTES.md, minimum of 6 neighbours).
   int minNeighbors = 6;
 };
 

@@ -60,8 +60,8 @@ std::size_t gatherPortable(const SampleColumns& s, const Vec3& y, double t, Outp
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
 /// Eight candidates at a time: the kept lanes are packed to the front (vcompresspd) and stored
 /// at the output's end. (Compressing in registers and storing whole vectors was slower here.)
-/// Gathering and filling the columns one candidate at a time (scalar code) was ~45% of fitAt's own
-/// time in a robust stack's profile.
+/// Gathering and filling the columns one candidate at a time (scalar code) was a large part of
+/// fitAt's own time in a robust stack's profile.
 SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const Vec3& y, double t,
                                                   Outputs o) {
   const WeightKernel kernel(t);

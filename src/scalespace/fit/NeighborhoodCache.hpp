@@ -52,9 +52,9 @@ class NeighborhoodCache {
 
 /// How far apart the evaluation points of one prefetched block may be: the half-diagonal of
 /// their bounding box is at most kBlockSpread t. Larger spreads make fewer index queries but
-/// longer candidate lists to scan (on a surface the list grows like (1 + spread + slack)^2). On
-/// 100k points x 50 scales (bench/fig_1_10, 1 thread) spreads 0.12 / 0.25 / 0.5 / 1.0 took
-/// 9.5 / 9.1 / 8.9 / 9.05 s of projection against 10.0-10.9 s without the cache.
+/// longer candidate lists to scan (on a surface the list grows like (1 + spread + slack)^2).
+/// 0.5 balances the two: the projection time is flat around it (bench/fig_1_10 --mode timing
+/// --threads 1).
 constexpr double kBlockSpread = 0.5;
 
 /// Evaluation points are walked in fixed groups of kPrefetchGroup consecutive (Morton-ordered)

@@ -111,7 +111,7 @@ SphereJets jetsOf(const SphereTerms<S>& u) {
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
 // The same solve with each Jet2 in two registers: (v, g) in four lanes and the six Hessian
 // entries (Jet2's order) in eight, the last two zero. A product is a dozen vector instructions
-// instead of ~50 scalar ones: the scalar solve was ~9% of a robust stack's profile, spread over
+// instead of ~50 scalar ones: the scalar solve showed in a robust stack's profile, spread over
 // ~1800 instructions of finish().
 struct Jet2x {
   __m256d vg;  // v, g_x, g_y, g_z

@@ -1,11 +1,12 @@
 #pragma once
 // Closed-form fit of an algebraic sphere to oriented samples (Eq. 1.7-1.9, Guennebaud 2008),
-// evaluated in a frame centred at the evaluation point x (q = p - x, NOTES.md). One pass over the
-// neighbours accumulates the weighted sums of 1, q, n, q.n, |q|^2 and, on request, their first and
-// second derivatives with respect to x (through the weights only: the frame stays fixed at x) and
-// with respect to t. The quotient/product rules (Jet.hpp) then give the derivatives of u_c, u_l,
-// u_q, hence the complete gradient (Eq. 1.33) and Hessians of Eq. 1.34 (W2) and 1.36 (W3) of the
-// scalar field f(y) = u_c(y) + u_l(y).(y - x) + u_q(y) |y - x|^2 at y = x.
+// evaluated in a frame centred at the evaluation point x (q = p - x; docs/THESIS_NOTES.md, frame
+// centred at the evaluation point). One pass over the neighbours accumulates the weighted sums of
+// 1, q, n, q.n, |q|^2 and, on request, their first and second derivatives with respect to x
+// (through the weights only: the frame stays fixed at x) and with respect to t. The
+// quotient/product rules (Jet.hpp) then give the derivatives of u_c, u_l, u_q, hence the complete
+// gradient (Eq. 1.33) and Hessians of Eq. 1.34 (W2) and 1.36 (W3) of the scalar field
+// f(y) = u_c(y) + u_l(y).(y - x) + u_q(y) |y - x|^2 at y = x.
 #include <Eigen/Core>
 #include <cstddef>
 

@@ -3,7 +3,8 @@
 // weights of Eq. 1.6): "Plane" (weighted PCA plane) and "Mean" (weighted barycentre + averaged
 // normals, MeanFit.hpp). Both estimate H = 8 d / t^2 from the signed distance d of x to the fitted
 // plane (Sec. 1.4.3: the normal displacement is H t^2 / 8 + o(t^2) under this kernel), with the
-// sign chosen so that a sphere with outward normals has H > 0 (NOTES.md).
+// sign chosen so that a sphere with outward normals has H > 0 (docs/THESIS_NOTES.md, sign
+// convention).
 // They have no principal curvatures: the fits report kMax = kMin = H (umbilic, like W1) and an
 // arbitrary orthonormal tangent pair (tangentBasis of the normal) as directions.
 #include <vector>

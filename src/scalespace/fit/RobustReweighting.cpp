@@ -95,7 +95,7 @@ SCALESPACE_TARGET_AVX2 double reweightAvx2(const AlgebraicSphere& s, double invS
   __m256i used = _mm256_setzero_si256();
   const std::size_t n = c.size();
   // The last group of 1-3 neighbours runs masked: lanes past n load zeros, get the factor 0 (so
-  // a zero weight, counted nowhere) and store nothing. A scalar tail cost a quarter of the pass.
+  // a zero weight, counted nowhere) and store nothing. A scalar tail was a large share of the pass.
   const __m256i lanes = _mm256_set_epi64x(3, 2, 1, 0);
   for (std::size_t k = 0; k < n; k += 4) {
     const __m256i mask = _mm256_cmpgt_epi64(_mm256_set1_epi64x(std::int64_t(n - k)), lanes);
@@ -247,10 +247,9 @@ SCALESPACE_TARGET_AVX512 inline __m512d factors8(const Spheres8& s, __m512d twoU
   return expNegative8(_mm512_fmadd_pd(_mm512_mul_pd(r, r), sr, _mm512_mul_pd(dn, sn)));
 }
 
-/// The AVX2 pass on eight lanes. Measured on this machine's Zen 5 (30 neighbours): 86 ns per pass
-/// against 190 ns for the AVX2 one, whose body (~120 instructions for 4 neighbours, accumulators
-/// spilled: 16 registers) is latency-bound; here 32 registers hold everything and the last group's
-/// mask is a mask register.
+/// The pass of reweightAvx2 on eight lanes (AVX-512), much faster than reweightAvx2, whose body
+/// (~120 instructions for 4 neighbours, accumulators spilled: 16 registers) is latency-bound;
+/// here 32 registers hold everything and the last group's mask is a mask register.
 /// kSums: accumulate the next fit's sums; kTrack: count the samples of positive weight and
 /// measure the largest change (ReweightOutput; each is a few instructions of ~70 per group).
 template <bool kSums, bool kTrack>
@@ -546,7 +545,7 @@ SCALESPACE_TARGET_AVX512 inline void transpose8(const __m512d* rows, __m512d* ou
 
 /// assign() eight neighbours at a time: each fit's next eight entries (zeros past its count) as
 /// the rows of a block, transposed into eight interleaved entries. The scalar strided copy and
-/// the zeroing took 6.5% of a robust stack's profile.
+/// the zeroing showed in a robust stack's profile.
 SCALESPACE_TARGET_AVX512 void interleaveAvx512(const NeighborColumns* const* fits, int count,
                                                std::size_t length, Column* const* out) {
   const std::size_t kLanes = InterleavedColumns::kLanes;

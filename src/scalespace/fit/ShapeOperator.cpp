@@ -26,11 +26,11 @@ PrincipalCurvatures shapeOperatorCurvatures(const Vec3& gradient, const Mat3& he
   P.col(1) = v;
   Eigen::Matrix2d W = P.transpose() * hessian * P / gn;  // Eq. 1.28
   // Closed-form eigen-decomposition of the symmetric 2 x 2 [[a, b], [b, d]] instead of Eigen's
-  // iterative solver (this function's share of a stack's profile went from 6.8% to 3.8%):
+  // iterative solver, which was a large part of this function's cost:
   // lambda = (a + d) / 2 +- hypot((a - d) / 2, b).
   const double a = W(0, 0), d = W(1, 1), b = 0.5 * (W(0, 1) + W(1, 0));
   const double half = 0.5 * (a - d);
-  // sqrt, not std::hypot (1.3% of the stack's time): curvatures squared are far from overflow.
+  // sqrt, not std::hypot (slower, as it avoids overflow): curvatures squared are far from it.
   const double radius = std::sqrt(half * half + b * b);
   pc.kMax = 0.5 * (a + d) + radius;
   pc.kMin = 0.5 * (a + d) - radius;

@@ -1,8 +1,9 @@
 #pragma once
 // Shape operator of an implicit surface (Eq. 1.28): W = P^T (hess f / |grad f|) P with P an
 // orthonormal tangent basis of grad f. Its eigenvalues are the principal curvatures; with grad f
-// pointing outwards a sphere of radius r gets kappa = +1/r (NOTES.md, Eq. 1.32 convention).
-// W1 (Eq. 1.31), W2 (Eq. 1.35) and W3 (Eq. 1.38) differ only in the gradient and Hessian passed.
+// pointing outwards a sphere of radius r gets kappa = +1/r (Eq. 1.32; docs/THESIS_NOTES.md, sign
+// convention). W1 (Eq. 1.31), W2 (Eq. 1.35) and W3 (Eq. 1.38) differ only in the gradient and
+// Hessian passed.
 #include "scalespace/core/Types.hpp"
 
 namespace scalespace {

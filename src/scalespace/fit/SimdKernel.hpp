@@ -1,9 +1,9 @@
 #pragma once
 // Which implementation of a hot loop runs. The project builds for baseline x86-64 (SSE2: 2-wide,
-// no FMA; -march=native for the whole build was measured no faster overall), so the few loops
-// that gain from wider instructions (fit/DerivativeSums, fit/RobustReweighting) have an AVX2 + FMA
-// version (and the re-weighting an AVX-512 one) compiled on its own (__attribute__((target))) and
-// chosen at run time, next to a portable one that tests can ask for on any CPU. A machine always
+// no FMA; -march=native for the whole build gave no overall gain), so the few loops that gain
+// from wider instructions (fit/DerivativeSums, fit/RobustReweighting) have an AVX2 + FMA version
+// (and the re-weighting an AVX-512 one) compiled on its own (__attribute__((target))) and chosen
+// at run time, next to a portable one that tests can ask for on any CPU. A machine always
 // takes the same path, so results do not depend on the thread count; the two paths differ in the
 // last bits (FMA rounds once).
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))

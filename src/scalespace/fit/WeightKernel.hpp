@@ -1,6 +1,7 @@
 #pragma once
-// The APSS weight w_t(q) = K(|q|/t) with K(x) = (x^2 - 1)^2 for x < 1, else 0 (Eq. 1.6, NOTES.md).
-// Written as a polynomial in r = |q|^2/t^2 so no square root is needed: w = (r - 1)^2.
+// The APSS weight w_t(q) = K(|q|/t) with K(x) = (x^2 - 1)^2 for x < 1, else 0 (Eq. 1.6;
+// docs/THESIS_NOTES.md, weight kernel). Written as a polynomial in r = |q|^2/t^2 so no square root
+// is needed: w = (r - 1)^2.
 // Spatial derivatives are taken with respect to q (the sample relative to the evaluation point);
 // with q = p - x, derivatives with respect to x flip the sign of the gradient (dq/dx = -I).
 #include "scalespace/core/Types.hpp"

@@ -34,8 +34,8 @@ std::vector<Kernel::Point_2> toCgal(const std::vector<Vec2>& points) {
 // interior when its squared circumradius is <= alpha (what CGAL::Alpha_shape_2 classifies as
 // INTERIOR in REGULARIZED mode; tests/planes compare both), and the outline is made of the edges
 // between an interior triangle and a non-interior (or infinite) one. Alpha_shape_2 itself also
-// builds the whole alpha spectrum: with it, the components of a 1M-point Stairs scene took 25 s,
-// now 2 s.
+// builds the whole alpha spectrum, which costs far more than the one alpha needed here (the
+// components time of bench/bench_planes).
 /// Marks the interior faces (squared circumradius <= alpha) in their info and returns their area.
 double markInterior(Delaunay& dt, double alpha) {
   const auto squaredRadius = Kernel().compute_squared_radius_2_object();
@@ -187,8 +187,8 @@ constexpr std::size_t kSubsetPoints = 4096;
 /// The first "yes" test's patch: the points within kPatchRadius sqrt(alpha) of the middle (a disk
 /// of area pi alpha), thinned to one per cell of side sqrt(alpha) / kPatchCells, give a lower
 /// bound (alphaShapeAreaLowerBound holds for any subset). Regions hold every input point, so at
-/// coarse scales the certified patch below held tens of thousands of them: on the robust 200k
-/// Stairs stack its triangulations took 0.48 s, and the thinned patch keeps ~200 points.
+/// coarse scales the certified patch below held tens of thousands of them, costly to
+/// triangulate; the thinned patch keeps ~200 points.
 constexpr double kPatchRadius = 1.0;
 constexpr double kPatchCells = 8;
 
@@ -231,7 +231,7 @@ bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double
   if (std::abs(hullArea) * (1 + 1e-9) < minArea) return false;
   // "Yes" from a subset: coarse-scale regions lie within a few radii of their middle, so the
   // patch is the whole set; one point per cell of radius / 32 keeps a few thousand of them.
-  // On the robust 200k Stairs stack, the whole-shape triangulations took 1.9 s of 2.7 s.
+  // Triangulating whole shapes was most of the filter's time (filtering in bench/bench_planes).
   const double cell = std::sqrt(alpha) / 32;
   const double cells = box.volume() / (cell * cell);  // at most this many subset points
   if (points.size() >= kSubsetPoints && 4 * cells < double(points.size()) &&

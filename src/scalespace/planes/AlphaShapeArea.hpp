@@ -17,7 +17,8 @@ struct AlphaShape {
 };
 
 /// Regularized alpha shape (CGAL::Alpha_shape_2, REGULARIZED mode). `alpha` is CGAL's alpha, a
-/// SQUARED radius (NOTES.md: radius 2t -> alpha = (2t)^2). Fewer than 3 points: area 0.
+/// SQUARED radius (docs/THESIS_NOTES.md: radius 2t -> alpha = (2t)^2). Fewer than 3 points:
+/// area 0.
 AlphaShape alphaShape2(const std::vector<Vec2>& points, double alpha, bool withOutlines = false);
 
 /// alphaShape2(points, alpha).area >= minArea, decided without triangulating every point when

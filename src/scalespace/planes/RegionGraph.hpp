@@ -21,7 +21,7 @@ struct GraphComponent {
   double birthScale = 0.0;
   double deathScale = 0.0;
   std::vector<int> regionAt;  // region index at level birthLevel + k
-  /// pers(C) = l_d - l_b in levels (Sec. 2.3.3; NOTES.md: the one definition we keep).
+  /// pers(C) = l_d - l_b in levels (Sec. 2.3.3; docs/THESIS_NOTES.md: the one definition we keep).
   int persistence() const { return deathLevel - birthLevel; }
 };
 

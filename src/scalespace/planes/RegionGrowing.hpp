@@ -35,10 +35,10 @@ struct FilteredRegion {
   std::vector<Index> points;  // increasing
 };
 
-/// Keeps the regions with sqrt(alpha-shape area) >= alphaFactor * t (NOTES.md reading of
-/// "a < 2t"), in their input order. Regions run in parallel; a large region is usually accepted
-/// from the alpha shape of a patch around its middle (alphaShapeAreaAtLeast), so the area itself
-/// is not computed (the components compute theirs at their representative level).
+/// Keeps the regions with sqrt(alpha-shape area) >= alphaFactor * t (the docs/THESIS_NOTES.md
+/// reading of "a < 2t"), in their input order. Regions run in parallel; a large region is usually
+/// accepted from the alpha shape of a patch around its middle (alphaShapeAreaAtLeast), so the area
+/// itself is not computed (the components compute theirs at their representative level).
 std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
                                           const Segmentation& segmentation, double t,
                                           const RegionFilterOptions& options = {},

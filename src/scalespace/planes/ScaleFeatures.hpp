@@ -28,8 +28,8 @@ struct KnnGraph {
   /// vertex v is point order[v], point i is vertex rank[i], and the neighbours of vertex v are
   /// the vertices localNeighbors[offsets[v] .. offsets[v+1]) (every point has the same number of
   /// neighbours, so the offsets are shared). Region growing walks this one: in input order the
-  /// neighbours of a point lie anywhere in memory and the walk waited on cache misses (perf, 200k
-  /// points); on 1M Stairs points segmentation went from 17.2 s to 11.8 s.
+  /// neighbours of a point lie anywhere in memory and the walk waits on cache misses
+  /// (segmentation time of bench/bench_planes).
   std::vector<Index> order, rank, localNeighbors;
   /// Per point, the distance to its k-th nearest other point (knnRadii of scales/ScaleSeries with
   /// K = k, from the same queries): its median is the automatic t_min of the stack, which then

@@ -40,8 +40,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   out.knnSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Scale j is segmented and filtered in a task while the stack projects scale j+1: region
   // growing is sequential and the filter's time goes to a few large regions, so done in the sink
-  // they kept one core idle (1M Stairs: ~15 s of ~80). Each task owns its copy of the features
-  // and its slot (deque: stable references), so the levels do not depend on the scheduling.
+  // they kept the other cores idle. Each task owns its copy of the features and its slot
+  // (deque: stable references), so the levels do not depend on the scheduling.
   struct Slot {
     RegionLevel level;
     PlaneDetectionTimings timings;
@@ -51,8 +51,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   std::atomic<int> pending{0};
   // The sink only copies what the features are made of (four float arrays, into a buffer
   // reused from scale to scale): the conversion to ScaleFeatures runs in the task. Made in the
-  // sink, it held up the next scale's projection with the other core idle (~25 ms per scale on
-  // 1M points, most of it first-touch page faults of a fresh 33 MB).
+  // sink, it held up the next scale's projection with the other cores idle (mostly first-touch
+  // page faults of a fresh array at every scale).
   std::mutex poolMutex;
   std::vector<std::unique_ptr<ScaleLayer>> pool;
   const ScaleSink sink = [&](std::size_t, const ScaleLayer& layer, const ScaleStats& stats) {

@@ -38,10 +38,9 @@ std::uint64_t packCell(std::int64_t x, std::int64_t y, std::int64_t z) {
 /// cells. For fixed (dx, dy) the keys of z - 1, z, z + 1 are consecutive, so 9 searches suffice,
 /// and their targets grow with the cell's own key: asked for cells of increasing key (one colour
 /// of a task's range), each search gallops forward from where it ended for the previous cell.
-/// Measured (bench/fig_1_10 --points 1000000 --mode timing): the sampling of the 50 levels took
-/// 2.68 s with 9 binary searches over all cells per cell, 1.69 s with these cursors and
-/// 1.45-1.60 s with the flag scan of increasingIndices too; the first level, about one point per
-/// cell, 0.47 -> 0.32 s.
+/// Cheaper than 9 binary searches over all cells per cell: at the first levels a cell holds about
+/// one point, so there are about as many cells as points (sampling time of bench/fig_1_10
+/// --mode timing).
 class NeighbourCells {
  public:
   explicit NeighbourCells(const std::vector<std::uint64_t>& keys) : keys_(keys) {}

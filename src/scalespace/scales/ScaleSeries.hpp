@@ -11,7 +11,7 @@
 namespace scalespace {
 
 enum class ScaleSpacing {
-  Log,    // geometric series, corrected Eq. 1.40 (NOTES.md): constant ratio t_{j+1}/t_j
+  Log,    // geometric series, Eq. 1.40 corrected (docs/THESIS_NOTES.md): constant ratio t_{j+1}/t_j
   Linear  // arithmetic series, Eq. 1.39: constant difference t_{j+1} - t_j
 };
 

@@ -20,8 +20,9 @@ namespace scalespace {
 namespace {
 
 /// The shortest run of a block that fitAtBatch takes (shorter runs are fitted point by point):
-/// its lanes cost the same whether they are full or not. Summed projection times of a robust
-/// 100k Stairs stack, two runs each: 3.75 / 3.66 / 3.72 s for 4 / 6 / 8 (4.31 s without lanes).
+/// its lanes cost the same whether they are full or not, so a short run wastes most of them. The
+/// value is the best of those compared on a robust stack's time (bench/bench_planes --scene
+/// stairs; the figures are in bench/README.md).
 constexpr std::size_t kMinBatch = 6;
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -78,8 +79,8 @@ void gather(const std::vector<T>& in, const std::vector<Index>& rank, std::size_
 /// The layer in input order from the layer in processing (Morton) order: point i of the cloud is
 /// point rank[i] of the processing order. The fits are recorded in processing order and put in
 /// input order here, one array at a time: storing each fit straight at its input index scatters
-/// ~200 bytes per point over 14 arrays of the whole cloud: the projection of 1M points x 50
-/// scales (bench/fig_1_10) took 40.0 s that way and 31.9 s with this gather.
+/// ~200 bytes per point over 14 arrays of the whole cloud, which is slower than this gather
+/// (projection time of bench/fig_1_10 --mode timing).
 void toInputOrder(const ScaleLayer& spatial, const std::vector<Index>& rank, LayerContents contents,
                   ScaleLayer& layer) {
   const bool all = contents == LayerContents::All;
@@ -230,8 +231,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   std::vector<std::uint32_t> neighborCount(n);
   std::vector<std::uint8_t> mlsSteps(n);
   // Level j + 1 of the pyramid depends on level j only, not on the projection: it is drawn and
-  // indexed in a task while scale j projects (the index build is sequential: on 1M points the
-  // levels took 2.3 s, ~0.8 s of it building indexes with the other core idle).
+  // indexed in a task while scale j projects (the index build is sequential and would leave the
+  // other cores idle; bench/fig_1_10 --mode timing prints both times per scale).
   PyramidLevel thisLevel, nextLevel;
   tbb::task_group prepare;
   auto prepareLevel = [&](std::size_t j, const std::vector<Index>& previous, PyramidLevel& out) {

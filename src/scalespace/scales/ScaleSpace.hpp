@@ -33,21 +33,23 @@ enum class LayerOrder {
 struct ScaleSpaceOptions {
   ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
   double alpha = 0.1;  // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2): samples >= 2 r_j apart
-  /// Robust APSS (RIMLS re-weighting, Sec. 2.3, NOTES.md): what the planes of Chapter 2 use.
-  /// Off by default: Sec. 1.5 builds the representation with the plain APSS, ~3x faster.
+  /// Robust APSS (RIMLS re-weighting, Sec. 2.3; docs/THESIS_NOTES.md, robust APSS parameters):
+  /// what the planes of Chapter 2 use. Off by default: Sec. 1.5 builds the representation with the
+  /// plain APSS, which is much cheaper (bench/fig_1_10 --mode timing --robust 0, then 1).
   bool robust = false;
-  int robustIterations = 5;    // re-weightings per fit (NOTES.md: 5)
+  int robustIterations = 5;    // re-weightings per fit (docs/THESIS_NOTES.md, robust APSS)
   double robustTolerance = 0;  // stop re-weighting once factors change less (FitOptions)
   /// MLS projection steps per scale; each scale starts from the previous scale's projection,
-  /// so few steps are needed (NOTES.md: the authors allow up to 10, stop below 0.01 t).
+  /// so few steps are needed (docs/THESIS_NOTES.md, robust APSS parameters: the authors allow up
+  /// to 10, stop below 0.01 t).
   int mlsSteps = 10;
   double mlsTolerance = 0.01;  // step < mlsTolerance * t_j stops the projection
-  int minNeighbors = 6;        // fits with fewer samples are invalid (NOTES.md)
+  int minNeighbors = 6;        // fits with fewer samples are invalid (docs/THESIS_NOTES.md)
   EstimatorKind estimator = EstimatorKind::W3;
   std::uint64_t seed = 1;  // Poisson-disk visiting order
   int threads = 0;         // 0: all cores
   /// NormalAndCurvatures is what plane detection reads: putting only those arrays in input order
-  /// saves ~1 s per 50 scales of 1M points (2 cores).
+  /// saves reordering the others.
   LayerContents layerContents = LayerContents::All;
   LayerOrder layerOrder = LayerOrder::Input;
 };

@@ -195,8 +195,7 @@ struct CompactCodecs {
 // the layer's order) into buf in input order. A layer in processing order (L.inputIndex) is read
 // in its own order and each point's codes are stored at its input index: reordering the ~19
 // encoded bytes of a point costs less than putting its ~80 bytes of floats in input order first
-// (perf on bench/fig_1_10 --points 1000000 --mode timing: the float gather took 4.8% of the
-// samples; scattering the codes raised this function's own share from 0.5% to 2.1%).
+// (compare both in a profile of bench/fig_1_10 --mode timing).
 void encodeCompact(const ScaleLayer& L, double t, const std::vector<double>& rel,
                    const CompactCodecs& codecs, std::vector<std::vector<unsigned char>>& buf,
                    std::vector<std::size_t>& clamped, std::vector<std::uint8_t>& validScratch) {
@@ -609,7 +608,7 @@ void ScaleStackWriter::writeScale(std::size_t j, const ScaleLayer& layer, double
     writeAll(d.fds[k], p, bytes, (d.tmpPath / q.name).string() + ".npy");
     d.sums[k].add(p, bytes);
     // Start writing this scale to disk now (asynchronous): the fsync of finish() then waits for
-    // the last scale only, instead of flushing the whole stack (~10 s for 1.2 GB) at the end.
+    // the last scale only, instead of flushing the whole stack at the end.
     ::sync_file_range(d.fds[k], 0, 0, SYNC_FILE_RANGE_WRITE);
     ++k;
   }
