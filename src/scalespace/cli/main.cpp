@@ -29,6 +29,18 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"deathTolerance", "--death-tolerance"},
     {"SimilarityOptions::maxAreaDifference", "--area-tolerance"},
     {"SimilarityOptions::maxAngleDegrees", "--angle"},
+    {"ScaleSeriesOptions::spacing", "--spacing"},
+    {"ScaleSeriesOptions::tMin", "--tmin"},
+    {"ScaleSeriesOptions::tMax", "--tmax"},
+    {"ScaleSpaceOptions::mlsSteps", "--mls-steps"},
+    {"ScaleSpaceOptions::alpha", "--alpha"},
+    {"StackWriteOptions::encoding", "--encoding"},
+    {"RenderOptions::up", "--up"},
+    {"RenderOptions::view", "--view"},
+    {"RenderOptions::width and height", "--size width and height"},
+    {"SceneOptions::noise", "--noise"},
+    {"the thread count (threads option)", "--threads"},
+    {"findSimilar: no component", "--similar: no component"},
 };
 
 std::string withFlags(std::string message) {

@@ -68,7 +68,7 @@ std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence
 
 int nearestLevel(const PlaneModel& model, double t) {
   if (model.scales.empty()) throw OptionError("the plane model has no scales");
-  if (!(t > 0)) throw OptionError("--scale must be > 0");
+  if (!(t > 0)) throw OptionError("labelsAtScale: the scale t must be > 0");
   int best = 0;
   for (int j = 1; j < model.scaleCount(); ++j)
     if (std::abs(std::log(model.scales[std::size_t(j)] / t)) <
@@ -121,7 +121,7 @@ std::vector<int> findSimilar(const PlaneModel& model, int query, const std::vect
                              const SimilarityOptions& options) {
   validate(options);
   if (query < 0 || query >= int(model.components.size()))
-    throw OptionError("--similar " + std::to_string(query) + ": no such component (0.." +
+    throw OptionError("findSimilar: no component " + std::to_string(query) + " (0.." +
                       std::to_string(int(model.components.size()) - 1) + ")");
   checkIndices(model, domain, "similarity domain");
   const PlaneComponent& q = model.components[std::size_t(query)];

@@ -15,7 +15,7 @@ UpFrame upFrame(const std::string& up) {
   const bool negated = !up.empty() && up[0] == '-';
   const std::string axis = negated ? up.substr(1) : up;
   if (axis.size() != 1 || axis[0] < 'x' || axis[0] > 'z')
-    throw OptionError("--up '" + up + "' is not x, y, z, -x, -y or -z");
+    throw OptionError("RenderOptions::up '" + up + "' is not x, y, z, -x, -y or -z");
   // Cyclic order: up e_i, side e_(i+1), ahead +-e_(i+2), so side x ahead = up.
   const int i = axis[0] - 'x';
   const double sign = negated ? -1.0 : 1.0;
@@ -37,7 +37,7 @@ Vec3 viewDirection(const std::string& view, const std::string& up) {
   if (in >> d.x() >> c1 >> d.y() >> c2 >> d.z() && c1 == ',' && c2 == ',' &&
       (in >> std::ws).eof() && d.allFinite() && d.norm() > 0)
     return d.normalized();
-  throw OptionError("--view '" + view +
+  throw OptionError("RenderOptions::view '" + view +
                     "' is not front, top, iso or a direction X,Y,Z (e.g. 1,0,-1)");
 }
 
@@ -98,7 +98,7 @@ std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& optio
 
 Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
   if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
-    throw OptionError("--size must be between 1x1 and 16384x16384");
+    throw OptionError("RenderOptions::width and height must be between 1 and 16384");
   if (options.margin < 0 || options.margin >= 0.5)
     throw OptionError("render margin must be in [0, 0.5)");
   const Vec3 forward = viewDirection(options.view, options.up);

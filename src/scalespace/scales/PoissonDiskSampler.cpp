@@ -267,7 +267,7 @@ SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
                                  const std::vector<double>& scales, double alpha,
                                  std::uint64_t seed, const ProgressCallback& progress) {
   if (!(alpha >= 0) || !std::isfinite(alpha))
-    throw OptionError("--alpha must be >= 0 (Poisson-disk radius / scale), got " +
+    throw OptionError("ScaleSpaceOptions::alpha (Poisson-disk radius / scale) must be finite and >= 0, got " +
                       std::to_string(alpha));
   SamplePyramid pyramid;
   std::vector<Index> previous(positions.size());

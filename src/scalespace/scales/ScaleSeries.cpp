@@ -19,7 +19,7 @@ const char* scaleSpacingName(ScaleSpacing spacing) {
 ScaleSpacing parseScaleSpacing(const std::string& name) {
   if (name == "log") return ScaleSpacing::Log;
   if (name == "linear") return ScaleSpacing::Linear;
-  throw OptionError("--spacing must be 'log' or 'linear', got '" + name + "'");
+  throw OptionError("ScaleSeriesOptions::spacing must be 'log' or 'linear', got '" + name + "'");
 }
 
 void validateScaleCount(int count) {
@@ -31,11 +31,11 @@ void validateScaleCount(int count) {
 std::vector<double> scaleSeries(double tMin, double tMax, int count, ScaleSpacing spacing) {
   validateScaleCount(count);
   if (!std::isfinite(tMin) || !std::isfinite(tMax) || !(tMin > 0))
-    throw OptionError("--tmin must be finite and > 0 and --tmax finite, got tmin=" +
+    throw OptionError("ScaleSeriesOptions::tMin must be finite and > 0 and ScaleSeriesOptions::tMax finite, got tmin=" +
                       std::to_string(tMin) + " tmax=" + std::to_string(tMax));
   if (count == 1 ? !(tMin <= tMax) : !(tMin < tMax))
-    throw OptionError("--tmin must be < --tmax, got tmin=" + std::to_string(tMin) +
-                      " tmax=" + std::to_string(tMax) + " (lower --tmin or raise --tmax)");
+    throw OptionError("ScaleSeriesOptions::tMin must be < ScaleSeriesOptions::tMax, got tmin=" + std::to_string(tMin) +
+                      " tmax=" + std::to_string(tMax) + " (lower ScaleSeriesOptions::tMin or raise ScaleSeriesOptions::tMax)");
   std::vector<double> t(static_cast<std::size_t>(count));
   if (count == 1) {
     t[0] = tMin;
@@ -58,7 +58,7 @@ std::vector<double> knnRadii(const std::vector<Vec3>& positions, const SpatialIn
   if (positions.size() < std::size_t(K) + 1)
     throw OptionError("the cloud has " + std::to_string(positions.size()) +
                       " points: at least K + 1 = " + std::to_string(K + 1) +
-                      " are needed to compute t_min (give --tmin explicitly)");
+                      " are needed to compute t_min (set ScaleSeriesOptions::tMin explicitly)");
   std::vector<double> radii(positions.size());
   tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
   parallelFor(positions.size(), [&](std::size_t i) {
@@ -84,7 +84,7 @@ double medianKnnRadius(const std::vector<Vec3>& positions, const SpatialIndex& i
 ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
                                   const ScaleSeriesOptions& options, const SpatialIndex* index) {
   if (options.tMin < 0 || options.tMax < 0)
-    throw OptionError("--tmin and --tmax must be >= 0 (0 = automatic)");
+    throw OptionError("ScaleSeriesOptions::tMin and ScaleSeriesOptions::tMax must be >= 0 (0 = automatic)");
   ScaleSeriesResult r;
   r.tMinAuto = options.tMin == 0;
   r.tMaxAuto = options.tMax == 0;
@@ -101,7 +101,7 @@ ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
     r.tMin = medianKnnRadius(positions, *index, options.K);
     if (!(r.tMin > 0))
       throw OptionError("the median distance to the " + std::to_string(options.K) +
-                        "-th neighbour is 0 (duplicate points): give --tmin explicitly");
+                        "-th neighbour is 0 (duplicate points): set ScaleSeriesOptions::tMin explicitly");
   }
   if (r.tMaxAuto) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;

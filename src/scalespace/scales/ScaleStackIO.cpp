@@ -449,7 +449,7 @@ const char* stackEncodingName(StackEncoding encoding) {
 StackEncoding parseStackEncoding(const std::string& name) {
   if (name == "compact") return StackEncoding::Compact;
   if (name == "float32") return StackEncoding::Float32;
-  throw OptionError("--encoding must be compact or float32, not '" + name + "'");
+  throw OptionError("StackWriteOptions::encoding must be compact or float32, not '" + name + "'");
 }
 
 // ---------------------------------------------------------------------------------------- writer
@@ -987,7 +987,7 @@ const StackInfo& ScaleStackReader::info() const { return impl_->info; }
 ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
   Impl& d = *impl_;
   if (j >= scaleCount())
-    throw OptionError("--scale " + std::to_string(j) + " is out of range: the stack has " +
+    throw OptionError("scale " + std::to_string(j) + " is out of range: the stack has " +
                       std::to_string(scaleCount()) + " scales (0.." +
                       std::to_string(scaleCount() - 1) + ")");
   const std::size_t n = pointCount();
@@ -1015,7 +1015,7 @@ ScaleLayer ScaleStackReader::readScale(std::size_t j) const {
 ScaleLayer ScaleStackReader::readPointSeries(std::size_t i) const {
   Impl& d = *impl_;
   if (i >= pointCount())
-    throw OptionError("--point " + std::to_string(i) + " is out of range: the stack has " +
+    throw OptionError("point " + std::to_string(i) + " is out of range: the stack has " +
                       std::to_string(pointCount()) + " points");
   const std::size_t m = scaleCount(), n = pointCount();
   ScaleLayer series;
