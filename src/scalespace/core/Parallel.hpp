@@ -29,7 +29,8 @@ class ThreadLimit {
  public:
   explicit ThreadLimit(int threads) {
     if (threads < 0)
-      throw OptionError("the thread count (threads option) must be >= 0 (0 = all cores), got " + std::to_string(threads));
+      throw OptionError("the thread count (threads option) must be >= 0 (0 = all cores), got " +
+                        std::to_string(threads));
     if (threads > 0)
       control_.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   }

@@ -176,7 +176,8 @@ std::vector<SceneFace> sceneFaces(SceneKind kind, const SceneOptions& options) {
 }
 
 PointCloud generateScene(SceneKind kind, const SceneOptions& options) {
-  if (options.noise < 0) throw OptionError("SceneOptions::noise must be >= 0 (fraction of the diagonal)");
+  if (options.noise < 0)
+    throw OptionError("SceneOptions::noise must be >= 0 (fraction of the diagonal)");
   const std::vector<SceneFace> faces = sceneFaces(kind, options);
 
   // Cumulative triangle areas: drawing u in [0, total) and locating it picks a triangle with

@@ -267,8 +267,9 @@ SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
                                  const std::vector<double>& scales, double alpha,
                                  std::uint64_t seed, const ProgressCallback& progress) {
   if (!(alpha >= 0) || !std::isfinite(alpha))
-    throw OptionError("ScaleSpaceOptions::alpha (Poisson-disk radius / scale) must be finite and >= 0, got " +
-                      std::to_string(alpha));
+    throw OptionError(
+        "ScaleSpaceOptions::alpha (Poisson-disk radius / scale) must be finite and >= 0, got " +
+        std::to_string(alpha));
   SamplePyramid pyramid;
   std::vector<Index> previous(positions.size());
   std::iota(previous.begin(), previous.end(), Index(0));

@@ -31,11 +31,14 @@ void validateScaleCount(int count) {
 std::vector<double> scaleSeries(double tMin, double tMax, int count, ScaleSpacing spacing) {
   validateScaleCount(count);
   if (!std::isfinite(tMin) || !std::isfinite(tMax) || !(tMin > 0))
-    throw OptionError("ScaleSeriesOptions::tMin must be finite and > 0 and ScaleSeriesOptions::tMax finite, got tmin=" +
-                      std::to_string(tMin) + " tmax=" + std::to_string(tMax));
+    throw OptionError(
+        "ScaleSeriesOptions::tMin must be finite and > 0 and ScaleSeriesOptions::tMax finite, got "
+        "tmin=" +
+        std::to_string(tMin) + " tmax=" + std::to_string(tMax));
   if (count == 1 ? !(tMin <= tMax) : !(tMin < tMax))
-    throw OptionError("ScaleSeriesOptions::tMin must be < ScaleSeriesOptions::tMax, got tmin=" + std::to_string(tMin) +
-                      " tmax=" + std::to_string(tMax) + " (lower ScaleSeriesOptions::tMin or raise ScaleSeriesOptions::tMax)");
+    throw OptionError("ScaleSeriesOptions::tMin must be < ScaleSeriesOptions::tMax, got tmin=" +
+                      std::to_string(tMin) + " tmax=" + std::to_string(tMax) +
+                      " (lower ScaleSeriesOptions::tMin or raise ScaleSeriesOptions::tMax)");
   std::vector<double> t(static_cast<std::size_t>(count));
   if (count == 1) {
     t[0] = tMin;
@@ -84,7 +87,8 @@ double medianKnnRadius(const std::vector<Vec3>& positions, const SpatialIndex& i
 ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
                                   const ScaleSeriesOptions& options, const SpatialIndex* index) {
   if (options.tMin < 0 || options.tMax < 0)
-    throw OptionError("ScaleSeriesOptions::tMin and ScaleSeriesOptions::tMax must be >= 0 (0 = automatic)");
+    throw OptionError(
+        "ScaleSeriesOptions::tMin and ScaleSeriesOptions::tMax must be >= 0 (0 = automatic)");
   ScaleSeriesResult r;
   r.tMinAuto = options.tMin == 0;
   r.tMaxAuto = options.tMax == 0;
@@ -100,8 +104,9 @@ ScaleSeriesResult makeScaleSeries(const std::vector<Vec3>& positions,
     }
     r.tMin = medianKnnRadius(positions, *index, options.K);
     if (!(r.tMin > 0))
-      throw OptionError("the median distance to the " + std::to_string(options.K) +
-                        "-th neighbour is 0 (duplicate points): set ScaleSeriesOptions::tMin explicitly");
+      throw OptionError(
+          "the median distance to the " + std::to_string(options.K) +
+          "-th neighbour is 0 (duplicate points): set ScaleSeriesOptions::tMin explicitly");
   }
   if (r.tMaxAuto) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;

@@ -188,7 +188,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
         "the multi-scale projection needs oriented normals: estimate and orient them first "
         "(core/NormalEstimation + NormalOrientation; the CLI does it when they are missing)");
   if (options.mlsSteps < 1)
-    throw OptionError("ScaleSpaceOptions::mlsSteps must be >= 1, got " + std::to_string(options.mlsSteps));
+    throw OptionError("ScaleSpaceOptions::mlsSteps must be >= 1, got " +
+                      std::to_string(options.mlsSteps));
   if (!(options.mlsTolerance > 0)) throw OptionError("MLS tolerance must be > 0 (fraction of t)");
   ThreadLimit limit(options.threads);
 
@@ -205,7 +206,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   const std::vector<double>& scales = summary.series.scales;
   const std::size_t m = scales.size();
   if (!(options.alpha >= 0) || !std::isfinite(options.alpha))
-    throw OptionError("ScaleSpaceOptions::alpha must be finite and >= 0, got " + std::to_string(options.alpha));
+    throw OptionError("ScaleSpaceOptions::alpha must be finite and >= 0, got " +
+                      std::to_string(options.alpha));
 
   FitOptions fit;
   fit.estimator = options.estimator;
