@@ -220,6 +220,11 @@ TEST_F(Cli, MostlyInvalidFitsAreReportedWithTheirCause) {
   r = run("curvature " + path("nan.ply") + " -o " + path("n.ply") + " --scale 0.3 -q");
   EXPECT_NE(r.err.find("1000 input normals are NaN/Inf"), std::string::npos) << r.err;
   EXPECT_NE(readText(path("n.json")).find("1000 input normals are NaN/Inf"), std::string::npos);
+  for (const std::string cmd : {"scales", "planes"}) {
+    r = run(cmd + " " + path("nan.ply") + " -o " + path(cmd + "_out") + " --scales 3 -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("1000 input normals are NaN/Inf"), std::string::npos) << cmd << r.err;
+  }
   r = run("curvature " + path("s.xyz") + " -o " + path("big.ply") + " --scale 1e7 -q");
   EXPECT_NE(r.err.find("times the cloud's diagonal"), std::string::npos) << r.err;
   // A healthy run has no warning.

@@ -317,6 +317,7 @@ void addPlanesCommand(CLI::App& app) {
     StackPlaneDetection result;
     if (args->stack.empty()) {
       result = detectPlanesInCloud(cloud, stack, options, makeProgressBar(args->quiet));
+      printWarnings(invalidFitWarnings(cloud, stackFitCounts(result.stack, cloud.size(), stack)));
     } else {
       const ScaleStackReader reader(args->stack);
       result.detection =

@@ -16,7 +16,6 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
-#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/scales/ScaleStackIO.hpp"
@@ -132,15 +131,7 @@ void addScalesCommand(CLI::App& app) {
     ensureNormals(cloud, args->quiet);
     const ScaleSpaceSummary s =
         computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet), write);
-    FitCounts counts;
-    counts.largestScale = s.series.tMax;
-    for (const ScaleStats& stats : s.stats) {
-      counts.total += cloud.size();
-      counts.invalid += cloud.size() - stats.validPoints;
-      counts.meanNeighbors += stats.meanNeighbors / double(s.stats.size());
-    }
-    counts.minNeighbors = options.minNeighbors;
-    printWarnings(invalidFitWarnings(cloud, counts));
+    printWarnings(invalidFitWarnings(cloud, stackFitCounts(s, cloud.size(), options)));
     if (!args->quiet)
       std::fprintf(stderr, "%s%zu points x %zu scales (t = %.6g .. %.6g) -> %s\n",
                    scaleTable(s.stats, cloud.size()).c_str(), cloud.size(), s.series.scales.size(),

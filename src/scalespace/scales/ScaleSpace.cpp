@@ -336,4 +336,17 @@ ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& o
   return stack;
 }
 
+FitCounts stackFitCounts(const ScaleSpaceSummary& summary, std::size_t points,
+                         const ScaleSpaceOptions& options) {
+  FitCounts counts;
+  counts.largestScale = summary.series.tMax;
+  counts.minNeighbors = options.minNeighbors;
+  for (const ScaleStats& stats : summary.stats) {
+    counts.total += points;
+    counts.invalid += points - stats.validPoints;
+    counts.meanNeighbors += stats.meanNeighbors / double(summary.stats.size());
+  }
+  return counts;
+}
+
 }  // namespace scalespace

@@ -11,6 +11,7 @@
 
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/fit/LocalFit.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
@@ -114,5 +115,10 @@ ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& o
 /// FNV-1a 64-bit over the absolute positions and the normals (as little-endian doubles): identifies
 /// the input a stack was computed from.
 std::uint64_t cloudChecksum(const PointCloud& cloud);
+
+/// The fits of a whole stack (every point at every scale) as fit/FitDiagnosis counts them, for
+/// invalidFitWarnings: a run whose fits are mostly invalid says so.
+FitCounts stackFitCounts(const ScaleSpaceSummary& summary, std::size_t points,
+                         const ScaleSpaceOptions& options);
 
 }  // namespace scalespace
