@@ -218,10 +218,12 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
     throw FileError(jsonPath, "", std::string("invalid JSON: ") + e.what());
   }
   PlaneModel model;
+  std::string where;  // the component being read, for the message
   try {
     model.scales = root.at("scales").get<std::vector<double>>();
     if (input) *input = root.at("input").get<std::string>();
     for (const auto& j : root.at("components")) {
+      where = "component " + std::to_string(model.components.size());
       PlaneComponent c;
       c.id = j.at("id").get<int>();
       c.birthLevel = j.at("birth_level").get<int>();
@@ -239,10 +241,20 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
       c.plane.valid = j.value("plane_valid", true);
       c.area = j.at("area").get<double>();
       if (c.id != int(model.components.size())) throw std::runtime_error("ids must be 0, 1, ...");
+      // The levels index the scales and membership.bin's levels (the queries, `segment`).
+      if (c.birthLevel < 0 || c.birthLevel > c.representativeLevel ||
+          c.representativeLevel > c.deathLevel || c.deathLevel >= model.scaleCount() ||
+          c.persistence != c.deathLevel - c.birthLevel)
+        throw std::runtime_error(
+            "birth_level " + std::to_string(c.birthLevel) + ", representative_level " +
+            std::to_string(c.representativeLevel) + ", death_level " +
+            std::to_string(c.deathLevel) + ", persistence " + std::to_string(c.persistence) +
+            ": expected 0 <= birth <= representative <= death < " +
+            std::to_string(model.scaleCount()) + " (the scales) and persistence = death - birth");
       model.components.push_back(std::move(c));
     }
   } catch (const std::exception& e) {
-    throw FileError(jsonPath, "", std::string("unexpected content: ") + e.what(),
+    throw FileError(jsonPath, where, std::string("unexpected content: ") + e.what(),
                     "run `scalespace planes` again");
   }
   model.membership = readMembership((std::filesystem::path(directory) / "membership.bin").string());
