@@ -85,3 +85,15 @@ TEST(PlaneModelMalformed, LevelsOutsideTheScalesAreRejected) {
                  "components.json");
   expectRejected(componentsJson(withKey("persistence", "5")), kMembership, "components.json");
 }
+
+TEST(PlaneModelMalformed, MembershipCountsThatWrapAreRejected) {
+  // 16 + 4 n levels wraps to 16 for n = 2^62 (then: vector::resize(2^62), std::length_error).
+  const std::string json = componentsJson(kComponent);
+  expectRejected(json, membership(std::uint64_t(1) << 62, 2, {}), "membership.bin: byte 4");
+  expectRejected(json, membership(std::uint64_t(1) << 61, 2, {}), "membership.bin: byte 4");
+  // Points without levels: the queries would allocate a label per point.
+  const std::string none =
+      R"({"input": "in.ply", "point_count": 5, "scales": [], "components": []})";
+  expectRejected(none, membership(std::uint64_t(1) << 60, 0, {}), "membership.bin: byte 4");
+  expectRejected(json, kMembership.substr(0, 18), "membership.bin");  // 2 bytes of ids
+}

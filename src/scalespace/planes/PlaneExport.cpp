@@ -196,10 +196,19 @@ PointMembership readMembership(const std::string& path) {
   PointMembership m;
   m.pointCount = std::size_t(n);
   m.levelCount = int(levels);
-  const auto expected = std::uintmax_t(n) * levels * 4 + 16;
+  // 16 + 4 n levels bytes, checked by division: the product can wrap (n = 2^62 gives 16 bytes),
+  // and without levels there must be no points either (the queries allocate per point).
   std::error_code ec;
-  if (std::filesystem::file_size(path, ec) != expected)
-    throw FileError(path, "", "truncated or corrupt (size does not match its header)",
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  const std::uintmax_t ids = ec || size < 16 ? 0 : (size - 16) / 4;
+  const bool consistent =
+      !ec && size >= 16 && (size - 16) % 4 == 0 &&
+      (levels == 0 ? ids == 0 && n == 0 : ids % levels == 0 && ids / levels == n);
+  if (!consistent)
+    throw FileError(path, "byte 4",
+                    "truncated or corrupt: " + std::to_string(n) + " points and " +
+                        std::to_string(levels) + " levels do not match the size (" +
+                        std::to_string(size) + " bytes)",
                     "run `scalespace planes` again");
   m.ids.resize(std::size_t(n) * levels);
   in.read(reinterpret_cast<char*>(m.ids.data()), std::streamsize(m.ids.size() * 4));
