@@ -97,3 +97,17 @@ TEST(PlaneModelMalformed, MembershipCountsThatWrapAreRejected) {
   expectRejected(none, membership(std::uint64_t(1) << 60, 0, {}), "membership.bin: byte 4");
   expectRejected(json, kMembership.substr(0, 18), "membership.bin");  // 2 bytes of ids
 }
+
+TEST(PlaneModelMalformed, NonIntegerNumbersAreRejected) {
+  // get<int>() of 1e300 was undefined behaviour (a float cast out of range; UBSan).
+  expectRejected(componentsJson(withKey("birth_level", "1e300")), kMembership,
+                 "components.json: component 0");
+  expectRejected(componentsJson(withKey("point_count", "-1.5")), kMembership, "components.json");
+  expectRejected(componentsJson(withKey("id", "0.5")), kMembership, "components.json");
+  // The message names what is not a number by its type (dump() would recurse 100000 deep).
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  expectRejected(componentsJson(withKey("id", deep)), kMembership, "components.json");
+  // An integral float is an integer.
+  const Files files(componentsJson(withKey("death_level", "1.0")), kMembership);
+  EXPECT_EQ(readPlaneModel(files.dir.string()).components.at(0).deathLevel, 1);
+}

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/JsonInteger.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/render/ColorMap.hpp"
 
@@ -234,14 +235,14 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
     for (const auto& j : root.at("components")) {
       where = "component " + std::to_string(model.components.size());
       PlaneComponent c;
-      c.id = j.at("id").get<int>();
-      c.birthLevel = j.at("birth_level").get<int>();
+      c.id = jsonInteger<int>(j.at("id"));
+      c.birthLevel = jsonInteger<int>(j.at("birth_level"));
       c.birthScale = j.at("birth_scale").get<double>();
-      c.deathLevel = j.at("death_level").get<int>();
+      c.deathLevel = jsonInteger<int>(j.at("death_level"));
       c.deathScale = j.at("death_scale").get<double>();
-      c.persistence = j.at("persistence").get<int>();
-      c.representativeLevel = j.at("representative_level").get<int>();
-      c.pointCount = j.at("point_count").get<std::size_t>();
+      c.persistence = jsonInteger<int>(j.at("persistence"));
+      c.representativeLevel = jsonInteger<int>(j.at("representative_level"));
+      c.pointCount = jsonInteger<std::size_t>(j.at("point_count"));
       const auto n = j.at("normal").get<std::vector<double>>();
       if (n.size() != 3) throw std::runtime_error("normal must have 3 values");
       c.plane.normal = Vec3(n[0], n[1], n[2]);
