@@ -290,7 +290,10 @@ struct CompactFixture : StackFixture {
                      const char* what) const {
     nlohmann::json m = good;
     edit(m);
-    writeManifest(compactPath, m);
+    expectRefused(m.dump(1), what);
+  }
+  void expectRefused(const std::string& manifestText, const char* what) const {
+    std::ofstream(fs::path(compactPath) / "manifest.json") << manifestText;
     try {
       ScaleStackReader reader(compactPath);
       ADD_FAILURE() << what << " was accepted";
@@ -542,6 +545,16 @@ TEST_F(CompactFixture, NonIntegerCountsInTheManifestAreRefused) {
   writeManifest(compactPath, m);
   EXPECT_EQ(ScaleStackReader(compactPath).pointCount(), cloud.size());
   writeManifest(compactPath, good);
+}
+
+TEST_F(CompactFixture, DeeplyNestedManifestIsRefused) {
+  // 100000 nested arrays as "parameters": dump() (StackInfo::parametersJson) overflowed the stack.
+  std::string text = manifest(compactPath).dump();
+  const std::string key = "\"parameters\":";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.insert(text.find(key) + key.size(),
+              std::string(100000, '[') + std::string(100000, ']') + ",\"old_parameters\":");
+  expectRefused(text, "100000 nested arrays");
 }
 
 TEST_F(CompactFixture, WrongSizeFilesAreRejected) {

@@ -876,9 +876,22 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     throw FileError(path, "", "no manifest.json: an incomplete stack (its writer was interrupted)",
                     "recompute it with 'scalespace scales'");
   nlohmann::json manifest;
+  // A manifest nests 4 levels deep. Deeper JSON is refused while parsing: dump() (parametersJson,
+  // manifestJson) recurses once per level and overflowed the stack at 100000 levels.
+  constexpr int kMaxDepth = 32;
+  const auto depthLimit = [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+    if (depth > kMaxDepth)
+      throw FileError(
+          manifestPath, "",
+          "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels: not a stack manifest",
+          "recompute the stack with 'scalespace scales'");
+    return true;
+  };
   try {
     std::ifstream in(manifestPath);
-    manifest = nlohmann::json::parse(in);
+    manifest = nlohmann::json::parse(in, depthLimit);
+  } catch (const FileError&) {
+    throw;
   } catch (const std::exception& e) {
     throw FileError(manifestPath, "", std::string("invalid JSON: ") + e.what(),
                     "recompute the stack with 'scalespace scales'");
