@@ -309,6 +309,22 @@ struct CompactFixture : StackFixture {
   void writeManifest(const std::string& stackPath, const nlohmann::json& m) const {
     std::ofstream(fs::path(stackPath) / "manifest.json") << m.dump(1);
   }
+  // Writes `good` edited as the compact stack's manifest: the reader must refuse it.
+  void expectRefused(const nlohmann::json& good, const std::function<void(nlohmann::json&)>& edit,
+                     const char* what) const {
+    nlohmann::json m = good;
+    edit(m);
+    expectRefused(m.dump(1), what);
+  }
+  void expectRefused(const std::string& manifestText, const char* what) const {
+    std::ofstream(fs::path(compactPath) / "manifest.json") << manifestText;
+    try {
+      ScaleStackReader reader(compactPath);
+      ADD_FAILURE() << what << " was accepted";
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find("manifest.json"), std::string::npos) << e.what();
+    }
+  }
   void checkDecoded(const std::string& stackPath, int version) const;
 };
 
@@ -492,15 +508,7 @@ TEST_F(CompactFixture, Version2StacksStillRead) {
 TEST_F(CompactFixture, Version3ManifestCodecsAreValidated) {
   const nlohmann::json good = manifest(compactPath);
   auto refused = [&](const std::function<void(nlohmann::json&)>& edit, const char* what) {
-    nlohmann::json m = good;
-    edit(m);
-    writeManifest(compactPath, m);
-    try {
-      ScaleStackReader reader(compactPath);
-      ADD_FAILURE() << what << " was accepted";
-    } catch (const FileError& e) {
-      EXPECT_NE(std::string(e.what()).find("manifest.json"), std::string::npos) << e.what();
-    }
+    expectRefused(good, edit, what);
   };
   refused([](nlohmann::json& m) { m["quantities"]["projection_offset"]["bias"] = 99; }, "bias 99");
   refused([](nlohmann::json& m) { m["quantities"]["projection_offset"].erase("bias"); }, "no bias");
@@ -532,6 +540,45 @@ TEST_F(CompactFixture, Version3ManifestCodecsAreValidated) {
     EXPECT_THROW(ScaleStackReader{compactPath}, FileError) << name << " " << codec;
   }
   writeManifest(compactPath, good);
+}
+
+// nlohmann's get<int>() / get<std::size_t>() cast a float with static_cast, undefined out of range
+// (UBSan in fuzz_stack): integers are read with jsonInteger, and anything else is refused.
+TEST_F(CompactFixture, NonIntegerCountsInTheManifestAreRefused) {
+  const nlohmann::json good = manifest(compactPath);
+  expectRefused(
+      good, [](nlohmann::json& m) { m["point_count"] = 1e300; }, "point_count 1e300");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["point_count"] = -1.5; }, "point_count -1.5");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["format_version"] = 3e10; }, "version 3e10");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["scale_count"] = 3.5; }, "scale_count 3.5");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["stats"][0]["samples"] = -1e30; }, "samples");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["clamped_values"] = 1e20; }, "clamped 1e20");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["quantities"]["projection_offset"]["bias"] = 1e300; },
+      "bias 1e300");
+  expectRefused(
+      good, [](nlohmann::json& m) { m["quantities"]["frame"]["shape"][1] = 1e300; }, "shape 1e300");
+  // An integral float is an integer (as a hand-edited or another program's manifest may say).
+  nlohmann::json m = good;
+  m["point_count"] = double(cloud.size());
+  writeManifest(compactPath, m);
+  EXPECT_EQ(ScaleStackReader(compactPath).pointCount(), cloud.size());
+  writeManifest(compactPath, good);
+}
+
+TEST_F(CompactFixture, DeeplyNestedManifestIsRefused) {
+  // 100000 nested arrays as "parameters": dump() (StackInfo::parametersJson) overflowed the stack.
+  std::string text = manifest(compactPath).dump();
+  const std::string key = "\"parameters\":";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.insert(text.find(key) + key.size(),
+              std::string(100000, '[') + std::string(100000, ']') + ",\"old_parameters\":");
+  expectRefused(text, "100000 nested arrays");
 }
 
 TEST_F(CompactFixture, WrongSizeFilesAreRejected) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/JsonInteger.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/render/ColorMap.hpp"
 
@@ -196,10 +197,19 @@ PointMembership readMembership(const std::string& path) {
   PointMembership m;
   m.pointCount = std::size_t(n);
   m.levelCount = int(levels);
-  const auto expected = std::uintmax_t(n) * levels * 4 + 16;
+  // 16 + 4 n levels bytes, checked by division: the product can wrap (n = 2^62 gives 16 bytes),
+  // and without levels there must be no points either (the queries allocate per point).
   std::error_code ec;
-  if (std::filesystem::file_size(path, ec) != expected)
-    throw FileError(path, "", "truncated or corrupt (size does not match its header)",
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  const std::uintmax_t ids = ec || size < 16 ? 0 : (size - 16) / 4;
+  const bool consistent =
+      !ec && size >= 16 && (size - 16) % 4 == 0 &&
+      (levels == 0 ? ids == 0 && n == 0 : ids % levels == 0 && ids / levels == n);
+  if (!consistent)
+    throw FileError(path, "byte 4",
+                    "truncated or corrupt: " + std::to_string(n) + " points and " +
+                        std::to_string(levels) + " levels do not match the size (" +
+                        std::to_string(size) + " bytes)",
                     "run `scalespace planes` again");
   m.ids.resize(std::size_t(n) * levels);
   in.read(reinterpret_cast<char*>(m.ids.data()), std::streamsize(m.ids.size() * 4));
@@ -218,19 +228,21 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
     throw FileError(jsonPath, "", std::string("invalid JSON: ") + e.what());
   }
   PlaneModel model;
+  std::string where;  // the component being read, for the message
   try {
     model.scales = root.at("scales").get<std::vector<double>>();
     if (input) *input = root.at("input").get<std::string>();
     for (const auto& j : root.at("components")) {
+      where = "component " + std::to_string(model.components.size());
       PlaneComponent c;
-      c.id = j.at("id").get<int>();
-      c.birthLevel = j.at("birth_level").get<int>();
+      c.id = jsonInteger<int>(j.at("id"));
+      c.birthLevel = jsonInteger<int>(j.at("birth_level"));
       c.birthScale = j.at("birth_scale").get<double>();
-      c.deathLevel = j.at("death_level").get<int>();
+      c.deathLevel = jsonInteger<int>(j.at("death_level"));
       c.deathScale = j.at("death_scale").get<double>();
-      c.persistence = j.at("persistence").get<int>();
-      c.representativeLevel = j.at("representative_level").get<int>();
-      c.pointCount = j.at("point_count").get<std::size_t>();
+      c.persistence = jsonInteger<int>(j.at("persistence"));
+      c.representativeLevel = jsonInteger<int>(j.at("representative_level"));
+      c.pointCount = jsonInteger<std::size_t>(j.at("point_count"));
       const auto n = j.at("normal").get<std::vector<double>>();
       if (n.size() != 3) throw std::runtime_error("normal must have 3 values");
       c.plane.normal = Vec3(n[0], n[1], n[2]);
@@ -239,10 +251,20 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
       c.plane.valid = j.value("plane_valid", true);
       c.area = j.at("area").get<double>();
       if (c.id != int(model.components.size())) throw std::runtime_error("ids must be 0, 1, ...");
+      // The levels index the scales and membership.bin's levels (the queries, `segment`).
+      if (c.birthLevel < 0 || c.birthLevel > c.representativeLevel ||
+          c.representativeLevel > c.deathLevel || c.deathLevel >= model.scaleCount() ||
+          c.persistence != c.deathLevel - c.birthLevel)
+        throw std::runtime_error(
+            "birth_level " + std::to_string(c.birthLevel) + ", representative_level " +
+            std::to_string(c.representativeLevel) + ", death_level " +
+            std::to_string(c.deathLevel) + ", persistence " + std::to_string(c.persistence) +
+            ": expected 0 <= birth <= representative <= death < " +
+            std::to_string(model.scaleCount()) + " (the scales) and persistence = death - birth");
       model.components.push_back(std::move(c));
     }
   } catch (const std::exception& e) {
-    throw FileError(jsonPath, "", std::string("unexpected content: ") + e.what(),
+    throw FileError(jsonPath, where, std::string("unexpected content: ") + e.what(),
                     "run `scalespace planes` again");
   }
   model.membership = readMembership((std::filesystem::path(directory) / "membership.bin").string());

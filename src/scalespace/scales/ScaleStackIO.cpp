@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/JsonInteger.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
 #include "scalespace/scales/StackQuantization.hpp"
 
@@ -778,7 +779,7 @@ void readCodec(const std::string& manifestPath, const Quantity& q, const nlohman
                     fix);
   if (std::strcmp(q.codec, "shared_exponent") == 0) {
     // Any bias decodes exactly; beyond 0..64 the values would be absurd (2^-64 t and finer).
-    const int bias = entry.at("bias").get<int>();
+    const int bias = jsonInteger<int>(entry.at("bias"));
     if (bias < 0 || bias > 64)
       throw FileError(manifestPath, "", what + "bias " + std::to_string(bias) + " is not in 0..64",
                       fix);
@@ -880,9 +881,22 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     throw FileError(path, "", "no manifest.json: an incomplete stack (its writer was interrupted)",
                     "recompute it with 'scalespace scales'");
   nlohmann::json manifest;
+  // A manifest nests 4 levels deep. Deeper JSON is refused while parsing: dump() (parametersJson,
+  // manifestJson) recurses once per level and overflowed the stack at 100000 levels.
+  constexpr int kMaxDepth = 32;
+  const auto depthLimit = [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+    if (depth > kMaxDepth)
+      throw FileError(
+          manifestPath, "",
+          "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels: not a stack manifest",
+          "recompute the stack with 'scalespace scales'");
+    return true;
+  };
   try {
     std::ifstream in(manifestPath);
-    manifest = nlohmann::json::parse(in);
+    manifest = nlohmann::json::parse(in, depthLimit);
+  } catch (const FileError&) {
+    throw;
   } catch (const std::exception& e) {
     throw FileError(manifestPath, "", std::string("invalid JSON: ") + e.what(),
                     "recompute the stack with 'scalespace scales'");
@@ -892,7 +906,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     if (manifest.at("format").get<std::string>() != "scalespace-stack")
       throw FileError(manifestPath, "", "not a scalespace stack manifest", fix);
     StackInfo& info = d.info;
-    info.formatVersion = manifest.at("format_version").get<int>();
+    info.formatVersion = jsonInteger<int>(manifest.at("format_version"));
     if (info.formatVersion < 1 || info.formatVersion > kStackFormatVersion)
       throw FileError(manifestPath, "",
                       "format version " + std::to_string(info.formatVersion) +
@@ -900,10 +914,10 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
                           std::to_string(kStackFormatVersion) + ")",
                       "recompute the stack with this version of scalespace");
     info.programVersion = manifest.at("program_version").get<std::string>();
-    info.pointCount = manifest.at("point_count").get<std::size_t>();
+    info.pointCount = jsonInteger<std::size_t>(manifest.at("point_count"));
     info.scales = manifest.at("scales").get<std::vector<double>>();
     if (info.scales.empty()) throw FileError(manifestPath, "", "the stack has no scales", fix);
-    if (manifest.at("scale_count").get<std::size_t>() != info.scales.size())
+    if (jsonInteger<std::size_t>(manifest.at("scale_count")) != info.scales.size())
       throw FileError(manifestPath, "", "scale_count differs from the number of scale values", fix);
     const auto origin = manifest.at("origin").get<std::vector<double>>();
     if (origin.size() != 3)
@@ -913,10 +927,10 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     for (const auto& s : manifest.at("stats")) {
       ScaleStats st;
       st.t = s.at("t").get<double>();
-      st.samples = s.at("samples").get<std::size_t>();
+      st.samples = jsonInteger<std::size_t>(s.at("samples"));
       st.meanNeighbors = s.at("mean_neighbors").get<double>();
       st.meanMlsSteps = s.value("mean_mls_steps", 0.0);  // absent from stacks of version <= 0.1
-      st.validPoints = s.at("valid_points").get<std::size_t>();
+      st.validPoints = jsonInteger<std::size_t>(s.at("valid_points"));
       st.samplingSeconds = s.at("sampling_seconds").get<double>();
       st.indexSeconds = s.at("index_seconds").get<double>();
       st.projectionSeconds = s.at("projection_seconds").get<double>();
@@ -940,7 +954,9 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
     const std::string quantisation = manifest.at("quantisation").get<std::string>();
     if (quantisation != (info.encoding == StackEncoding::Compact ? "compact" : "none"))
       throw FileError(manifestPath, "", "unknown quantisation '" + quantisation + "'", fix);
-    info.clampedValues = manifest.value("clamped_values", std::size_t(0));
+    info.clampedValues = manifest.contains("clamped_values")
+                             ? jsonInteger<std::size_t>(manifest.at("clamped_values"))
+                             : 0;
     d.codecs.version = info.formatVersion;
     d.table = quantities(info.encoding, info.formatVersion);
     for (std::size_t j = 0; j < info.scales.size(); ++j)
@@ -954,7 +970,7 @@ ScaleStackReader::ScaleStackReader(const std::string& path) : impl_(std::make_un
       perScale += sliceBytes(q, n);
       const auto& entry = manifest.at("quantities").at(q.name);
       if (entry.at("dtype").get<std::string>() != q.dtype ||
-          entry.at("shape").get<std::vector<std::size_t>>() != quantityShape(q, m, n))
+          jsonIntegers<std::size_t>(entry.at("shape")) != quantityShape(q, m, n))
         throw FileError(manifestPath, "",
                         std::string("quantity '") + q.name + "' has an unexpected dtype or shape",
                         fix);
