@@ -19,7 +19,8 @@
 #include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
-#include "scalespace/scales/ScaleStackIO.hpp"
+#include "scalespace/scales/ScaleStackCompute.hpp"
+#include "scalespace/scales/ScaleStackReader.hpp"
 
 namespace scalespace::cli {
 namespace {
@@ -131,7 +132,7 @@ void addScalesCommand(CLI::App& app) {
     PointCloud cloud = loadCloud(args->input, args->quiet);
     ensureNormals(cloud, args->quiet);
     const ScaleSpaceSummary s =
-        computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet), write);
+        computeScaleStackToDisk(cloud, options, args->output, makeProgressBar(args->quiet), write);
     FitCounts counts;
     counts.largestScale = s.series.tMax;
     for (const ScaleStats& stats : s.stats) {
