@@ -29,7 +29,7 @@
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
-#include "scalespace/scales/ScaleStackIO.hpp"
+#include "scalespace/scales/ScaleStackCompute.hpp"
 
 using namespace scalespace;
 namespace fs = std::filesystem;
@@ -151,7 +151,7 @@ void timingBench(const PointCloud& cloud, const ScaleSpaceOptions& options, cons
       cloud.size(), options.series.count, options.alpha, int(options.robust), options.mlsSteps,
       ThreadLimit::active());
   auto t0 = Clock::now();
-  const ScaleSpaceSummary s = computeScaleStack(cloud, options, stackPath.string());
+  const ScaleSpaceSummary s = computeScaleStackToDisk(cloud, options, stackPath.string());
   const double total = seconds(t0);
   double sampling = 0, index = 0, projection = 0;
   std::printf("%5s %10s %9s %10s %9s %9s %9s %9s\n", "j", "t", "samples", "nbrs/proj", "mls_steps",

@@ -8,6 +8,8 @@
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
 #include "scalespace/planes/StackPlanes.hpp"
+#include "scalespace/scales/ScaleStackCompute.hpp"
+#include "scalespace/scales/ScaleStackReader.hpp"
 
 using namespace scalespace;
 
@@ -72,7 +74,7 @@ TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
   // refused (checksum).
   const auto path = std::filesystem::temp_directory_path() / "scalespace_planes_test.stack";
   std::filesystem::remove_all(path);
-  computeScaleStack(cloud, stack, path.string());
+  computeScaleStackToDisk(cloud, stack, path.string());
   {
     const ScaleStackReader reader(path.string());
     const PlaneModel fromDisk = makePlaneModel(detectPlanesFromStack(cloud, reader));
@@ -119,7 +121,7 @@ void expectSameDetection(const PlaneDetection& a, const PlaneDetection& b) {
 TEST(StackPlanes, OverlappedSegmentationEqualsTheSequentialPipeline) {
   const PointCloud cloud = smallStairs();
   const ScaleSpaceOptions stack = robustStack(12);
-  const ScaleStack layers = computeScaleSpace(cloud, stack);
+  const ScaleStack layers = computeScaleStackInMemory(cloud, stack);
   std::vector<ScaleFeatures> features;
   for (std::size_t j = 0; j < layers.layers.size(); ++j)
     features.push_back(scaleFeaturesFromLayer(layers.layers[j], layers.summary.series.scales[j]));

@@ -23,7 +23,7 @@ TEST(ScaleSpace, SphereProjectionsStayOnTheSphere) {
   const PointCloud cloud = test::sphereCloud(2000, r);
   ScaleSpaceOptions o = smallOptions(6);
   o.series.tMax = 1.0;  // up to the radius: larger supports see the whole sphere (still exact)
-  const ScaleStack stack = computeScaleSpace(cloud, o);
+  const ScaleStack stack = computeScaleStackInMemory(cloud, o);
   ASSERT_EQ(stack.layers.size(), 6u);
   for (std::size_t j = 0; j < stack.layers.size(); ++j) {
     const ScaleLayer& L = stack.layers[j];
@@ -70,7 +70,7 @@ TEST(ScaleSpace, NoisyPlaneGetsFlatterWithScale) {
   o.series.tMax = 0.25;  // supports around the interior stay inside the square
   // Without decimation (alpha = 0) every scale averages more samples: strictly flatter.
   o.alpha = 0;
-  const std::vector<double> full = interiorRmsHeights(cloud, computeScaleSpace(cloud, o));
+  const std::vector<double> full = interiorRmsHeights(cloud, computeScaleStackInMemory(cloud, o));
   for (std::size_t j = 1; j < full.size(); ++j) EXPECT_LT(full[j], full[j - 1]) << "scale " << j;
   EXPECT_LT(full.front(), noise);
   EXPECT_LT(full.back(), 0.1 * noise);
@@ -78,7 +78,8 @@ TEST(ScaleSpace, NoisyPlaneGetsFlatterWithScale) {
   // the thesis, Fig. 1.11), so the smoothing levels off (Sec. 1.5.2, the balance between
   // decimation and smoothing) but stays well below the noise at every scale.
   o.alpha = 0.1;
-  const std::vector<double> pyramid = interiorRmsHeights(cloud, computeScaleSpace(cloud, o));
+  const std::vector<double> pyramid =
+      interiorRmsHeights(cloud, computeScaleStackInMemory(cloud, o));
   EXPECT_DOUBLE_EQ(pyramid[0], full[0]);  // the finest level keeps every point
   for (std::size_t j = 0; j < pyramid.size(); ++j)
     EXPECT_LT(pyramid[j], 0.5 * noise) << "scale " << j;
@@ -88,9 +89,9 @@ TEST(ScaleSpace, IdenticalForOneAndTwoThreads) {
   const PointCloud cloud = test::noisyPlane(40, 1.0, 0.02, 8);
   ScaleSpaceOptions o = smallOptions(4);
   o.threads = 1;
-  const ScaleStack a = computeScaleSpace(cloud, o);
+  const ScaleStack a = computeScaleStackInMemory(cloud, o);
   o.threads = 2;
-  const ScaleStack b = computeScaleSpace(cloud, o);
+  const ScaleStack b = computeScaleStackInMemory(cloud, o);
   ASSERT_EQ(a.layers.size(), b.layers.size());
   for (std::size_t j = 0; j < a.layers.size(); ++j) {
     EXPECT_EQ(a.layers[j].projection, b.layers[j].projection);
@@ -103,9 +104,9 @@ TEST(ScaleSpace, IdenticalForOneAndTwoThreads) {
 TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
   const PointCloud cloud = test::noisyPlane(40, 1.0, 0.02, 9);
   ScaleSpaceOptions o = smallOptions(3);
-  const ScaleStack all = computeScaleSpace(cloud, o);
+  const ScaleStack all = computeScaleStackInMemory(cloud, o);
   o.layerContents = LayerContents::NormalAndCurvatures;
-  const ScaleStack some = computeScaleSpace(cloud, o);
+  const ScaleStack some = computeScaleStackInMemory(cloud, o);
   ASSERT_EQ(all.layers.size(), some.layers.size());
   for (std::size_t j = 0; j < all.layers.size(); ++j) {
     const ScaleLayer &a = all.layers[j], &b = some.layers[j];
@@ -120,7 +121,7 @@ TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
   }
   // In processing order too: the same five arrays, permuted, and nothing else.
   o.layerOrder = LayerOrder::Processing;
-  const ScaleStack processing = computeScaleSpace(cloud, o);
+  const ScaleStack processing = computeScaleStackInMemory(cloud, o);
   for (std::size_t j = 0; j < all.layers.size(); ++j) {
     const ScaleLayer &a = all.layers[j], &p = processing.layers[j];
     ASSERT_EQ(p.inputIndex.size(), cloud.size());
@@ -137,9 +138,9 @@ TEST(ScaleSpace, NormalAndCurvatureLayersHoldTheSameValues) {
 TEST(ScaleSpace, ProcessingOrderLayersAreTheInputOrderLayersPermuted) {
   const PointCloud cloud = test::sphereCloud(800, 1.0);
   ScaleSpaceOptions o = smallOptions(3);
-  const ScaleStack input = computeScaleSpace(cloud, o);
+  const ScaleStack input = computeScaleStackInMemory(cloud, o);
   o.layerOrder = LayerOrder::Processing;
-  const ScaleStack processing = computeScaleSpace(cloud, o);
+  const ScaleStack processing = computeScaleStackInMemory(cloud, o);
   ASSERT_EQ(input.layers.size(), processing.layers.size());
   for (std::size_t j = 0; j < input.layers.size(); ++j) {
     const ScaleLayer &a = input.layers[j], &b = processing.layers[j];
@@ -185,7 +186,7 @@ TEST(ScaleSpace, ProcessingOrderLayersAreTheInputOrderLayersPermuted) {
 
 TEST(ScaleSpace, SamplesShrinkAndStatsAreFilled) {
   const PointCloud cloud = test::sphereCloud(3000, 1.0);
-  const ScaleStack s = computeScaleSpace(cloud, smallOptions(5));
+  const ScaleStack s = computeScaleStackInMemory(cloud, smallOptions(5));
   ASSERT_EQ(s.summary.stats.size(), 5u);
   EXPECT_EQ(s.summary.stats[0].t, s.summary.series.scales[0]);
   for (std::size_t j = 1; j < 5; ++j)
@@ -197,11 +198,11 @@ TEST(ScaleSpace, SamplesShrinkAndStatsAreFilled) {
 
 TEST(ScaleSpace, NeedsNormalsAndCanBeCancelled) {
   PointCloud cloud = test::sphereCloud(500, 1.0);
-  EXPECT_THROW(
-      computeScaleSpace(cloud, smallOptions(3), [](double, std::string_view) { return false; }),
-      Cancelled);
+  EXPECT_THROW(computeScaleStackInMemory(cloud, smallOptions(3),
+                                         [](double, std::string_view) { return false; }),
+               Cancelled);
   cloud.setNormals({});
-  EXPECT_THROW(computeScaleSpace(cloud, smallOptions(3)), OptionError);
+  EXPECT_THROW(computeScaleStackInMemory(cloud, smallOptions(3)), OptionError);
 }
 
 // The next pyramid level is drawn in a task while a scale projects: a cancelled projection or a
@@ -209,7 +210,7 @@ TEST(ScaleSpace, NeedsNormalsAndCanBeCancelled) {
 // the frame), and the stack runs again afterwards with the same result.
 TEST(ScaleSpace, StopsCleanlyWhileTheNextLevelIsPrepared) {
   const PointCloud cloud = test::sphereCloud(3000, 1.0);
-  const ScaleStack reference = computeScaleSpace(cloud, smallOptions(6));
+  const ScaleStack reference = computeScaleStackInMemory(cloud, smallOptions(6));
   for (std::size_t failAt : {0u, 2u, 5u}) {
     const auto failing = [&](std::size_t j, const ScaleLayer&, const ScaleStats&) {
       if (j == failAt) throw Error("the sink failed at scale " + std::to_string(j));
@@ -218,9 +219,9 @@ TEST(ScaleSpace, StopsCleanlyWhileTheNextLevelIsPrepared) {
   }
   for (double stopAt : {0.1, 0.5, 0.9}) {
     const auto cancel = [&](double f, std::string_view) { return f < stopAt; };
-    EXPECT_THROW(computeScaleSpace(cloud, smallOptions(6), cancel), Cancelled) << stopAt;
+    EXPECT_THROW(computeScaleStackInMemory(cloud, smallOptions(6), cancel), Cancelled) << stopAt;
   }
-  const ScaleStack again = computeScaleSpace(cloud, smallOptions(6));
+  const ScaleStack again = computeScaleStackInMemory(cloud, smallOptions(6));
   ASSERT_EQ(again.layers.size(), reference.layers.size());
   for (std::size_t j = 0; j < again.layers.size(); ++j) {
     EXPECT_EQ(again.summary.stats[j].samples, reference.summary.stats[j].samples);

@@ -39,7 +39,7 @@ struct StackFixture : ::testing::Test {
   std::string path;
   void SetUp() override {
     options.series.count = 3;
-    stack = computeScaleSpace(cloud, options);
+    stack = computeScaleStackInMemory(cloud, options);
     path = (dir.path / "sphere.stack").string();
     writeScaleStack(path, cloud, options, stack, float32());
   }
@@ -99,7 +99,7 @@ TEST_F(StackFixture, RoundTripIsExactByScaleAndByPoint) {
 }
 
 TEST_F(StackFixture, StreamedStackEqualsInMemoryAndReplacesTheOldOne) {
-  const ScaleSpaceSummary s = computeScaleStack(cloud, options, path, {}, float32());
+  const ScaleSpaceSummary s = computeScaleStackToDisk(cloud, options, path, {}, float32());
   ScaleStackReader reader(path);
   EXPECT_EQ(reader.readScale(2).projection, stack.layers[2].projection);
   EXPECT_NO_THROW(reader.verifyChecksums());
@@ -122,7 +122,7 @@ TEST_F(StackFixture, LayersInProcessingOrderAreWrittenInInputOrder) {
   // must be byte for byte those written from input-order layers, in both encodings.
   ScaleSpaceOptions processing = options;
   processing.layerOrder = LayerOrder::Processing;
-  const ScaleStack permuted = computeScaleSpace(cloud, processing);
+  const ScaleStack permuted = computeScaleStackInMemory(cloud, processing);
   ASSERT_FALSE(permuted.layers[0].inputIndex.empty());
   for (const StackWriteOptions& write : {StackWriteOptions{}, float32()}) {
     const std::string a = (dir.path / "input.stack").string();
@@ -132,8 +132,8 @@ TEST_F(StackFixture, LayersInProcessingOrderAreWrittenInInputOrder) {
     const auto fa = stackFiles(a), fb = stackFiles(b);
     EXPECT_GE(fa.size(), 10u);
     EXPECT_TRUE(fa == fb);
-    // The streamed stack (computeScaleStack) too.
-    computeScaleStack(cloud, options, b, {}, write);
+    // The streamed stack (computeScaleStackToDisk) too.
+    computeScaleStackToDisk(cloud, options, b, {}, write);
     EXPECT_TRUE(stackFiles(b) == fa);
     // Input indices that are not a permutation are refused (the encoder writes at them), and the
     // stack already in place stays.
@@ -158,7 +158,7 @@ TEST_F(StackFixture, OnlyAStackIsEverReplaced) {
   for (const std::string& target : {file, mine.string()}) {
     EXPECT_FALSE(isScaleStack(target));
     EXPECT_THROW(writeScaleStack(target, cloud, options, stack, float32()), FileError) << target;
-    EXPECT_THROW(computeScaleStack(cloud, options, target), FileError) << target;
+    EXPECT_THROW(computeScaleStackToDisk(cloud, options, target), FileError) << target;
   }
   EXPECT_TRUE(fs::is_regular_file(file));
   EXPECT_TRUE(fs::exists(mine / "data.bin"));
@@ -487,7 +487,7 @@ TEST_F(CompactFixture, Version3DecodesWithinTheDocumentedTolerances) {
   EXPECT_EQ(q["geometric_variation"]["log_max"], quant::kVariationLogMax);
   EXPECT_EQ(q["curv_max_t"]["codec"], "float16");
   // Streaming gives the same files as the in-memory writer.
-  computeScaleStack(cloud, options, path);
+  computeScaleStackToDisk(cloud, options, path);
   ScaleStackReader streamed(path);
   EXPECT_EQ(streamed.info().formatVersion, 3);
   EXPECT_EQ(streamed.readScale(2).kMax, ScaleStackReader(compactPath).readScale(2).kMax);

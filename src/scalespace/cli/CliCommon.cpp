@@ -15,7 +15,7 @@
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/planes/PlaneExport.hpp"
-#include "scalespace/scales/ScaleStackIO.hpp"
+#include "scalespace/scales/ScaleStackReader.hpp"
 
 namespace scalespace::cli {
 

@@ -18,7 +18,8 @@
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
-#include "scalespace/scales/ScaleStackIO.hpp"
+#include "scalespace/scales/ScaleStackCompute.hpp"
+#include "scalespace/scales/ScaleStackReader.hpp"
 
 namespace scalespace::cli {
 namespace {
@@ -130,7 +131,7 @@ void addScalesCommand(CLI::App& app) {
     PointCloud cloud = loadCloud(args->input, args->quiet);
     ensureNormals(cloud, args->quiet);
     const ScaleSpaceSummary s =
-        computeScaleStack(cloud, options, args->output, makeProgressBar(args->quiet), write);
+        computeScaleStackToDisk(cloud, options, args->output, makeProgressBar(args->quiet), write);
     printWarnings(invalidFitWarnings(cloud, stackFitCounts(s, cloud.size(), options)));
     if (!args->quiet)
       std::fprintf(stderr, "%s%zu points x %zu scales (t = %.6g .. %.6g) -> %s\n",

@@ -1,6 +1,5 @@
 #include "scalespace/io/AtomicFile.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -9,6 +8,7 @@
 #include <sstream>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/FileSync.hpp"
 
 namespace scalespace {
 
@@ -21,14 +21,6 @@ std::string temporaryPathFor(const std::string& path) {
   std::ostringstream name;
   name << path << ".tmp-" << ::getpid() << '-' << std::hex << device() << device();
   return name.str();
-}
-
-/// fsync so that the rename never exposes a file whose content is still only in the page cache.
-void syncFile(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
 }
 
 }  // namespace
@@ -64,7 +56,9 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
     removeTemporary();
     throw;
   }
-  syncFile(temporary);
+  // fsync before the rename, so that it never exposes a file whose content is only in the page
+  // cache (core/FileSync.hpp).
+  syncPath(temporary);
   std::error_code ec;
   fs::rename(temporary, path, ec);
   if (ec) {

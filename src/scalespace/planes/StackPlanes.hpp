@@ -5,7 +5,7 @@
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/planes/PlaneDetection.hpp"
 #include "scalespace/scales/ScaleSpace.hpp"
-#include "scalespace/scales/ScaleStackIO.hpp"
+#include "scalespace/scales/ScaleStackReader.hpp"
 
 namespace scalespace {
 

@@ -324,8 +324,8 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   return summary;
 }
 
-ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
-                             const ProgressCallback& progress) {
+ScaleStack computeScaleStackInMemory(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                     const ProgressCallback& progress) {
   ScaleStack stack;
   stack.summary = runScaleSpace(
       cloud, options,

@@ -109,8 +109,10 @@ struct ScaleStack {
   ScaleSpaceSummary summary;
   std::vector<ScaleLayer> layers;
 };
-ScaleStack computeScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
-                             const ProgressCallback& progress = {});
+/// Computes the whole stack in memory (M layers of N points: small clouds and tests). Large clouds
+/// stream it to disk instead, one scale at a time: computeScaleStackToDisk (ScaleStackCompute.hpp).
+ScaleStack computeScaleStackInMemory(const PointCloud& cloud, const ScaleSpaceOptions& options,
+                                     const ProgressCallback& progress = {});
 
 /// FNV-1a 64-bit over the absolute positions and the normals (as little-endian doubles): identifies
 /// the input a stack was computed from.
