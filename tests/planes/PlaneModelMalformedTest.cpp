@@ -2,6 +2,7 @@
 // two-point, two-scale model: readPlaneModel must reject each with a FileError naming the file
 // (before, the queries or `segment` read out of bounds).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -37,8 +38,9 @@ std::string membership(std::uint64_t points, std::uint32_t levels, const std::ve
 const std::string kMembership = membership(2, 2, {0, 0, 0, -1});
 
 struct Files {
-  std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "scalespace_planes_malformed";
+  // One folder per process: ctest runs the tests of this file in parallel processes.
+  std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                              ("scalespace_planes_malformed_" + std::to_string(::getpid()));
   Files(const std::string& json, const std::string& bin) {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
