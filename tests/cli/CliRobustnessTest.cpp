@@ -164,6 +164,9 @@ TEST_F(Cli, OptionsThatWouldRunWithoutBoundAreRefusedOrClamped) {
   r = run("normals " + path("s.ply") + " -o " + path("n.ply") + " --k 1500");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--k must be in [3, 1000]"), std::string::npos) << r.err;
+  r = run("curvature " + path("s.ply") + " -o " + path("c.ply"));  // no scale at all
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("(--scale) or a neighbour count (--scale-k)"), std::string::npos) << r.err;
   r = run("curvature " + path("s.ply") + " -o " + path("c.ply") + " --scale-k 5000");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--scale-k"), std::string::npos) << r.err;

@@ -15,7 +15,7 @@
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/planes/PlaneExport.hpp"
-#include "scalespace/scales/ScaleStackReader.hpp"
+#include "scalespace/scales/ScaleStackWriter.hpp"
 
 namespace scalespace::cli {
 
@@ -130,11 +130,7 @@ void checkOutput(const std::string& output, OutputKind kind,
         throw OptionError("output " + output + ": this output is CSV text; name it *.csv");
       break;
     case OutputKind::Stack:
-      if (fs::exists(output, ec) && !isScaleStack(output))
-        throw FileError(output, "",
-                        "exists and is not a scale stack (no scalespace manifest.json): refusing "
-                        "to replace it",
-                        "choose another -o, e.g. NAME.stack");
+      checkStackDestination(output);
       break;
     case OutputKind::PlanesResult:
       checkPlaneResultDestination(output);

@@ -16,6 +16,7 @@
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
+#include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/io/CloudIO.hpp"
 
 namespace scalespace::cli {
@@ -52,9 +53,7 @@ void addInfoCommand(CLI::App& app) {
       std::printf("diagonal    %.6g\n", (hi - lo).norm());
     }
     if (cloud.hasNormals()) {
-      const std::size_t bad = std::size_t(
-          std::count_if(cloud.normals().begin(), cloud.normals().end(),
-                        [](const Vec3& n) { return !n.allFinite() || n.squaredNorm() < 1e-12; }));
+      const std::size_t bad = unusableNormalCount(cloud);
       std::printf("normals     yes (nx ny nz)");
       if (bad > 0)
         std::printf(
@@ -252,8 +251,6 @@ void addCurvatureCommand(CLI::App& app) {
   addNormalOptions(*cmd, args->normals);
   cmd->callback([args] {
     const auto start = Clock::now();
-    if ((args->scale > 0) == (args->scaleK > 0))
-      throw OptionError("give exactly one of --scale T (> 0) or --scale-k K (> 0)");
     ThreadScope threads(args->threads);
     checkOutput(args->output, OutputKind::Cloud, {args->input.path});
     CurvatureOptions options;

@@ -26,7 +26,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"CoverageOptions::maxDistanceFraction", "--coverage-distance"},
     {"CoverageOptions::maxAngleDegrees", "--coverage-angle"},
     {"SimilarityOptions::birthTolerance", "--birth-tolerance"},
-    {"deathTolerance", "--death-tolerance"},
+    {"SimilarityOptions::deathTolerance", "--death-tolerance"},
     {"SimilarityOptions::maxAreaDifference", "--area-tolerance"},
     {"SimilarityOptions::maxAngleDegrees", "--angle"},
     {"ScaleSeriesOptions::spacing", "--spacing"},

@@ -140,7 +140,9 @@ std::vector<int> findSimilar(const PlaneModel& model, int query, const std::vect
 
 void validate(const SimilarityOptions& options) {
   if (options.birthTolerance < 0 || options.deathTolerance < 0)
-    throw OptionError("SimilarityOptions::birthTolerance and deathTolerance must be >= 0 levels");
+    throw OptionError(
+        "SimilarityOptions::birthTolerance and SimilarityOptions::deathTolerance must be >= 0 "
+        "levels");
   if (!(std::isfinite(options.maxAreaDifference) && options.maxAreaDifference >= 0))
     throw OptionError("SimilarityOptions::maxAreaDifference must be a finite fraction >= 0");
   if (!(options.maxAngleDegrees >= 0 && options.maxAngleDegrees <= 90))

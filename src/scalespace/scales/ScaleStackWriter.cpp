@@ -96,6 +96,15 @@ struct ScaleStackWriter::Impl {
   }
 };
 
+void checkStackDestination(const std::string& path) {
+  std::error_code ec;
+  if (fs::exists(path, ec) && !isScaleStack(path))
+    throw FileError(path, "",
+                    "exists and is not a scale stack (no scalespace manifest.json): refusing to "
+                    "replace it",
+                    "choose another output path for the stack, e.g. NAME.stack");
+}
+
 ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cloud,
                                    const ScaleSpaceOptions& options, std::size_t scaleCount,
                                    const StackWriteOptions& write)
@@ -117,12 +126,7 @@ ScaleStackWriter::ScaleStackWriter(const std::string& path, const PointCloud& cl
   d.clamped.assign(kCompactFiles, 0);
   d.bufs.resize(kCompactFiles);
   std::error_code ec;
-  // finish() replaces what is at `path`: only ever a stack this program wrote.
-  if (fs::exists(d.finalPath, ec) && !isScaleStack(d.finalPath.string()))
-    throw FileError(d.finalPath.string(), "",
-                    "exists and is not a scale stack (no scalespace manifest.json): refusing to "
-                    "replace it",
-                    "choose another output path for the stack, e.g. NAME.stack");
+  checkStackDestination(d.finalPath.string());  // finish() replaces what is there
   fs::remove_all(d.tmpPath, ec);
   if (!fs::create_directories(d.tmpPath, ec) || ec)
     throw FileError(d.tmpPath.string(), "",

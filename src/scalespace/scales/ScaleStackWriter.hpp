@@ -26,6 +26,10 @@ struct StackWriteOptions {
   int compactVersion = kStackFormatVersion;
 };
 
+/// FileError unless `path` is absent or a scale stack (isScaleStack): the only thing a stack writer
+/// replaces. Callers check it before long work; the writer checks it again.
+void checkStackDestination(const std::string& path);
+
 /// Streams a stack to disk scale by scale (peak memory: one ScaleLayer).
 class ScaleStackWriter {
  public:
