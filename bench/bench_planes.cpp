@@ -11,7 +11,7 @@
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
 //                     [--robust-iterations N]
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
-// --robust-tolerance / --robust-iterations set the stack's ScaleSpaceOptions::robustTolerance /
+// --robust-tolerance / --robust-iterations set the stack's ScaleSpaceOptions::fit.robustTolerance /
 // robustIterations (default: the library's; 0 iterations = the plain APSS stack).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
@@ -161,9 +161,9 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
              const char* sceneName, double noise, double robustTolerance, int robustIterations) {
   ScaleSpaceOptions stack;
   stack.series.count = scales;
-  if (robustTolerance >= 0) stack.robustTolerance = robustTolerance;
-  stack.robust = robustIterations != 0;  // as `scalespace planes` (Sec. 2.3)
-  if (robustIterations > 0) stack.robustIterations = robustIterations;
+  if (robustTolerance >= 0) stack.fit.robustTolerance = robustTolerance;
+  stack.fit.robust = robustIterations != 0;  // as `scalespace planes` (Sec. 2.3)
+  if (robustIterations > 0) stack.fit.robustIterations = robustIterations;
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
   std::vector<std::size_t> faceSize(std::size_t(faceCount), 0);

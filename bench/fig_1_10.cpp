@@ -148,8 +148,8 @@ void timingBench(const PointCloud& cloud, const ScaleSpaceOptions& options, cons
   const fs::path stackPath = out / "bench.stack";
   std::printf(
       "\n== Stack: %zu points x %d scales, alpha %.3g, robust %d, mls steps %d, %zu threads ==\n",
-      cloud.size(), options.series.count, options.alpha, int(options.robust), options.mlsSteps,
-      ThreadLimit::active());
+      cloud.size(), options.series.count, options.alpha, int(options.fit.robust),
+      options.fit.mlsMaxSteps, ThreadLimit::active());
   auto t0 = Clock::now();
   const ScaleSpaceSummary s = computeScaleStackToDisk(cloud, options, stackPath.string());
   const double total = seconds(t0);
@@ -192,11 +192,7 @@ void timingBench(const PointCloud& cloud, const ScaleSpaceOptions& options, cons
   const double t = s.series.scales.front();
   auto idx = makeSpatialIndex(cloud.positions());
   const SurfaceSamples samplesRef{cloud.positions(), cloud.normals(), *idx};
-  FitOptions fit;
-  fit.mls = true;
-  fit.mlsMaxSteps = options.mlsSteps;
-  fit.mlsTolerance = options.mlsTolerance;
-  fit.robust = options.robust;
+  const FitOptions fit = options.fit;
   tbb::enumerable_thread_specific<FitWorkspace> ws;
   t0 = Clock::now();
   std::vector<std::uint8_t> valid(cloud.size());
@@ -226,11 +222,7 @@ void fig10Bench(const PointCloud& cloud, ScaleSpaceOptions options, const fs::pa
       cloud.size(), m, series.tMin, series.tMax, subset.size());
   auto index = makeSpatialIndex(cloud.positions());
   const SurfaceSamples all{cloud.positions(), cloud.normals(), *index};
-  FitOptions fit;
-  fit.mls = true;
-  fit.mlsMaxSteps = options.mlsSteps;
-  fit.mlsTolerance = options.mlsTolerance;
-  fit.robust = options.robust;
+  const FitOptions fit = options.fit;
   std::vector<std::vector<Vec3>> refP(m, std::vector<Vec3>(subset.size())), refN = refP;
   std::vector<Vec3> current(subset.size());
   for (std::size_t k = 0; k < subset.size(); ++k) current[k] = cloud.positions()[subset[k]];
@@ -327,8 +319,8 @@ int main(int argc, char** argv) {
   ScaleSpaceOptions options;
   options.series.count = scales;
   options.series.tMax = tMax;
-  options.robust = robust;
-  if (mlsSteps > 0) options.mlsSteps = mlsSteps;
+  options.fit.robust = robust;
+  if (mlsSteps > 0) options.fit.mlsMaxSteps = mlsSteps;
   if (mode == "all" || mode == "sampler" || mode == "timing") {
     const PointCloud cloud = scanLikeCloud(n, 1);
     if (mode != "timing") {

@@ -9,6 +9,7 @@
 #include "FitTestClouds.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/PointCloud.hpp"
+#include "scalespace/fit/FitScratch.hpp"
 #include "scalespace/fit/LocalFit.hpp"
 #include "scalespace/fit/OrientedSphereFit.hpp"
 

@@ -52,7 +52,7 @@ TEST(StackPlanes, BoxFacesAreFoundFromTheStack) {
   for (double v : cloud.findAttribute("gt_face")->values) gt.push_back(int(v));
   ScaleSpaceOptions stack;
   stack.series.count = 8;
-  stack.robust = true;  // as `scalespace planes` (Sec. 2.3)
+  stack.fit.robust = true;  // as `scalespace planes` (Sec. 2.3)
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
   const PlaneModel model = makePlaneModel(result.detection);
   ASSERT_EQ(model.scaleCount(), 8);
@@ -98,7 +98,7 @@ PointCloud smallStairs() {
 ScaleSpaceOptions robustStack(int scales) {
   ScaleSpaceOptions stack;
   stack.series.count = scales;
-  stack.robust = true;
+  stack.fit.robust = true;
   return stack;
 }
 

@@ -308,7 +308,7 @@ void addPlanesCommand(CLI::App& app) {
     PointCloud cloud = loadCloud(args->input, args->quiet);
     if (args->stack.empty()) ensureNormals(cloud, args->quiet);
     ScaleSpaceOptions stack;
-    stack.robust = args->robust;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
+    stack.fit.robust = args->robust;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
     stack.series.count = args->scales;
     stack.alpha = args->alpha;
     stack.threads = args->threads;

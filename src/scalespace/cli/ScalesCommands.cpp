@@ -102,9 +102,9 @@ void addScalesCommand(CLI::App& app) {
   cmd->add_option("--alpha", args->options.alpha,
                   "Poisson-disk radius / scale (0 = keep all points)")
       ->capture_default_str();
-  cmd->add_flag("--robust,!--no-robust", args->options.robust,
+  cmd->add_flag("--robust,!--no-robust", args->options.fit.robust,
                 "robust APSS re-weighting (RIMLS, as the planes use; default off)");
-  cmd->add_option("--mls-steps", args->options.mlsSteps, "MLS projection steps per scale")
+  cmd->add_option("--mls-steps", args->options.fit.mlsMaxSteps, "MLS projection steps per scale")
       ->capture_default_str();
   cmd->add_option("--estimator", args->estimator, "w3 | w2 | w1 | plane | mean | quadric | jet")
       ->capture_default_str();
@@ -121,10 +121,9 @@ void addScalesCommand(CLI::App& app) {
     checkOutput(args->output, OutputKind::Stack, {args->input.path});
     ScaleSpaceOptions options = args->options;
     options.series.spacing = parseScaleSpacing(args->spacing);
-    options.estimator = parseEstimator(args->estimator);
-    // Validate the series options before the (possibly long) read.
-    validateScaleCount(options.series.count);
-    if (options.alpha < 0) throw OptionError("--alpha must be >= 0");
+    options.fit.estimator = parseEstimator(args->estimator);
+    // Validate the options before the (possibly long) read.
+    validateScaleSpaceOptions(options);
     StackWriteOptions write;
     write.encoding = parseStackEncoding(args->encoding);
     ThreadScope threads(options.threads);

@@ -32,7 +32,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"ScaleSeriesOptions::spacing", "--spacing"},
     {"ScaleSeriesOptions::tMin", "--tmin"},
     {"ScaleSeriesOptions::tMax", "--tmax"},
-    {"ScaleSpaceOptions::mlsSteps", "--mls-steps"},
+    {"FitOptions::mlsMaxSteps", "--mls-steps"},
     {"ScaleSpaceOptions::alpha", "--alpha"},
     {"StackWriteOptions::encoding", "--encoding"},
     {"RenderOptions::up", "--up"},

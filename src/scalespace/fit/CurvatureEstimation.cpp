@@ -13,7 +13,7 @@
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
 #include "scalespace/fit/FitDiagnosis.hpp"
-#include "scalespace/fit/NeighborhoodCache.hpp"
+#include "scalespace/fit/FitPoints.hpp"
 
 namespace scalespace {
 namespace {
@@ -39,9 +39,7 @@ void validateCurvatureOptions(const CurvatureOptions& options) {
     throw OptionError("CurvatureOptions::scaleK must be in [1, " +
                       std::to_string(kMaxNeighborCount) + "], got " +
                       std::to_string(options.scaleK));
-  if (options.fit.minNeighbors < 1)
-    throw OptionError("FitOptions::minNeighbors must be >= 1, got " +
-                      std::to_string(options.fit.minNeighbors));
+  validateFitOptions(options.fit);
 }
 
 namespace {
@@ -53,10 +51,27 @@ void validate(const PointCloud& cloud, const CurvatureOptions& options) {
                 " estimator needs oriented normals: estimate them first (scalespace normals)");
 }
 
+/// Per-point support radii: t_k = distance to the K-th nearest neighbour of point k (the point
+/// itself excluded), widened by a hair because the support is open (|q| < t) and the K-th
+/// neighbour must be inside it.
+std::vector<double> scalesFromNeighborCount(const std::vector<Vec3>& positions,
+                                            const SpatialIndex& index, std::size_t k) {
+  std::vector<double> scales(positions.size());
+  tbb::enumerable_thread_specific<std::vector<Neighbor>> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 256), [&](const auto& r) {
+    std::vector<Neighbor>& nb = found.local();
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      index.knnSearch(positions[i], k + 1, nb);  // + 1: the point is its own nearest neighbour
+      scales[i] = nb.empty() ? 0.0 : std::sqrt(nb.back().distSq) * (1.0 + 1e-9);
+    }
+  });
+  return scales;
+}
+
 /// Calls `visit(k, fit)` for every point, in parallel, k in the processing order that it returns
-/// in `order` (point k is the cloud's point order[k]). The cloud is traversed in
-/// spatial order (core/SpatialOrder) so that consecutive fits touch the same memory: this is
-/// where most of the time goes (neighbour queries and accumulation over ~40 samples).
+/// in `order` (point k is the cloud's point order[k]). The samples are the cloud in spatial order
+/// (core/SpatialOrder), so that consecutive fits touch the same memory, and the fits are
+/// fitPoints' walk over them.
 void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
                 const ProgressCallback& progress, CurvatureSummary& summary,
                 const std::function<void(std::size_t, const LocalFit&)>& visit,
@@ -69,82 +84,38 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   if (n == 0) return;
 
   order = spatialOrder(cloud.positions());
-  std::vector<Vec3> positions(n), normals;
-  for (std::size_t k = 0; k < n; ++k) positions[k] = cloud.positions()[order[k]];
-  if (cloud.hasNormals()) {
-    normals.resize(n);
-    for (std::size_t k = 0; k < n; ++k) normals[k] = cloud.normals()[order[k]];
-  }
+  const std::vector<Vec3> positions = applyPermutation(cloud.positions(), order);
+  const std::vector<Vec3> normals =
+      cloud.hasNormals() ? applyPermutation(cloud.normals(), order) : std::vector<Vec3>{};
   const std::unique_ptr<SpatialIndex> index = makeSpatialIndex(positions);
   const SurfaceSamples samples{positions, normals, *index};
   summary.setupSeconds = secondsSince(start);
   const auto fitStart = std::chrono::steady_clock::now();
 
-  std::vector<double> scales(n, options.scale);
-  struct Counters {
-    std::size_t invalid = 0;
-    double neighbors = 0, allNeighbors = 0;
-    FitWorkspace workspace;
-  };
-  tbb::enumerable_thread_specific<Counters> counters;
-  auto fitOne = [&](std::size_t k, Counters& c) {
-    double t = options.scale;
-    if (options.scaleK > 0) {
-      // K + 1 because the point itself is its own nearest neighbour.
-      index->knnSearch(positions[k], std::size_t(options.scaleK) + 1, c.workspace.neighbors);
-      t = c.workspace.neighbors.empty() ? 0.0 : std::sqrt(c.workspace.neighbors.back().distSq);
-      // The support is open (|q| < t): widen by a hair so the K-th neighbour is inside it.
-      t *= 1.0 + 1e-9;
-      scales[k] = t;
-    }
-    LocalFit fit;
-    if (t > 0) fit = fitAt(positions[k], t, samples, options.fit, c.workspace);
-    c.allNeighbors += fit.neighbors;
-    if (fit.valid)
-      c.neighbors += fit.neighbors;
-    else
-      ++c.invalid;
-    visit(k, fit);
-  };
-  ProgressTracker tracker(progress, "fitting", n);
-  // At a fixed scale, consecutive (Morton-ordered) points share most neighbours: their fits read
-  // one prefetched ball per block (fit/NeighborhoodCache). Per-point scales (scaleK) query alone.
-  const double slack = options.fit.mls ? kMlsSlack : 0.0;
-  const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 4), [&](const auto& range) {
-    Counters& c = counters.local();
-    for (std::size_t g = range.begin(); g != range.end(); ++g) {
-      auto fit = [&](std::size_t k) { fitOne(k, c); };
-      if (options.scaleK == 0) {
-        tracker.advance(
-            fitGroupByBlocks(positions, g, samples, options.scale, slack, c.workspace.cache, fit));
-      } else {
-        const std::size_t end = std::min(n, (g + 1) * kPrefetchGroup);
-        for (std::size_t k = g * kPrefetchGroup; k < end; ++k) fit(k);
-        tracker.advance(end - g * kPrefetchGroup);
-      }
-    }
-  });
-  tracker.finish();
+  const std::vector<double> scales =
+      options.scaleK > 0 ? scalesFromNeighborCount(positions, *index, std::size_t(options.scaleK))
+                         : std::vector<double>{options.scale};
+  FitPointsOptions walk;
+  walk.fit = options.fit;
+  walk.walk = QueryWalk::AsGiven;
+  const FitPointsSummary fits = fitPoints(
+      samples, FitQueries{positions, scales}, walk,
+      [&](std::size_t k, std::size_t, const LocalFit& f) { visit(k, f); }, progress);
   summary.fitSeconds = secondsSince(fitStart);
 
-  double allNeighbors = 0;
-  for (const Counters& c : counters) {
-    summary.invalid += c.invalid;
-    summary.meanNeighbors += c.neighbors;
-    allNeighbors += c.allNeighbors;
-  }
+  summary.invalid = fits.invalid;
   const std::size_t valid = n - summary.invalid;
-  summary.meanNeighbors = valid ? summary.meanNeighbors / double(valid) : 0.0;
+  summary.meanNeighbors = valid ? fits.validNeighbors / double(valid) : 0.0;
   FitCounts counts;
   counts.total = n;
   counts.invalid = summary.invalid;
-  counts.largestScale = n ? *std::max_element(scales.begin(), scales.end()) : 0.0;
-  counts.meanNeighbors = n ? allNeighbors / double(n) : 0.0;
+  counts.largestScale = *std::max_element(scales.begin(), scales.end());
+  counts.meanNeighbors = fits.neighbors / double(n);
   counts.minNeighbors = options.fit.minNeighbors;
   summary.warnings = invalidFitWarnings(cloud, counts);
-  std::nth_element(scales.begin(), scales.begin() + n / 2, scales.end());
-  summary.medianScale = scales[n / 2];
+  std::vector<double> median = scales;
+  std::nth_element(median.begin(), median.begin() + median.size() / 2, median.end());
+  summary.medianScale = median[median.size() / 2];
   summary.seconds = secondsSince(start);
 }
 

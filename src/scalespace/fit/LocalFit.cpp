@@ -4,6 +4,7 @@
 #include <string>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/fit/FitScratch.hpp"
 #include "scalespace/fit/JetFit.hpp"
 #include "scalespace/fit/MeanFit.hpp"
 #include "scalespace/fit/NeighborColumns.hpp"
@@ -64,7 +65,7 @@ constexpr double kRobustSigmaN = 0.5;
 /// Gathers the samples within t of y into ws.columns (offsets q = p - y, normals, kernel
 /// weights): the robust passes read them several times. Reads the driver's prefetched samples
 /// when they cover the ball, else queries the index.
-void gatherNeighbors(const Vec3& y, double t, const SurfaceSamples& samples, FitWorkspace& ws) {
+void gatherNeighbors(const Vec3& y, double t, const SurfaceSamples& samples, FitScratch& ws) {
   if (ws.cache.covers(samples, y, t)) {
     ++ws.cache.hits;
     gatherWithin(ws.cache.samples(), y, t, ws.columns);
@@ -83,7 +84,7 @@ void gatherNeighbors(const Vec3& y, double t, const SurfaceSamples& samples, Fit
 
 /// One accumulation over the gathered neighbours with re-weighting factors `rho` (frame centred
 /// at y, so the offsets are the positions).
-OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::vector<double>& rho,
+OrientedSphereFitResult spherePass(double t, const FitScratch& ws, const std::vector<double>& rho,
                                    FitDerivatives order, bool scaleDerivatives, int minNeighbors) {
   OrientedSphereFit acc;
   acc.begin(Vec3::Zero(), t, order, scaleDerivatives);
@@ -93,7 +94,7 @@ OrientedSphereFitResult spherePass(double t, const FitWorkspace& ws, const std::
 
 /// The sphere of the kernel weights alone, without derivatives (what spherePass gives for
 /// FitDerivatives::None and factors 1), with its sums.
-OrientedSphereFitResult kernelSphere(double t, const FitWorkspace& ws, int minNeighbors,
+OrientedSphereFitResult kernelSphere(double t, const FitScratch& ws, int minNeighbors,
                                      SphereSums& sums) {
   kernelWeightedSums(ws.columns, sums);
   OrientedSphereFitResult res;
@@ -115,14 +116,14 @@ FitDerivatives derivativesOf(EstimatorKind kind) {
 }
 
 /// ws.weights, filled with 1 when empty (robustSphere leaves it empty for the kernel-only fit).
-const std::vector<double>& factorsOf(FitWorkspace& ws) {
+const std::vector<double>& factorsOf(FitScratch& ws) {
   if (ws.weights.empty()) ws.weights.assign(ws.columns.size(), 1.0);
   return ws.weights;
 }
 
 /// The pass whose result is reported again, with the spatial derivatives the estimator needs
 /// and the scale derivatives (nu), on the factors left in ws.weights.
-OrientedSphereFitResult reportedPass(double t, const FitOptions& options, FitWorkspace& ws,
+OrientedSphereFitResult reportedPass(double t, const FitOptions& options, FitScratch& ws,
                                      int neighbors) {
   OrientedSphereFitResult res =
       spherePass(t, ws, factorsOf(ws), derivativesOf(options.estimator), true, 1);
@@ -134,7 +135,7 @@ OrientedSphereFitResult reportedPass(double t, const FitOptions& options, FitWor
 /// the next re-weighting, so every pass is made without derivatives except, when `reported` is
 /// set, the last one (redone with derivatives if a re-weighting failed and an earlier pass is
 /// kept). On return ws.weights holds the factors of the returned fit (empty: all 1).
-OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitWorkspace& ws,
+OrientedSphereFitResult robustSphere(double t, const FitOptions& options, FitScratch& ws,
                                      bool reported) {
   const int passes = options.robust ? std::max(0, options.robustIterations) : 0;
   const FitDerivatives order = derivativesOf(options.estimator);
@@ -243,7 +244,7 @@ LocalFit sphereQuantities(const OrientedSphereFitResult& res, const Vec3& y, dou
 /// robust sphere made already without derivatives, with its neighbours in ws.columns and its
 /// factors in ws.weights.
 LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
-                      const FitOptions& options, FitWorkspace& ws,
+                      const FitOptions& options, FitScratch& ws,
                       const OrientedSphereFitResult* given = nullptr, int firstStep = 1) {
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
   Vec3 y = x;
@@ -280,7 +281,7 @@ LocalFit fitSphereMls(const Vec3& x, double t, const SurfaceSamples& samples,
 
 /// The baselines: one fit at y over the neighbours within t.
 LocalFit fitBaseline(const Vec3& y, double t, const SurfaceSamples& samples,
-                     const FitOptions& options, FitWorkspace& ws) {
+                     const FitOptions& options, FitScratch& ws) {
   samples.index.radiusSearch(y, t, ws.neighbors);
   switch (options.estimator) {
     case EstimatorKind::Plane:
@@ -299,8 +300,16 @@ LocalFit fitBaseline(const Vec3& y, double t, const SurfaceSamples& samples,
 
 }  // namespace
 
+FitWorkspace::FitWorkspace() : scratch_(std::make_unique<FitScratch>()) {}
+FitWorkspace::FitWorkspace(const FitWorkspace&) : FitWorkspace() {}
+FitWorkspace::FitWorkspace(FitWorkspace&&) noexcept = default;
+FitWorkspace& FitWorkspace::operator=(const FitWorkspace&) { return *this; }
+FitWorkspace& FitWorkspace::operator=(FitWorkspace&&) noexcept = default;
+FitWorkspace::~FitWorkspace() = default;
+
 LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const FitOptions& options,
                FitWorkspace& workspace) {
+  FitScratch& ws = workspace.scratch();
   if (!(t > 0) || !std::isfinite(t)) {
     throw OptionError("fit scale t must be a positive finite number (got " + std::to_string(t) +
                       ")");
@@ -313,13 +322,13 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
   }
   if (!x.allFinite()) return LocalFit{};
   if (isAlgebraicSphere(options.estimator)) {
-    return fitSphereMls(x, t, samples, options, workspace);
+    return fitSphereMls(x, t, samples, options, ws);
   }
   Vec3 y = x;
   LocalFit fit;
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;
   for (int step = 1; step <= maxSteps; ++step) {
-    fit = fitBaseline(y, t, samples, options, workspace);
+    fit = fitBaseline(y, t, samples, options, ws);
     fit.mlsSteps = step;
     if (!fit.valid) {
       markInvalid(fit);
@@ -344,7 +353,8 @@ LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const Fit
 }
 
 void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSamples& samples,
-                const FitOptions& options, FitWorkspace& ws, LocalFit* out) {
+                const FitOptions& options, FitWorkspace& workspace, LocalFit* out) {
+  FitScratch& ws = workspace.scratch();
   if (count > kFitBatch) throw OptionError("fitAtBatch takes at most 8 points at once");
   bool lanes = count > 1 && isAlgebraicSphere(options.estimator) && options.robust &&
                options.robustIterations > 0 && !(options.robustTolerance > 0) &&
@@ -352,7 +362,7 @@ void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSample
                samples.normals.size() == samples.positions.size();
   for (std::size_t l = 0; l < count && lanes; ++l) lanes = xs[l].allFinite();
   if (!lanes) {
-    for (std::size_t l = 0; l < count; ++l) out[l] = fitAt(xs[l], t, samples, options, ws);
+    for (std::size_t l = 0; l < count; ++l) out[l] = fitAt(xs[l], t, samples, options, workspace);
     return;
   }
   const int maxSteps = options.mls ? std::max(1, options.mlsMaxSteps) : 1;

@@ -2,13 +2,12 @@
 // Contract between the per-point fits (fit/) and the drivers that run them over a cloud
 // (fit/CurvatureEstimation, scales/). One call estimates the differential quantities of the
 // surface near x at scale t from the samples within distance t (Sec. 1.2.1, 1.4).
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Types.hpp"
-#include "scalespace/fit/NeighborhoodCache.hpp"
-#include "scalespace/fit/RobustReweighting.hpp"
 
 namespace scalespace {
 
@@ -96,34 +95,28 @@ struct SurfaceSamples {
   const SpatialIndex& index;
 };
 
-/// Per-thread scratch memory, reused across calls to avoid allocations in the hot loop.
-struct FitWorkspace {
-  /// Samples prefetched by the driver for nearby fits (the APSS fits read them when they cover
-  /// the support ball, fit/NeighborhoodCache.hpp); empty unless the driver fills it.
-  NeighborhoodCache cache;
-  std::vector<Neighbor> neighbors;
-  NeighborColumns columns;                    // the neighbours of the current fit (p - x, n)
-  std::vector<double> weights, trialWeights;  // robust re-weighting factors
-  /// fitAtBatch's neighbours and factors, point by point, and the neighbours interleaved.
-  NeighborColumns batchColumns[InterleavedColumns::kLanes];
-  std::vector<double> batchFactors[InterleavedColumns::kLanes];
-  InterleavedColumns interleaved;
+struct FitScratch;  // fit/FitScratch.hpp, internal to fit/
+
+/// Scratch memory that one thread reuses across fits (no allocation in the hot loop). What it
+/// holds is private to fit/; a copy starts with empty scratch of its own.
+class FitWorkspace {
+ public:
+  FitWorkspace();
+  FitWorkspace(const FitWorkspace&);
+  FitWorkspace(FitWorkspace&&) noexcept;
+  FitWorkspace& operator=(const FitWorkspace&);
+  FitWorkspace& operator=(FitWorkspace&&) noexcept;
+  ~FitWorkspace();
+  FitScratch& scratch() { return *scratch_; }
+
+ private:
+  std::unique_ptr<FitScratch> scratch_;
 };
 
-/// Estimates the differential quantities at x with support radius t.
+/// Estimates the differential quantities at x with support radius t: one fit, the slow path.
+/// Many points: fitPoints (fit/FitPoints.hpp) walks them in spatial order and shares their
+/// neighbour queries.
 LocalFit fitAt(const Vec3& x, double t, const SurfaceSamples& samples, const FitOptions& options,
                FitWorkspace& workspace);
-
-/// The most points fitAtBatch takes at once.
-constexpr std::size_t kFitBatch = InterleavedColumns::kLanes;
-
-/// fitAt at each of xs[0..count) (count <= kFitBatch) into out[0..count). For the robust APSS
-/// estimators (no robustTolerance) on CPUs with AVX-512, the first MLS step of every point is
-/// made at once, one point per lane (robustSpheresInLanes); each point then goes on alone as in
-/// fitAt (derivatives, further MLS steps). The results are fitAt's up to the last bits (the sums
-/// are made in another order); options.expectFirstStepConverged is not read (the first step's
-/// derivatives are made once it has converged).
-void fitAtBatch(const Vec3* xs, std::size_t count, double t, const SurfaceSamples& samples,
-                const FitOptions& options, FitWorkspace& workspace, LocalFit* out);
 
 }  // namespace scalespace

@@ -99,11 +99,11 @@ std::vector<Index> increasingIndices(const std::vector<Index>& accepted,
   return out;
 }
 
-// r(i, k) of the rejection rule: the larger radius (homogeneous: the radius).
+// r(i, k) of the rejection rule: the larger separation (homogeneous: the separation).
 template <class RadiusOf>
 std::vector<Index> gridSample(const std::vector<Vec3>& positions,
-                              const std::vector<Index>& candidates, double maxRadius,
-                              const RadiusOf& radiusOf, std::uint64_t seed) {
+                              const std::vector<Index>& candidates, double maxSeparation,
+                              const RadiusOf& separationOf, std::uint64_t seed) {
   if (candidates.empty()) return {};
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (Index i : candidates) {
@@ -113,7 +113,7 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
   // A cell of size >= r keeps every conflict within the 27 neighbouring cells; grow it when the
   // grid would overflow the 21-bit cell coordinates (still correct, just more points per cell).
   const double extent = (hi - lo).maxCoeff();
-  const double cell = std::max(maxRadius, extent / double(kCellMax));
+  const double cell = std::max(maxSeparation, extent / double(kCellMax));
   std::vector<Candidate> c(candidates.size());
   parallelFor(candidates.size(), [&](std::size_t k) {
     const Index i = candidates[k];
@@ -168,7 +168,7 @@ std::vector<Index> gridSample(const std::vector<Vec3>& positions,
               for (int nb = 0; nb < nearCount && free; ++nb) {
                 const std::size_t f = near[nb];
                 for (std::size_t a = cellBegin[f]; a < cellBegin[f] + acceptedCount[f]; ++a) {
-                  const double r = radiusOf(candidate, accepted[a]);
+                  const double r = separationOf(candidate, accepted[a]);
                   if ((positions[accepted[a]] - p).squaredNorm() < r * r) {
                     free = false;
                     break;
@@ -197,45 +197,46 @@ std::uint64_t pyramidLevelSeed(std::uint64_t seed, std::size_t level) {
 }
 
 std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
-                                     const std::vector<Index>& candidates, double radius,
+                                     const std::vector<Index>& candidates, double separation,
                                      std::uint64_t seed) {
-  if (!std::isfinite(radius)) throw OptionError("Poisson-disk radius must be finite");
-  if (radius <= 0) {
+  if (!std::isfinite(separation)) throw OptionError("Poisson-disk separation must be finite");
+  if (separation <= 0) {
     std::vector<Index> all = candidates;
     std::sort(all.begin(), all.end());
     return all;
   }
   return gridSample(
-      positions, candidates, radius, [radius](Index, Index) { return radius; }, seed);
+      positions, candidates, separation, [separation](Index, Index) { return separation; }, seed);
 }
 
 std::vector<Index> poissonDiskSampleAdaptive(const std::vector<Vec3>& positions,
                                              const std::vector<Index>& candidates,
-                                             const std::vector<double>& radii, std::uint64_t seed) {
-  if (radii.size() != positions.size())
-    throw OptionError("adaptive Poisson-disk sampling: " + std::to_string(radii.size()) +
-                      " radii for " + std::to_string(positions.size()) + " points");
-  double maxRadius = 0;
+                                             const std::vector<double>& separations,
+                                             std::uint64_t seed) {
+  if (separations.size() != positions.size())
+    throw OptionError("adaptive Poisson-disk sampling: " + std::to_string(separations.size()) +
+                      " separations for " + std::to_string(positions.size()) + " points");
+  double maxSeparation = 0;
   for (Index i : candidates) {
-    if (!std::isfinite(radii[i]) || radii[i] < 0)
-      throw OptionError("adaptive Poisson-disk radius of point " + std::to_string(i) +
+    if (!std::isfinite(separations[i]) || separations[i] < 0)
+      throw OptionError("adaptive Poisson-disk separation of point " + std::to_string(i) +
                         " must be finite and >= 0");
-    maxRadius = std::max(maxRadius, radii[i]);
+    maxSeparation = std::max(maxSeparation, separations[i]);
   }
-  if (maxRadius <= 0) {
+  if (maxSeparation <= 0) {
     std::vector<Index> all = candidates;
     std::sort(all.begin(), all.end());
     return all;
   }
   return gridSample(
-      positions, candidates, maxRadius,
-      [&radii](Index a, Index b) { return std::max(radii[a], radii[b]); }, seed);
+      positions, candidates, maxSeparation,
+      [&separations](Index a, Index b) { return std::max(separations[a], separations[b]); }, seed);
 }
 
 std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
-                                           const std::vector<Index>& candidates, double radius,
+                                           const std::vector<Index>& candidates, double separation,
                                            std::uint64_t seed) {
-  if (radius <= 0) {
+  if (separation <= 0) {
     std::vector<Index> all = candidates;
     std::sort(all.begin(), all.end());
     return all;
@@ -256,26 +257,37 @@ std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
   for (std::size_t k : order) {
     if (removed[k]) continue;
     out.push_back(candidates[k]);
-    index->radiusSearch(pts[k], radius, nb);
+    index->radiusSearch(pts[k], separation, nb);
     for (const Neighbor& n : nb) removed[n.index] = 1;
   }
   std::sort(out.begin(), out.end());
   return out;
 }
 
-SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
-                                 const std::vector<double>& scales, double alpha,
-                                 std::uint64_t seed, const ProgressCallback& progress) {
+void validatePyramidAlpha(double alpha) {
   if (!(alpha >= 0) || !std::isfinite(alpha))
     throw OptionError(
         "ScaleSpaceOptions::alpha (Poisson-disk radius / scale) must be finite and >= 0, got " +
         std::to_string(alpha));
+}
+
+std::vector<Index> samplePyramidLevel(const std::vector<Vec3>& positions,
+                                      const std::vector<Index>& previous, double alpha, double t,
+                                      std::uint64_t seed, std::size_t level) {
+  validatePyramidAlpha(alpha);
+  return poissonDiskSample(positions, previous, poissonDiskSeparation(alpha, t),
+                           pyramidLevelSeed(seed, level));
+}
+
+SamplePyramid buildSamplePyramid(const std::vector<Vec3>& positions,
+                                 const std::vector<double>& scales, double alpha,
+                                 std::uint64_t seed, const ProgressCallback& progress) {
+  validatePyramidAlpha(alpha);
   SamplePyramid pyramid;
   std::vector<Index> previous(positions.size());
   std::iota(previous.begin(), previous.end(), Index(0));
   for (std::size_t j = 0; j < scales.size(); ++j) {
-    std::vector<Index> level = poissonDiskSample(
-        positions, previous, poissonDiskSeparation(alpha, scales[j]), pyramidLevelSeed(seed, j));
+    std::vector<Index> level = samplePyramidLevel(positions, previous, alpha, scales[j], seed, j);
     pyramid.radii.push_back(alpha * scales[j]);
     pyramid.levels.push_back(level);
     previous = std::move(level);

@@ -29,22 +29,23 @@
 
 namespace scalespace {
 
-/// The Poisson-disk subset of `candidates` (indices into `positions`) with radius `radius`,
-/// sorted by increasing index. radius <= 0 keeps every candidate. Throws OptionError on a
-/// non-finite radius.
+/// The Poisson-disk subset of `candidates` (indices into `positions`) whose samples are at least
+/// `separation` apart, sorted by increasing index. separation <= 0 keeps every candidate. Throws
+/// OptionError on a non-finite separation.
 std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
-                                     const std::vector<Index>& candidates, double radius,
+                                     const std::vector<Index>& candidates, double separation,
                                      std::uint64_t seed);
 
-/// Adaptive variant: radii[i] is the radius of point i (indexed like `positions`).
+/// Adaptive variant: separations[i] is the separation of point i (indexed like `positions`).
 std::vector<Index> poissonDiskSampleAdaptive(const std::vector<Vec3>& positions,
                                              const std::vector<Index>& candidates,
-                                             const std::vector<double>& radii, std::uint64_t seed);
+                                             const std::vector<double>& separations,
+                                             std::uint64_t seed);
 
 /// Reference: the thesis' greedy sequential sampler (random order, kd-tree radius query around
 /// each accepted sample). Same rule, different visiting order; used by tests and the bench.
 std::vector<Index> poissonDiskSampleGreedy(const std::vector<Vec3>& positions,
-                                           const std::vector<Index>& candidates, double radius,
+                                           const std::vector<Index>& candidates, double separation,
                                            std::uint64_t seed);
 
 /// Minimum distance between two samples of the level of scale t: 2 r = 2 alpha t (Eq. 1.41).
@@ -57,6 +58,16 @@ struct SamplePyramid {
   std::vector<std::vector<Index>> levels;
   std::vector<double> radii;  // disk radius r_j = alpha t_j; samples are >= 2 r_j apart
 };
+
+/// OptionError unless alpha is finite and >= 0 (ScaleSpaceOptions::alpha).
+void validatePyramidAlpha(double alpha);
+
+/// Pyramid level `level` (scale t) drawn from the level before it, `previous`, with disk radius
+/// alpha t, i.e. separation 2 alpha t: what buildSamplePyramid and the stack (scales/ScaleSpace,
+/// which draws each level while the previous scale projects) both run.
+std::vector<Index> samplePyramidLevel(const std::vector<Vec3>& positions,
+                                      const std::vector<Index>& previous, double alpha, double t,
+                                      std::uint64_t seed, std::size_t level);
 
 /// Level j drawn from level j-1 (level 0 from all points) with disk radius r_j = alpha scales[j],
 /// i.e. separation 2 r_j (Sec. 1.5.2). alpha = 0 keeps every point at every level. Throws

@@ -14,16 +14,11 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
+#include "scalespace/fit/FitPoints.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
 
 namespace scalespace {
 namespace {
-
-/// The shortest run of a block that fitAtBatch takes (shorter runs are fitted point by point):
-/// its lanes cost the same whether they are full or not, so a short run wastes most of them. The
-/// value is the best of those compared on a robust stack's time (bench/bench_planes --scene
-/// stairs; the figures are in bench/README.md).
-constexpr std::size_t kMinBatch = 6;
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -113,12 +108,12 @@ struct PyramidLevel {
 };
 
 /// Level j drawn from the level before it (`previous`) with disk radius r_j = alpha t_j (nested
-/// pyramid), with its samples' positions, normals and index.
+/// pyramid, samplePyramidLevel), with its samples' positions, normals and index.
 void makePyramidLevel(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
-                      const std::vector<Index>& previous, double radius, std::uint64_t seed,
-                      PyramidLevel& level) {
+                      const std::vector<Index>& previous, double alpha, double t,
+                      std::uint64_t seed, std::size_t j, PyramidLevel& level) {
   auto t0 = std::chrono::steady_clock::now();
-  level.members = poissonDiskSample(positions, previous, radius, seed);
+  level.members = samplePyramidLevel(positions, previous, alpha, t, seed, j);
   level.samplingSeconds = secondsSince(t0);
   t0 = std::chrono::steady_clock::now();
   level.positions.resize(level.members.size());
@@ -179,6 +174,15 @@ std::uint64_t cloudChecksum(const PointCloud& cloud) {
   return h;
 }
 
+void validateScaleSpaceOptions(const ScaleSpaceOptions& options) {
+  validateScaleCount(options.series.count);
+  validatePyramidAlpha(options.alpha);
+  validateFitOptions(options.fit);
+  if (!options.fit.mls)
+    throw OptionError(
+        "ScaleSpaceOptions::fit.mls must be true: the stack projects every point (Fig. 1.9)");
+}
+
 ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions& options,
                                 const ScaleSink& sink, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -187,10 +191,7 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
     throw OptionError(
         "the multi-scale projection needs oriented normals: estimate and orient them first "
         "(core/NormalEstimation + NormalOrientation; the CLI does it when they are missing)");
-  if (options.mlsSteps < 1)
-    throw OptionError("ScaleSpaceOptions::mlsSteps must be >= 1, got " +
-                      std::to_string(options.mlsSteps));
-  if (!(options.mlsTolerance > 0)) throw OptionError("MLS tolerance must be > 0 (fraction of t)");
+  validateScaleSpaceOptions(options);
   ThreadLimit limit(options.threads);
 
   ScaleSpaceSummary summary;
@@ -205,19 +206,6 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   summary.series = makeScaleSeries(positions, options.series);
   const std::vector<double>& scales = summary.series.scales;
   const std::size_t m = scales.size();
-  if (!(options.alpha >= 0) || !std::isfinite(options.alpha))
-    throw OptionError("ScaleSpaceOptions::alpha must be finite and >= 0, got " +
-                      std::to_string(options.alpha));
-
-  FitOptions fit;
-  fit.estimator = options.estimator;
-  fit.mls = true;
-  fit.mlsMaxSteps = options.mlsSteps;
-  fit.mlsTolerance = options.mlsTolerance;
-  fit.robust = options.robust;
-  fit.robustIterations = options.robustIterations;
-  fit.robustTolerance = options.robustTolerance;
-  fit.minNeighbors = options.minNeighbors;
 
   std::vector<Vec3> current = positions;  // projection at the previous scale (Fig. 1.9)
   // Level 0 draws from every point.
@@ -229,17 +217,22 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
   sizeLayer(spatial, n, options.layerContents);
   if (inputOrder) sizeLayer(layer, n, options.layerContents);
   if (!inputOrder) spatial.inputIndex = order;
-  tbb::enumerable_thread_specific<FitWorkspace> workspaces;
-  std::vector<std::uint32_t> neighborCount(n);
-  std::vector<std::uint8_t> mlsSteps(n);
+  // Each scale starts from the projections of the previous one (`current`) and writes this
+  // scale's into `next`; a point converged at its first MLS step at the previous scale likely
+  // does again (FitQueries::convergedAtFirstStep).
+  std::vector<Vec3> next(n);
+  std::vector<std::uint8_t> convergedBefore(n, 0), convergedNow(n, 0);
+  std::vector<double> scaleOfAll(1);
+  FitPointsOptions walk;
+  walk.fit = options.fit;
+  walk.walk = QueryWalk::AsGiven;  // the points are in Morton order already
   // Level j + 1 of the pyramid depends on level j only, not on the projection: it is drawn and
   // indexed in a task while scale j projects (the index build is sequential and would leave the
   // other cores idle; bench/fig_1_10 --mode timing prints both times per scale).
   PyramidLevel thisLevel, nextLevel;
   tbb::task_group prepare;
   auto prepareLevel = [&](std::size_t j, const std::vector<Index>& previous, PyramidLevel& out) {
-    makePyramidLevel(positions, normals, previous, poissonDiskSeparation(options.alpha, scales[j]),
-                     pyramidLevelSeed(options.seed, j), out);
+    makePyramidLevel(positions, normals, previous, options.alpha, scales[j], options.seed, j, out);
   };
   prepareLevel(0, everyPoint, thisLevel);
   everyPoint = {};
@@ -263,50 +256,22 @@ ScaleSpaceSummary runScaleSpace(const PointCloud& cloud, const ScaleSpaceOptions
                             "scale " + std::to_string(j + 1) + "/" + std::to_string(m));
           })
                    : ProgressCallback();
-      ProgressTracker tracker(scaleProgress, "projection", n);
-      // Neighbour-query reuse (fit/NeighborhoodCache): the radius-t queries of all MLS steps of a
-      // block of Morton-ordered points are answered by one index query, unless a step moves a
-      // point more than kMlsSlack t out of the block.
-      auto record = [&](std::size_t k, const LocalFit& f) {
-        neighborCount[k] = std::uint32_t(std::max(0, f.neighbors));
-        mlsSteps[k] = std::uint8_t(std::clamp(f.mlsSteps, 0, 255));
-        if (f.valid) current[k] = f.projection;  // else keep the last one
-        recordFit(f, current[k], k, options.layerContents, spatial);
+      auto record = [&](std::size_t k, std::size_t, const LocalFit& f) {
+        convergedNow[k] = f.mlsSteps == 1;
+        next[k] = f.valid ? f.projection : current[k];  // an invalid fit keeps the last one
+        recordFit(f, next[k], k, options.layerContents, spatial);
       };
-      // A block's points go through fitAtBatch eight at a time (their MLS steps side by side);
-      // a run of fewer than kMinBatch points (the blocks of the finest scales) one by one,
-      // where a lane kernel would run mostly empty.
-      auto projectGroup = [&](std::size_t g, FitWorkspace& ws) {
-        FitOptions pointFit = fit;
-        return fitGroupInRuns(current, g, samples, t, kMlsSlack, ws.cache, kFitBatch,
-                              [&](std::size_t k, std::size_t count) {
-                                if (count < kMinBatch) {
-                                  for (std::size_t i = k; i < k + count; ++i) {
-                                    pointFit.expectFirstStepConverged = j > 0 && mlsSteps[i] == 1;
-                                    record(i, fitAt(current[i], t, samples, pointFit, ws));
-                                  }
-                                  return;
-                                }
-                                LocalFit fits[kFitBatch];
-                                fitAtBatch(&current[k], count, t, samples, fit, ws, fits);
-                                for (std::size_t i = 0; i < count; ++i) record(k + i, fits[i]);
-                              });
-      };
-      const std::size_t groups = (n + kPrefetchGroup - 1) / kPrefetchGroup;
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups, 8),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          FitWorkspace& ws = workspaces.local();
-                          for (std::size_t g = r.begin(); g != r.end(); ++g)
-                            tracker.advance(projectGroup(g, ws));
-                        });
-      tracker.finish();
+      scaleOfAll[0] = t;
+      const FitPointsSummary fits =
+          fitPoints(samples, FitQueries{current, scaleOfAll, j > 0 ? &convergedBefore : nullptr},
+                    walk, record, scaleProgress);
+      std::swap(current, next);
+      std::swap(convergedBefore, convergedNow);
       if (inputOrder) toInputOrder(spatial, rank, options.layerContents, layer);
       const ScaleLayer& result = inputOrder ? layer : spatial;
       stats.projectionSeconds = secondsSince(t0);
-      double sum = 0, steps = 0;
-      for (std::size_t k = 0; k < n; ++k) sum += neighborCount[k], steps += mlsSteps[k];
-      stats.meanNeighbors = sum / double(n);
-      stats.meanMlsSteps = steps / double(n);
+      stats.meanNeighbors = fits.neighbors / double(n);
+      stats.meanMlsSteps = fits.mlsSteps / double(n);
       for (std::uint8_t v : result.valid) stats.validPoints += v;
       summary.stats.push_back(stats);
       if (sink) sink(j, result, stats);
@@ -340,7 +305,7 @@ FitCounts stackFitCounts(const ScaleSpaceSummary& summary, std::size_t points,
                          const ScaleSpaceOptions& options) {
   FitCounts counts;
   counts.largestScale = summary.series.tMax;
-  counts.minNeighbors = options.minNeighbors;
+  counts.minNeighbors = options.fit.minNeighbors;
   for (const ScaleStats& stats : summary.stats) {
     counts.total += points;
     counts.invalid += points - stats.validPoints;

@@ -31,22 +31,25 @@ enum class LayerOrder {
               // that reorders something smaller (the stack writer: the encoded bytes)
 };
 
+/// The fit each point makes at each scale of the stack: W3, MLS projection from the previous
+/// scale's projection, so few steps are needed (docs/THESIS_NOTES.md, robust APSS parameters:
+/// the authors allow up to 10, stop below 0.01 t). Robust re-weighting (RIMLS, Sec. 2.3) is what
+/// the planes of Chapter 2 use; it is off by default: Sec. 1.5 builds the representation with
+/// the plain APSS, which is much cheaper (bench/fig_1_10 --mode timing --robust 0, then 1).
+inline FitOptions stackFitOptions() {
+  FitOptions fit;
+  fit.mls = true;
+  fit.mlsMaxSteps = 10;
+  fit.mlsTolerance = 0.01;
+  return fit;
+}
+
 struct ScaleSpaceOptions {
   ScaleSeriesOptions series;  // M = 50 log-spaced scales by default (Sec. 1.5.1)
   double alpha = 0.1;  // Poisson-disk radius r_j = alpha t_j (Sec. 1.5.2): samples >= 2 r_j apart
-  /// Robust APSS (RIMLS re-weighting, Sec. 2.3; docs/THESIS_NOTES.md, robust APSS parameters):
-  /// what the planes of Chapter 2 use. Off by default: Sec. 1.5 builds the representation with the
-  /// plain APSS, which is much cheaper (bench/fig_1_10 --mode timing --robust 0, then 1).
-  bool robust = false;
-  int robustIterations = 5;    // re-weightings per fit (docs/THESIS_NOTES.md, robust APSS)
-  double robustTolerance = 0;  // stop re-weighting once factors change less (FitOptions)
-  /// MLS projection steps per scale; each scale starts from the previous scale's projection,
-  /// so few steps are needed (docs/THESIS_NOTES.md, robust APSS parameters: the authors allow up
-  /// to 10, stop below 0.01 t).
-  int mlsSteps = 10;
-  double mlsTolerance = 0.01;  // step < mlsTolerance * t_j stops the projection
-  int minNeighbors = 6;        // fits with fewer samples are invalid (docs/THESIS_NOTES.md)
-  EstimatorKind estimator = EstimatorKind::W3;
+  /// The per-point fit; `fit.mls` must stay on (the stack is a projection, Fig. 1.9) and
+  /// `fit.expectFirstStepConverged` is set point by point from the previous scale.
+  FitOptions fit = stackFitOptions();
   std::uint64_t seed = 1;  // Poisson-disk visiting order
   int threads = 0;         // 0: all cores
   /// NormalAndCurvatures is what plane detection reads: putting only those arrays in input order
@@ -54,6 +57,11 @@ struct ScaleSpaceOptions {
   LayerContents layerContents = LayerContents::All;
   LayerOrder layerOrder = LayerOrder::Input;
 };
+
+/// OptionError naming the field unless the options can run: the scale series' count, alpha, the
+/// fit options (fit/FitPoints.hpp validateFitOptions) and fit.mls on. runScaleSpace checks them
+/// first; a caller can check them before reading its input.
+void validateScaleSpaceOptions(const ScaleSpaceOptions& options);
 
 /// Statistics of one scale (what Fig. 1.11 plots).
 struct ScaleStats {

@@ -57,12 +57,12 @@ nlohmann::json optionsJson(const ScaleSpaceOptions& o) {
           {"tmax_option", o.series.tMax},
           {"K", o.series.K},
           {"alpha", o.alpha},
-          {"robust", o.robust},
-          {"robust_iterations", o.robustIterations},
-          {"mls_steps", o.mlsSteps},
-          {"mls_tolerance", o.mlsTolerance},
-          {"min_neighbors", o.minNeighbors},
-          {"estimator", estimatorName(o.estimator)},
+          {"robust", o.fit.robust},
+          {"robust_iterations", o.fit.robustIterations},
+          {"mls_steps", o.fit.mlsMaxSteps},
+          {"mls_tolerance", o.fit.mlsTolerance},
+          {"min_neighbors", o.fit.minNeighbors},
+          {"estimator", estimatorName(o.fit.estimator)},
           {"seed", o.seed}};
 }
 
