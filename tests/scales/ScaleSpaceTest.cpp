@@ -7,6 +7,8 @@
 
 #include "scales/ScalesTestClouds.hpp"
 #include "scalespace/core/Parallel.hpp"
+#include "scalespace/core/SpatialOrder.hpp"
+#include "scalespace/scales/PoissonDiskSampler.hpp"
 #include "scalespace/scales/ScaleSpace.hpp"
 
 namespace scalespace {
@@ -194,6 +196,48 @@ TEST(ScaleSpace, SamplesShrinkAndStatsAreFilled) {
   EXPECT_LT(s.summary.stats.back().samples, cloud.size() / 10);
   for (const auto& st : s.summary.stats) EXPECT_GE(st.meanNeighbors, 6.0);
   EXPECT_NE(s.summary.inputChecksum, 0u);
+}
+
+// The stack draws its pyramid level by level (each while the previous scale projects) with the
+// function buildSamplePyramid runs: over the Morton-ordered cloud, the same levels.
+TEST(ScaleSpace, TheStackDrawsTheTestedPyramid) {
+  const PointCloud cloud = test::sphereCloud(4000, 1.0);
+  ScaleSpaceOptions o = smallOptions(6);
+  o.alpha = 0.2;
+  const ScaleStack s = computeScaleStackInMemory(cloud, o);
+  const std::vector<Vec3> sorted =
+      applyPermutation(cloud.positions(), spatialOrder(cloud.positions()));
+  const SamplePyramid pyramid =
+      buildSamplePyramid(sorted, s.summary.series.scales, o.alpha, o.seed);
+  ASSERT_EQ(pyramid.levels.size(), s.summary.stats.size());
+  for (std::size_t j = 0; j < pyramid.levels.size(); ++j)
+    EXPECT_EQ(pyramid.levels[j].size(), s.summary.stats[j].samples) << j;
+  EXPECT_LT(pyramid.levels.back().size(), pyramid.levels.front().size());
+}
+
+TEST(ScaleSpace, OptionsAreValidatedBeforeAnyWorkNamingTheField) {
+  const PointCloud cloud = test::sphereCloud(500, 1.0);
+  auto messageOf = [&](const ScaleSpaceOptions& o) -> std::string {
+    try {
+      validateScaleSpaceOptions(o);
+    } catch (const OptionError& e) {
+      EXPECT_THROW(computeScaleStackInMemory(cloud, o), OptionError);
+      return e.what();
+    }
+    return "";
+  };
+  ScaleSpaceOptions o = smallOptions(3);
+  EXPECT_EQ(messageOf(o), "");
+  o.alpha = -1;
+  EXPECT_NE(messageOf(o).find("ScaleSpaceOptions::alpha"), std::string::npos);
+  o = smallOptions(3);
+  o.fit.mls = false;
+  EXPECT_NE(messageOf(o).find("ScaleSpaceOptions::fit.mls"), std::string::npos);
+  o = smallOptions(3);
+  o.fit.mlsMaxSteps = 0;
+  EXPECT_NE(messageOf(o).find("FitOptions::mlsMaxSteps"), std::string::npos);
+  o = smallOptions(0);
+  EXPECT_NE(messageOf(o).find("ScaleSeriesOptions::count"), std::string::npos);
 }
 
 TEST(ScaleSpace, NeedsNormalsAndCanBeCancelled) {
