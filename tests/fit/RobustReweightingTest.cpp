@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "scalespace/fit/OrientedSphereFit.hpp"
+#include "scalespace/fit/RobustLanes.hpp"
 #include "scalespace/fit/RobustReweighting.hpp"
 
 using namespace scalespace;

@@ -7,7 +7,7 @@
 
 #include "scalespace/fit/LocalFit.hpp"
 #include "scalespace/fit/NeighborhoodCache.hpp"
-#include "scalespace/fit/RobustReweighting.hpp"
+#include "scalespace/fit/RobustLanes.hpp"
 
 namespace scalespace {
 

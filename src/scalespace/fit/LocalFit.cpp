@@ -11,7 +11,7 @@
 #include "scalespace/fit/OrientedSphereFit.hpp"
 #include "scalespace/fit/PlaneFit.hpp"
 #include "scalespace/fit/QuadricFit.hpp"
-#include "scalespace/fit/RobustReweighting.hpp"
+#include "scalespace/fit/RobustLanes.hpp"
 #include "scalespace/fit/ShapeOperator.hpp"
 #include "scalespace/fit/WeightKernel.hpp"
 
