@@ -303,15 +303,15 @@ void addPlanesCommand(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     ThreadScope threads(args->threads);
     if (args->scales < 2) throw OptionError("--scales must be >= 2 (persistence needs levels)");
-    validateScaleCount(args->scales);
-    checkOutput(args->output, OutputKind::PlanesResult, {args->input.path, args->stack});
-    PointCloud cloud = loadCloud(args->input, args->quiet);
-    if (args->stack.empty()) ensureNormals(cloud, args->quiet);
     ScaleSpaceOptions stack;
     stack.fit.robust = args->robust;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
     stack.series.count = args->scales;
     stack.alpha = args->alpha;
     stack.threads = args->threads;
+    validateScaleSpaceOptions(stack);  // before the (possibly long) read
+    checkOutput(args->output, OutputKind::PlanesResult, {args->input.path, args->stack});
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    if (args->stack.empty()) ensureNormals(cloud, args->quiet);
     PlaneDetectionOptions options;
     options.growing.maxAngleDegrees = args->angle;
     StackPlaneDetection result;
