@@ -76,6 +76,17 @@ Segmentation referenceGrow(const KnnGraph& graph, const std::vector<Index>& seed
   return seg;
 }
 
+// The grower's regions, checked against the reference's.
+Segmentation grownLikeTheReference(const KnnGraph& graph, const std::vector<Index>& seeds,
+                                   const std::vector<std::uint8_t>& eligible,
+                                   const NearSeedValue& criterion) {
+  const Segmentation seg = growRegionsFromSeeds(graph, seeds, eligible, criterion);
+  const Segmentation expected = referenceGrow(graph, seeds, eligible, criterion);
+  EXPECT_EQ(seg.labels, expected.labels);
+  EXPECT_EQ(seg.regions, expected.regions);
+  return seg;
+}
+
 std::vector<Index> allPointsInOrder(std::size_t n) {
   std::vector<Index> seeds(n);
   for (std::size_t i = 0; i < n; ++i) seeds[i] = Index(i);
@@ -138,11 +149,7 @@ TEST(RegionGrower, ScalarFieldOnAGridMatchesTheBreadthFirstReference) {
   }
   std::vector<Index> seeds = allPointsInOrder(n);
   std::shuffle(seeds.begin(), seeds.end(), rng);
-  const NearSeedValue criterion{value, 0.2};
-  const Segmentation seg = growRegionsFromSeeds(grid, seeds, eligible, criterion);
-  const Segmentation expected = referenceGrow(grid, seeds, eligible, criterion);
-  EXPECT_EQ(seg.labels, expected.labels);
-  EXPECT_EQ(seg.regions, expected.regions);
+  const Segmentation seg = grownLikeTheReference(grid, seeds, eligible, NearSeedValue{value, 0.2});
   EXPECT_GT(seg.regions.size(), 20u);
   // Every eligible point is in a region (all are seeds); each region lies within the tolerance
   // of its seed, so within twice the tolerance of any of its points.
@@ -169,10 +176,7 @@ TEST(RegionGrower, MortonOrderedGraphGivesTheReferenceRegions) {
   const std::vector<Index> seeds =
       seedsByIncreasingKey(pts.size(), [&](Index i) { return pts[i].z(); });
   const NearSeedValue criterion{value, 0.1};
-  const Segmentation seg = growRegionsFromSeeds(graph, seeds, eligible, criterion);
-  const Segmentation expected = referenceGrow(graph, seeds, eligible, criterion);
-  EXPECT_EQ(seg.labels, expected.labels);
-  EXPECT_EQ(seg.regions, expected.regions);
+  const Segmentation seg = grownLikeTheReference(graph, seeds, eligible, criterion);
   EXPECT_GT(seg.regions.size(), 4u);
   const Segmentation again = growRegionsFromSeeds(graph, seeds, eligible, criterion);
   EXPECT_EQ(again.labels, seg.labels);

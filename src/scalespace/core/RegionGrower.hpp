@@ -108,20 +108,22 @@ Segmentation growRegionsFromSeeds(const KnnGraph& graph, const std::vector<Index
     taken[v >> 6] |= std::uint64_t(1) << (v & 63);
   };
   // The seeds as vertices, mapped in one parallel pass (a random read each) before the walk.
+  if (!seeds.empty() && *std::max_element(seeds.begin(), seeds.end()) >= n)
+    throw OptionError("region grower: a seed is out of range for a graph of " + std::to_string(n) +
+                      " points");
   std::vector<Index> seedVertices(seeds.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 4096), [&](const auto& r) {
-    for (std::size_t s = r.begin(); s != r.end(); ++s) {
-      if (seeds[s] >= n)
-        throw OptionError("region grower: seed " + std::to_string(seeds[s]) +
-                          " is out of range for a graph of " + std::to_string(n) + " points");
+    for (std::size_t s = r.begin(); s != r.end(); ++s)
       seedVertices[s] = local ? graph.rank[seeds[s]] : seeds[s];
-    }
   });
 
   // The walk labels the regions; their point lists are then filled in one pass over the points
   // in index order, which gives the increasing lists without sorting each region.
   std::vector<Index> frontier;
   std::vector<std::size_t> regionSize;
+  // A local copy: the walk's calls (the frontier's growth) cannot change it, so what accept()
+  // reads of it (the planes' cos theta) stays in registers.
+  const Criterion walkCriterion = criterion;
   for (const Index seed : seedVertices) {
     if (isTaken(seed)) continue;
     const int id = int(regionSize.size());
@@ -134,7 +136,7 @@ Segmentation growRegionsFromSeeds(const KnnGraph& graph, const std::vector<Index
       frontier.pop_back();
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
         const Index v = adjacency[e];
-        if (isTaken(v) || !criterion.accept(seedPayload, vertex[v].payload)) continue;
+        if (isTaken(v) || !walkCriterion.accept(seedPayload, vertex[v].payload)) continue;
         take(v, id);
         ++size;
         frontier.push_back(v);
