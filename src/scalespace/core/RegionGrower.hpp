@@ -55,7 +55,8 @@ std::vector<Index> seedsByIncreasingKey(std::size_t pointCount, KeyOf&& keyOf) {
   return seeds;
 }
 
-/// Grows one region from each seed not yet taken, in the order of `seeds` (point indices): the
+/// Grows one region from each seed not yet taken, in the order of `seeds` (point indices; taken
+/// by value, as the grower renumbers them in place: move them in when done with them): the
 /// region takes, through the graph's edges, every free eligible point q reached from a point of
 /// the region with criterion.accept(payload(seed), payload(q)). Points with eligible[i] == 0
 /// join no region (label -1); a seed already taken (or ineligible) is skipped. Deterministic:
@@ -63,7 +64,7 @@ std::vector<Index> seedsByIncreasingKey(std::size_t pointCount, KeyOf&& keyOf) {
 /// Throws OptionError when `eligible` does not have one entry per vertex or a seed is out of
 /// range.
 template <class Criterion>
-Segmentation growRegionsFromSeeds(const KnnGraph& graph, const std::vector<Index>& seeds,
+Segmentation growRegionsFromSeeds(const KnnGraph& graph, std::vector<Index> seeds,
                                   const std::vector<std::uint8_t>& eligible,
                                   const Criterion& criterion) {
   using Payload = std::decay_t<decltype(criterion.payload(Index(0)))>;
@@ -107,15 +108,15 @@ Segmentation growRegionsFromSeeds(const KnnGraph& graph, const std::vector<Index
     vertex[v].label = id;
     taken[v >> 6] |= std::uint64_t(1) << (v & 63);
   };
-  // The seeds as vertices, mapped in one parallel pass (a random read each) before the walk.
+  // The seeds as vertices, renumbered in place in one parallel pass (a random read each) before
+  // the walk.
   if (!seeds.empty() && *std::max_element(seeds.begin(), seeds.end()) >= n)
     throw OptionError("region grower: a seed is out of range for a graph of " + std::to_string(n) +
                       " points");
-  std::vector<Index> seedVertices(seeds.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 4096), [&](const auto& r) {
-    for (std::size_t s = r.begin(); s != r.end(); ++s)
-      seedVertices[s] = local ? graph.rank[seeds[s]] : seeds[s];
-  });
+  if (local)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seeds.size(), 4096), [&](const auto& r) {
+      for (std::size_t s = r.begin(); s != r.end(); ++s) seeds[s] = graph.rank[seeds[s]];
+    });
 
   // The walk labels the regions; their point lists are then filled in one pass over the points
   // in index order, which gives the increasing lists without sorting each region.
@@ -124,7 +125,7 @@ Segmentation growRegionsFromSeeds(const KnnGraph& graph, const std::vector<Index
   // A local copy: the walk's calls (the frontier's growth) cannot change it, so what accept()
   // reads of it (the planes' cos theta) stays in registers.
   const Criterion walkCriterion = criterion;
-  for (const Index seed : seedVertices) {
+  for (const Index seed : seeds) {
     if (isTaken(seed)) continue;
     const int id = int(regionSize.size());
     const Payload seedPayload = vertex[seed].payload;

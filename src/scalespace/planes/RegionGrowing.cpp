@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
@@ -41,12 +42,12 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
   // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2, ties by increasing
   // point index, so the result does not depend on anything else. A point with a non-finite
   // normal or curvature seeds nothing.
-  const std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
+  std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
     if (!scale.valid[i] || !scale.normals[i].allFinite())
       return std::numeric_limits<double>::quiet_NaN();
     return double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
   });
-  return growRegionsFromSeeds(graph, seeds, scale.valid,
+  return growRegionsFromSeeds(graph, std::move(seeds), scale.valid,
                               SeedNormalCriterion{scale.normals, cosTheta});
 }
 
