@@ -127,34 +127,6 @@ TEST(RegionGrowing, MortonOrderedWalkGivesTheSameRegions) {
   EXPECT_GT(a.regions.size(), 3u);
 }
 
-TEST(RegionGraph, ChainsJaccardAndPersistence) {
-  EXPECT_DOUBLE_EQ(jaccardIndex({1, 2, 3, 4}, {3, 4, 5}), 2.0 / 5.0);
-  EXPECT_DOUBLE_EQ(jaccardIndex({}, {}), 0.0);
-  auto region = [](std::vector<Index> p) { return FilteredRegion{std::move(p)}; };
-  std::vector<RegionLevel> levels(4);
-  for (int j = 0; j < 4; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
-  levels[0].regions = {region({0, 1, 2, 3}), region({4, 5, 6, 7})};
-  levels[1].regions = {region({4, 5, 6}), region({0, 1, 2, 3, 8})};  // J = 3/4 and 4/5
-  levels[2].regions = {region({0, 1, 2, 3, 4, 5, 6, 8})};  // J with {0,1,2,3,8}: 5/8 > 0.5
-  levels[3].regions = {region({0, 1, 2, 3}), region({4, 5, 6, 8})};  // J = 4/8: not > 0.5
-  const RegionGraph g = buildRegionGraph(levels, 9);
-  EXPECT_EQ(g.successor[0], (std::vector<int>{1, 0}));
-  EXPECT_EQ(g.successor[1], (std::vector<int>{-1, 0}));
-  EXPECT_EQ(g.successor[2], (std::vector<int>{-1}));
-  ASSERT_EQ(g.components.size(), 4u);
-  EXPECT_EQ(g.components[0].birthLevel, 0);  // {0..3} -> {0..3,8} -> {0..6,8}
-  EXPECT_EQ(g.components[0].deathLevel, 2);
-  EXPECT_EQ(g.components[0].persistence(), 2);
-  EXPECT_DOUBLE_EQ(g.components[0].deathScale, 0.3);
-  EXPECT_EQ(g.components[1].persistence(), 1);  // {4..7} -> {4,5,6}
-  EXPECT_EQ(g.components[2].birthLevel, 3);
-  EXPECT_EQ(g.components[2].persistence(), 0);
-  EXPECT_EQ(g.componentLabels(1), (std::vector<int>{0, 0, 0, 0, 1, 1, 1, -1, 0}));
-  // Overlapping regions in one level are a caller bug.
-  levels[3].regions.push_back(region({0}));
-  EXPECT_THROW(buildRegionGraph(levels, 9), OptionError);
-}
-
 TEST(PlaneDetection, CleanBoxEveryFaceIsOneComponentAndPersistenceGrowsWithSize) {
   const BoxRun run = runBox();
   const auto& comps = run.detection.components;

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/core/RegionGraph.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
-#include "scalespace/planes/RegionGraph.hpp"
 
 namespace scalespace {
 

@@ -3,9 +3,12 @@
 // graph and its components, with the time spent in each step (Table 2.1 columns).
 #include <vector>
 
+#include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/core/RegionGraph.hpp"
 #include "scalespace/planes/PlaneComponent.hpp"
-#include "scalespace/planes/RegionGraph.hpp"
+#include "scalespace/planes/RegionGrowing.hpp"
+#include "scalespace/planes/ScaleFeatures.hpp"
 
 namespace scalespace {
 

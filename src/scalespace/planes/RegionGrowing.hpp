@@ -1,21 +1,18 @@
 #pragma once
-// Per-scale planar segmentation (Sec. 2.3.1): seeded region growing on the k-NN graph, then the
-// alpha-shape filter that drops regions smaller than the scale.
+// Per-scale planar segmentation (Sec. 2.3.1): seeded region growing on the k-NN graph (the
+// generic core/RegionGrower.hpp with the planes' seed order and criterion), then the alpha-shape
+// filter that drops regions smaller than the scale.
 #include <vector>
 
+#include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/planes/ScaleFeatures.hpp"
 
 namespace scalespace {
 
 struct RegionGrowingOptions {
   double maxAngleDegrees = 5.0;  // theta of Sec. 2.3.1, against the SEED's normal
-};
-
-/// A partition of the (valid) points at one scale: labels[i] = region of point i or -1.
-struct Segmentation {
-  std::vector<int> labels;
-  std::vector<std::vector<Index>> regions;  // point indices, increasing
 };
 
 /// Seeds by decreasing planarity 1/(k1^2 + k2^2), i.e. increasing k1^2 + k2^2 (stable, index
@@ -30,18 +27,14 @@ struct RegionFilterOptions {
   double alphaFactor = 2.0;
 };
 
-/// A region kept by the filter.
-struct FilteredRegion {
-  std::vector<Index> points;  // increasing
-};
-
-/// Keeps the regions with sqrt(alpha-shape area) >= alphaFactor * t (the docs/THESIS_NOTES.md
-/// reading of "a < 2t"), in their input order. Regions run in parallel; a large region is usually
-/// accepted from the alpha shape of a patch around its middle (alphaShapeAreaAtLeast), so the area
-/// itself is not computed (the components compute theirs at their representative level).
-std::vector<FilteredRegion> filterRegions(const std::vector<Vec3>& positions,
-                                          const Segmentation& segmentation, double t,
-                                          const RegionFilterOptions& options = {},
-                                          const ProgressCallback& progress = {});
+/// Keeps the regions (their increasing point lists) with sqrt(alpha-shape area) >= alphaFactor * t
+/// (the docs/THESIS_NOTES.md reading of "a < 2t"), in their input order. Regions run in parallel; a
+/// large region is usually accepted from the alpha shape of a patch around its middle
+/// (alphaShapeAreaAtLeast), so the area itself is not computed (the components compute theirs at
+/// their representative level).
+std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions,
+                                              const Segmentation& segmentation, double t,
+                                              const RegionFilterOptions& options = {},
+                                              const ProgressCallback& progress = {});
 
 }  // namespace scalespace

@@ -1,4 +1,4 @@
-#include "scalespace/planes/RegionGraph.hpp"
+#include "scalespace/core/RegionGraph.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -26,7 +26,7 @@ namespace {
 std::vector<int> regionLabels(const RegionLevel& level, std::size_t pointCount) {
   std::vector<int> labels(pointCount, -1);
   for (std::size_t r = 0; r < level.regions.size(); ++r)
-    for (Index i : level.regions[r].points) {
+    for (Index i : level.regions[r]) {
       if (i >= pointCount) throw OptionError("region graph: a region holds a point out of range");
       if (labels[i] >= 0) throw OptionError("region graph: regions of one level overlap");
       labels[i] = int(r);
@@ -39,7 +39,7 @@ std::vector<int> RegionGraph::componentLabels(int level) const {
   std::vector<int> labels(pointCount, -1);
   const auto& regions = levels.at(std::size_t(level)).regions;
   for (std::size_t r = 0; r < regions.size(); ++r)
-    for (Index i : regions[r].points) labels[i] = componentOf[std::size_t(level)][r];
+    for (Index i : regions[r]) labels[i] = componentOf[std::size_t(level)][r];
   return labels;
 }
 
@@ -68,11 +68,10 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
     const auto& next = graph.levels[j + 1].regions;
     tbb::parallel_for(std::size_t(0), here.size(), [&](std::size_t r) {
       std::unordered_map<int, std::size_t> overlap;
-      for (Index i : here[r].points)
+      for (Index i : here[r])
         if (nextLabels[i] >= 0) ++overlap[nextLabels[i]];
       for (const auto& [s, common] : overlap) {
-        const std::size_t unionSize =
-            here[r].points.size() + next[std::size_t(s)].points.size() - common;
+        const std::size_t unionSize = here[r].size() + next[std::size_t(s)].size() - common;
         if (double(common) > minJaccard * double(unionSize)) graph.successor[j][r] = s;  // Eq. 2.1
       }
     });

@@ -1,17 +1,20 @@
 #pragma once
-// Multi-scale region graph and its components (Sec. 2.3.2-2.3.3): nodes are the filtered regions
-// of every scale, an edge joins regions of consecutive scales with Jaccard index > 0.5 (Eq. 2.1).
-// Regions of one scale are disjoint, so a node has at most one such successor and one such
-// predecessor: the components are chains, each with a birth and a death level.
+// Multi-scale region graph and its components (Sec. 2.3.2-2.3.3): nodes are the regions of every
+// scale (plain point-index lists, so any primitive's regions fit: the planes' filtered regions),
+// an edge joins regions of consecutive scales with Jaccard index > 0.5 (Eq. 2.1). Regions of one
+// scale are disjoint, so a node has at most one such successor and one such predecessor: the
+// components are chains, each with a birth and a death level.
+#include <cstddef>
 #include <vector>
 
-#include "scalespace/planes/RegionGrowing.hpp"
+#include "scalespace/core/Types.hpp"
 
 namespace scalespace {
 
+/// The regions of one scale: disjoint lists of point indices, each increasing.
 struct RegionLevel {
   double t = 0.0;
-  std::vector<FilteredRegion> regions;
+  std::vector<std::vector<Index>> regions;
 };
 
 /// A component: the chain of regions regionAt[0..] at levels birthLevel..deathLevel.
