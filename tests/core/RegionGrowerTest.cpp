@@ -22,8 +22,19 @@ struct NearSeedValue {
   const std::vector<double>& value;
   double tolerance;
   double payload(Index point) const { return value[point]; }
-  bool accept(double seed, double candidate) const {
+  bool accept(double seed, double, double candidate) const {
     return std::abs(candidate - seed) <= tolerance;
+  }
+};
+
+// A point joins when its value is within `step` of the point it is reached from (and within
+// `tolerance` of the seed's): a criterion that reads the edge, not only the seed.
+struct SmallSteps {
+  const std::vector<double>& value;
+  double tolerance, step;
+  double payload(Index point) const { return value[point]; }
+  bool accept(double seed, double from, double candidate) const {
+    return std::abs(candidate - seed) <= tolerance && std::abs(candidate - from) <= step;
   }
 };
 
@@ -45,9 +56,9 @@ KnnGraph gridGraph(std::size_t width, std::size_t height) {
 // The definition, written plainly: for each seed in turn that is free and eligible, a
 // breadth-first search over the graph's edges (input numbering) through free eligible points
 // accepted against the seed.
+template <class Criterion>
 Segmentation referenceGrow(const KnnGraph& graph, const std::vector<Index>& seeds,
-                           const std::vector<std::uint8_t>& eligible,
-                           const NearSeedValue& criterion) {
+                           const std::vector<std::uint8_t>& eligible, const Criterion& criterion) {
   Segmentation seg;
   seg.labels.assign(graph.size(), -1);
   for (const Index seed : seeds) {
@@ -63,7 +74,7 @@ Segmentation referenceGrow(const KnnGraph& graph, const std::vector<Index>& seed
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
         const Index q = graph.neighbors[e];
         if (!eligible[q] || seg.labels[q] >= 0 ||
-            !criterion.accept(criterion.payload(seed), criterion.payload(q)))
+            !criterion.accept(criterion.payload(seed), criterion.payload(p), criterion.payload(q)))
           continue;
         seg.labels[q] = id;
         region.push_back(q);
@@ -77,9 +88,10 @@ Segmentation referenceGrow(const KnnGraph& graph, const std::vector<Index>& seed
 }
 
 // The grower's regions, checked against the reference's.
+template <class Criterion>
 Segmentation grownLikeTheReference(const KnnGraph& graph, const std::vector<Index>& seeds,
                                    const std::vector<std::uint8_t>& eligible,
-                                   const NearSeedValue& criterion) {
+                                   const Criterion& criterion) {
   const Segmentation seg = growRegionsFromSeeds(graph, seeds, eligible, criterion);
   const Segmentation expected = referenceGrow(graph, seeds, eligible, criterion);
   EXPECT_EQ(seg.labels, expected.labels);
@@ -112,6 +124,39 @@ TEST(RegionGrower, LineOfValuesKnownAnswerFollowsTheSeedOrder) {
   // Points that are no seed and that no region reaches stay unlabelled.
   const Segmentation one = growRegionsFromSeeds(line, {0}, eligible, criterion);
   EXPECT_EQ(one.labels, (std::vector<int>{0, 0, -1, -1, -1}));
+}
+
+// A terrace: values 0 0 0 1 1 1 on a path. Against the seed alone (tolerance 2) it is one region;
+// with steps of at most 0.5 between neighbours, the jump splits it, whatever the seed order.
+TEST(RegionGrower, AStepLargerThanAllowedSplitsARegionTheSeedWouldAccept) {
+  const KnnGraph line = gridGraph(6, 1);
+  const std::vector<double> value{0, 0, 0, 1, 1, 1};
+  const std::vector<std::uint8_t> eligible(6, 1);
+  EXPECT_EQ(
+      grownLikeTheReference(line, allPointsInOrder(6), eligible, NearSeedValue{value, 2.0}).regions,
+      (std::vector<std::vector<Index>>{{0, 1, 2, 3, 4, 5}}));
+  const SmallSteps steps{value, 2.0, 0.5};
+  EXPECT_EQ(grownLikeTheReference(line, allPointsInOrder(6), eligible, steps).regions,
+            (std::vector<std::vector<Index>>{{0, 1, 2}, {3, 4, 5}}));
+  EXPECT_EQ(grownLikeTheReference(line, {5, 0}, eligible, steps).regions,
+            (std::vector<std::vector<Index>>{{3, 4, 5}, {0, 1, 2}}));
+}
+
+// On a grid, a field with ramps and cliffs: the step criterion gives the reference's regions.
+TEST(RegionGrower, StepCriterionOnAGridMatchesTheBreadthFirstReference) {
+  const std::size_t w = 40, h = 30;
+  const KnnGraph grid = gridGraph(w, h);
+  std::vector<double> value(w * h);
+  for (std::size_t y = 0; y < h; ++y)
+    for (std::size_t x = 0; x < w; ++x)
+      value[x + w * y] = 0.05 * double(x) + (x % 13 == 0 ? 1.0 : 0.0) + (y > 17 ? 2.0 : 0.0);
+  std::vector<std::uint8_t> eligible(w * h, 1);
+  for (std::size_t i = 0; i < eligible.size(); i += 29) eligible[i] = 0;
+  std::vector<Index> seeds = allPointsInOrder(w * h);
+  std::reverse(seeds.begin(), seeds.end());
+  const Segmentation seg =
+      grownLikeTheReference(grid, seeds, eligible, SmallSteps{value, 0.6, 0.3});
+  EXPECT_GT(seg.regions.size(), 4u);
 }
 
 TEST(RegionGrower, IneligiblePointsJoinNothingAndBlockTheWay) {

@@ -275,6 +275,7 @@ void addPlanesCommand(CLI::App& app) {
     std::string output, stack;
     int scales = 50;
     double alpha = 0.1, angle = 5.0;
+    PlaneDetectionOptions detection;
     int threads = 0;
     bool quiet = false, robust = true;
   };
@@ -294,6 +295,13 @@ void addPlanesCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--angle", args->angle, "region growing angle theta (degrees)")
       ->capture_default_str();
+  cmd->add_option("--max-step", args->detection.growing.maxStep,
+                  "largest step a region crosses between neighbours along its seed's normal, as a "
+                  "fraction of t (0 = the angle alone, Sec. 2.3.1)")
+      ->capture_default_str();
+  cmd->add_option("--max-rms", args->detection.maxRegionRms,
+                  "drop regions whose plane RMS exceeds this fraction of t (0 = no such filter)")
+      ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")
@@ -308,12 +316,13 @@ void addPlanesCommand(CLI::App& app) {
     stack.series.count = args->scales;
     stack.alpha = args->alpha;
     stack.threads = args->threads;
+    PlaneDetectionOptions options = args->detection;
+    options.growing.maxAngleDegrees = args->angle;
     validateScaleSpaceOptions(stack);  // before the (possibly long) read
+    validatePlaneDetectionOptions(options);
     checkOutput(args->output, OutputKind::PlanesResult, {args->input.path, args->stack});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     if (args->stack.empty()) ensureNormals(cloud, args->quiet);
-    PlaneDetectionOptions options;
-    options.growing.maxAngleDegrees = args->angle;
     StackPlaneDetection result;
     if (args->stack.empty()) {
       result = detectPlanesInCloud(cloud, stack, options, makeProgressBar(args->quiet));

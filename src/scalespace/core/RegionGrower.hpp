@@ -7,13 +7,14 @@
 //   struct SameValue {                                  // a criterion
 //     const std::vector<double>& value;
 //     double payload(Index point) const { return value[point]; }
-//     bool accept(double seed, double candidate) const { return candidate == seed; }
+//     bool accept(double seed, double from, double candidate) const { return candidate == seed; }
 //   };
 //   const Segmentation seg = growRegionsFromSeeds(graph, seeds, eligible, SameValue{value});
 //
-// A criterion's payload(point) is what accept() reads of a point: the grower copies it next to
-// the point's label in the graph's vertex order, so the walk reads one slot per neighbour, near
-// the slots it read last (see KnnGraph), instead of the caller's arrays in input order.
+// A criterion's payload(point) is what accept(seed, from, candidate) reads of a point: the grower
+// copies it next to the point's label in the graph's vertex order, so the walk reads one slot per
+// neighbour, near the slots it read last (see KnnGraph), instead of the caller's arrays in input
+// order.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -57,8 +58,9 @@ std::vector<Index> seedsByIncreasingKey(std::size_t pointCount, KeyOf&& keyOf) {
 
 /// Grows one region from each seed not yet taken, in the order of `seeds` (point indices; taken
 /// by value, as the grower renumbers them in place: move them in when done with them): the
-/// region takes, through the graph's edges, every free eligible point q reached from a point of
-/// the region with criterion.accept(payload(seed), payload(q)). Points with eligible[i] == 0
+/// region takes, through the graph's edges, every free eligible point q reached from a point p of
+/// the region with criterion.accept(payload(seed), payload(p), payload(q)) (the seed bounds what
+/// the region may become, p what a single step may cross). Points with eligible[i] == 0
 /// join no region (label -1); a seed already taken (or ineligible) is skipped. Deterministic:
 /// the result depends on the graph, the seeds, `eligible` and the criterion only.
 /// Throws OptionError when `eligible` does not have one entry per vertex or a seed is out of
@@ -137,7 +139,8 @@ Segmentation growRegionsFromSeeds(const KnnGraph& graph, std::vector<Index> seed
       frontier.pop_back();
       for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
         const Index v = adjacency[e];
-        if (isTaken(v) || !walkCriterion.accept(seedPayload, vertex[v].payload)) continue;
+        if (isTaken(v) || !walkCriterion.accept(seedPayload, vertex[p].payload, vertex[v].payload))
+          continue;
         take(v, id);
         ++size;
         frontier.push_back(v);

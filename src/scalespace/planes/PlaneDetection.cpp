@@ -1,6 +1,7 @@
 #include "scalespace/planes/PlaneDetection.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "scalespace/core/Error.hpp"
 
@@ -12,6 +13,22 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 }
 }  // namespace
 
+void validatePlaneDetectionOptions(const PlaneDetectionOptions& options) {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw OptionError(what);
+  };
+  const double angle = options.growing.maxAngleDegrees, step = options.growing.maxStep;
+  require(angle > 0 && angle < 180, "RegionGrowingOptions::maxAngleDegrees must be in (0, 180)");
+  require(std::isfinite(step) && step >= 0,
+          "RegionGrowingOptions::maxStep must be finite and >= 0");
+  require(std::isfinite(options.maxRegionRms) && options.maxRegionRms >= 0,
+          "RegionFilterOptions::maxRms must be finite and >= 0");
+  require(std::isfinite(options.alphaFactor) && options.alphaFactor > 0,
+          "RegionFilterOptions::alphaFactor must be positive");
+  require(options.minJaccard >= 0 && options.minJaccard < 1,
+          "PlaneDetectionOptions::minJaccard must be in [0, 1)");
+}
+
 RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
                          const ScaleFeatures& scale, const PlaneDetectionOptions& options,
                          PlaneDetectionTimings& timings) {
@@ -21,9 +38,10 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
   start = std::chrono::steady_clock::now();
   RegionFilterOptions filter;
   filter.alphaFactor = options.alphaFactor;
+  filter.maxRms = options.maxRegionRms;
   RegionLevel level;
   level.t = scale.t;
-  level.regions = filterRegions(positions, seg, scale.t, filter);
+  level.regions = filterRegions(positions, seg, scale.t, filter, {}, scale.projections);
   timings.filtering += secondsSince(start);
   return level;
 }
@@ -51,6 +69,7 @@ PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& 
                             const std::vector<ScaleFeatures>& scales,
                             const PlaneDetectionOptions& options,
                             const ProgressCallback& progress) {
+  validatePlaneDetectionOptions(options);
   if (knn.size() != positions.size())
     throw OptionError("plane detection: the neighbour graph was built on another cloud");
   checkScaleFeatures(scales, positions.size());

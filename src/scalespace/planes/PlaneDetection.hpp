@@ -15,6 +15,7 @@ namespace scalespace {
 struct PlaneDetectionOptions {
   RegionGrowingOptions growing;  // theta = 5 degrees
   double alphaFactor = 2.0;      // alpha-shape radius and minimum extent: 2t
+  double maxRegionRms = 0.0;     // RegionFilterOptions::maxRms (0: the thesis' filter)
   double minJaccard = 0.5;       // Sec. 2.3.2
   bool outlines = true;
 };
@@ -29,6 +30,11 @@ struct PlaneDetection {
   PlaneDetectionTimings timings;
   int scaleCount() const { return int(graph.levels.size()); }
 };
+
+/// OptionError naming the field unless every option is in its range (angle in (0, 180), maxStep,
+/// maxRegionRms finite and >= 0, alphaFactor > 0, minJaccard in [0, 1)); the entry points check
+/// it first, a caller can check it before reading its input.
+void validatePlaneDetectionOptions(const PlaneDetectionOptions& options);
 
 /// Sec. 2.3.1 for one scale: region growing then the alpha-shape filter; adds the time spent to
 /// `timings` (segmentation, filtering).

@@ -23,9 +23,37 @@ struct SeedNormalCriterion {
     const Vec3& n = normals[point];
     return {n.x(), n.y(), n.z()};
   }
-  bool accept(const Normal& seed, const Normal& normal) const {
+  bool accept(const Normal& seed, const Normal&, const Normal& normal) const {
     // Vec3::dot's order of operations, so the regions are those of the Vec3 version.
     return normal[0] * seed[0] + normal[1] * seed[1] + normal[2] * seed[2] >= cosTheta;
+  }
+};
+
+/// The same, and a step may not cross more than maxStep along the seed's normal: the projection
+/// of the point joining and that of the region point it is reached from lie in planes (with the
+/// seed's orientation) at most maxStep apart. Parallel faces offset by a few centimetres (a tile
+/// on a roof, a tread above the ground) have the same normal, so the angle alone joins them
+/// through any graph edge that spans the step (docs/THESIS_NOTES.md, region growing offset).
+struct SeedNormalAndStepCriterion {
+  struct Slot {
+    double normal[3];
+    double position[3];
+  };
+  const std::vector<Vec3>& normals;
+  const std::vector<Vec3>& projections;
+  double cosTheta, maxStep;
+  Slot payload(Index point) const {
+    const Vec3 &n = normals[point], &p = projections[point];
+    return {{n.x(), n.y(), n.z()}, {p.x(), p.y(), p.z()}};
+  }
+  bool accept(const Slot& seed, const Slot& from, const Slot& candidate) const {
+    const double* n = seed.normal;
+    const double* m = candidate.normal;
+    if (!(m[0] * n[0] + m[1] * n[1] + m[2] * n[2] >= cosTheta)) return false;
+    const double step = (candidate.position[0] - from.position[0]) * n[0] +
+                        (candidate.position[1] - from.position[1]) * n[1] +
+                        (candidate.position[2] - from.position[2]) * n[2];
+    return std::abs(step) <= maxStep;
   }
 };
 }  // namespace
@@ -38,6 +66,11 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
     throw OptionError("region growing: the scale features and the neighbour graph differ in size");
   if (!(options.maxAngleDegrees > 0 && options.maxAngleDegrees < 180))
     throw OptionError("RegionGrowingOptions::maxAngleDegrees must be in (0, 180)");
+  if (!(options.maxStep >= 0) || !std::isfinite(options.maxStep))
+    throw OptionError("RegionGrowingOptions::maxStep must be finite and >= 0");
+  if (options.maxStep > 0 && scale.projections.size() != n)
+    throw OptionError(
+        "RegionGrowingOptions::maxStep needs the projections of the scale (ScaleFeatures)");
   const double cosTheta = std::cos(options.maxAngleDegrees * M_PI / 180.0);
   // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2, ties by increasing
   // point index, so the result does not depend on anything else. A point with a non-finite
@@ -47,6 +80,10 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
       return std::numeric_limits<double>::quiet_NaN();
     return double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
   });
+  if (options.maxStep > 0)
+    return growRegionsFromSeeds(graph, std::move(seeds), scale.valid,
+                                SeedNormalAndStepCriterion{scale.normals, scale.projections,
+                                                           cosTheta, options.maxStep * scale.t});
   return growRegionsFromSeeds(graph, std::move(seeds), scale.valid,
                               SeedNormalCriterion{scale.normals, cosTheta});
 }
@@ -54,10 +91,16 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
 std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions,
                                               const Segmentation& segmentation, double t,
                                               const RegionFilterOptions& options,
-                                              const ProgressCallback& progress) {
+                                              const ProgressCallback& progress,
+                                              const std::vector<Vec3>& projections) {
   if (!(t > 0)) throw OptionError("region filter: the scale t must be positive");
   if (!(options.alphaFactor > 0))
     throw OptionError("RegionFilterOptions::alphaFactor must be positive");
+  if (!(options.maxRms >= 0) || !std::isfinite(options.maxRms))
+    throw OptionError("RegionFilterOptions::maxRms must be finite and >= 0");
+  if (options.maxRms > 0 && projections.size() != positions.size())
+    throw OptionError("RegionFilterOptions::maxRms needs the projections of the scale");
+  const double maxRms = options.maxRms * t;
   const double radius = options.alphaFactor * t;
   const auto& regions = segmentation.regions;
   std::vector<std::uint8_t> keep(regions.size(), 0);
@@ -67,6 +110,8 @@ std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions
       // A region whose point count cannot reach the area is skipped without an alpha shape:
       // fewer than 3 points have zero area.
       if (regions[r].size() < 3) continue;
+      // A region that no plane describes at its scale is no planar structure of that scale.
+      if (maxRms > 0 && !(fitPlane(projections, regions[r]).rms <= maxRms)) continue;
       const PlaneFit plane = fitPlane(positions, regions[r]);
       keep[r] = alphaShapeAreaAtLeast(projectOnPlane(plane, positions, regions[r]), radius * radius,
                                       radius * radius);

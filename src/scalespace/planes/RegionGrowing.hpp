@@ -13,11 +13,17 @@ namespace scalespace {
 
 struct RegionGrowingOptions {
   double maxAngleDegrees = 5.0;  // theta of Sec. 2.3.1, against the SEED's normal
+  /// The largest step, as a fraction of t, that a region may cross along the seed's normal from
+  /// one point's projection to its neighbour's (a departure from Sec. 2.3.1, which has the angle
+  /// alone: docs/THESIS_NOTES.md, region growing offset). 0: the thesis' criterion.
+  double maxStep = 0.0;
 };
 
 /// Seeds by decreasing planarity 1/(k1^2 + k2^2), i.e. increasing k1^2 + k2^2 (stable, index
 /// tie-break); a region grows through the graph over unassigned valid points whose normal is
-/// within theta of the seed's normal. Invalid points stay -1. Deterministic.
+/// within theta of the seed's normal (and, with maxStep, whose projection is at most maxStep t
+/// from the plane through the neighbour it is reached from). Invalid points stay -1.
+/// Deterministic.
 Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
                          const RegionGrowingOptions& options = {});
 
@@ -25,9 +31,14 @@ struct RegionFilterOptions {
   /// The alpha-shape radius and the minimum extent are alphaFactor * t (Sec. 2.3.1: 2t); CGAL's
   /// alpha is the squared radius.
   double alphaFactor = 2.0;
+  /// Regions whose projections (at t) lie farther from their least-squares plane than maxRms t
+  /// (root mean square) are dropped: no plane describes them at that scale (a departure from
+  /// Sec. 2.3.1: docs/THESIS_NOTES.md, planarity filter). 0: the thesis' filter.
+  double maxRms = 0.0;
 };
 
 /// Keeps the regions (their increasing point lists) with sqrt(alpha-shape area) >= alphaFactor * t
+/// (and, with maxRms, the projections' plane RMS <= maxRms t)
 /// (the docs/THESIS_NOTES.md reading of "a < 2t"), in their input order. Regions run in parallel; a
 /// large region is usually accepted from the alpha shape of a patch around its middle
 /// (alphaShapeAreaAtLeast), so the area itself is not computed (the components compute theirs at
@@ -35,6 +46,7 @@ struct RegionFilterOptions {
 std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions,
                                               const Segmentation& segmentation, double t,
                                               const RegionFilterOptions& options = {},
-                                              const ProgressCallback& progress = {});
+                                              const ProgressCallback& progress = {},
+                                              const std::vector<Vec3>& projections = {});
 
 }  // namespace scalespace

@@ -10,7 +10,8 @@ void checkScaleFeatures(const std::vector<ScaleFeatures>& scales, std::size_t po
   for (std::size_t j = 0; j < scales.size(); ++j) {
     const ScaleFeatures& s = scales[j];
     if (s.normals.size() != pointCount || s.kMax.size() != pointCount ||
-        s.kMin.size() != pointCount || s.valid.size() != pointCount)
+        s.kMin.size() != pointCount || s.valid.size() != pointCount ||
+        (!s.projections.empty() && s.projections.size() != pointCount))
       throw OptionError("scale " + std::to_string(j) + " has features for a different number of " +
                         "points than the cloud (" + std::to_string(pointCount) + ")");
     if (!(s.t > 0) || (j > 0 && !(s.t > scales[j - 1].t)))

@@ -15,6 +15,9 @@ struct ScaleFeatures {
   std::vector<Vec3> normals;        // per input point, unit (W3 of the APSS fit)
   std::vector<float> kMax, kMin;    // principal curvatures (Eq. 1.38)
   std::vector<std::uint8_t> valid;  // 0 where the fit failed: such points join no region
+  /// Per input point, its projection at t (same frame as the cloud's positions); may be empty
+  /// unless RegionGrowingOptions::maxStep or RegionFilterOptions::maxRms is set.
+  std::vector<Vec3> projections;
 };
 
 /// Throws OptionError when a scale's arrays do not have `pointCount` entries or scales are not

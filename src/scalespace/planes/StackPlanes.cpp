@@ -15,7 +15,8 @@ namespace scalespace {
 
 ScaleFeatures scaleFeaturesFromLayer(const ScaleLayer& layer, double t) {
   const std::size_t n = layer.size();
-  if (layer.normal.size() != 3 * n || layer.kMax.size() != n || layer.kMin.size() != n)
+  if (layer.normal.size() != 3 * n || layer.kMax.size() != n || layer.kMin.size() != n ||
+      (!layer.projection.empty() && layer.projection.size() != 3 * n))
     throw Error("scale layer arrays have inconsistent sizes");
   ScaleFeatures f;
   f.t = t;
@@ -25,6 +26,12 @@ ScaleFeatures scaleFeaturesFromLayer(const ScaleLayer& layer, double t) {
   f.kMax = layer.kMax;
   f.kMin = layer.kMin;
   f.valid = layer.valid;
+  if (!layer.projection.empty()) {
+    f.projections.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      f.projections[i] =
+          Vec3(layer.projection[3 * i], layer.projection[3 * i + 1], layer.projection[3 * i + 2]);
+  }
   return f;
 }
 
@@ -32,6 +39,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
                                         const ScaleSpaceOptions& stackOptions,
                                         const PlaneDetectionOptions& options,
                                         const ProgressCallback& progress) {
+  validatePlaneDetectionOptions(options);
   const auto begin = std::chrono::steady_clock::now();
   StackPlaneDetection out;
   const auto& positions = cloud.positions();
@@ -73,6 +81,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
     copy->kMax = layer.kMax;
     copy->kMin = layer.kMin;
     copy->valid = layer.valid;
+    copy->projection = layer.projection;
     ++pending;
     // The buffer goes back to the pool when the task's functor is destroyed, which TBB does
     // before the task counts as finished: the pool outlives every task (all are waited for).
@@ -89,7 +98,10 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   if (!knn.kthDistance.empty() && stack.series.K > 0 &&
       std::size_t(stack.series.K) * knn.size() == knn.neighbors.size())
     stack.series.knownMedianKnnRadius = lowerMedian(knn.kthDistance);
-  stack.layerContents = LayerContents::NormalAndCurvatures;  // what scaleFeaturesFromLayer reads
+  // What scaleFeaturesFromLayer reads: the projections only when a criterion needs them.
+  const bool projections = options.growing.maxStep > 0 || options.maxRegionRms > 0;
+  stack.layerContents = projections ? LayerContents::NormalCurvaturesAndProjection
+                                    : LayerContents::NormalAndCurvatures;
   try {
     out.stack = runScaleSpace(cloud, stack, sink, progress);
   } catch (...) {
@@ -121,6 +133,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
 PlaneDetection detectPlanesFromStack(const PointCloud& cloud, const ScaleStackReader& stack,
                                      const PlaneDetectionOptions& options,
                                      const ProgressCallback& progress) {
+  validatePlaneDetectionOptions(options);
   stack.checkInput(cloud, "the input cloud");
   const auto& positions = cloud.positions();
   const KnnGraph knn = buildKnnGraph(positions, 10);

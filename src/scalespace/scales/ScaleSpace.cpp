@@ -37,6 +37,8 @@ void sizeLayer(ScaleLayer& layer, std::size_t n, LayerContents contents) {
   layer.normal.assign(3 * n, 0.0f);
   for (auto* v : {&layer.meanCurvature, &layer.kMax, &layer.kMin}) v->assign(n, 0.0f);
   layer.valid.assign(n, 0);
+  if (contents == LayerContents::NormalCurvaturesAndProjection)
+    layer.projection.assign(3 * n, 0.0f);
 }
 
 /// Stores the fit of point i in the layer, with `projection` (the fit's, or the last valid one
@@ -49,6 +51,8 @@ void recordFit(const LocalFit& f, const Vec3& projection, std::size_t i, LayerCo
   layer.meanCurvature[i] = float(f.meanCurvature);
   layer.kMax[i] = float(f.kMax);
   layer.kMin[i] = float(f.kMin);
+  if (contents == LayerContents::NormalCurvaturesAndProjection)
+    put3(layer.projection, i, projection);
   if (contents != LayerContents::All) return;
   layer.neighbors[i] = std::uint16_t(std::clamp(f.neighbors, 0, 65535));
   put3(layer.projection, i, projection);
@@ -85,6 +89,8 @@ void toInputOrder(const ScaleLayer& spatial, const std::vector<Index>& rank, Lay
                          {&spatial.kMin, &layer.kMin}})
     gather(*in, rank, 1, *out);
   gather(spatial.valid, rank, 1, layer.valid);
+  if (contents == LayerContents::NormalCurvaturesAndProjection)
+    gather(spatial.projection, rank, 3, layer.projection);
   if (!all) return;
   for (auto [in, out] : {std::pair{&spatial.projection, &layer.projection},
                          {&spatial.dirMax, &layer.dirMax},

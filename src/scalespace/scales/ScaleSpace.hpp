@@ -19,8 +19,9 @@ namespace scalespace {
 
 /// What the layers handed to a ScaleSink hold (ScaleLayer).
 enum class LayerContents {
-  All,                 // every array
-  NormalAndCurvatures  // normal, meanCurvature, kMax, kMin, valid; the other arrays are empty
+  All,                  // every array
+  NormalAndCurvatures,  // normal, meanCurvature, kMax, kMin, valid; the other arrays are empty
+  NormalCurvaturesAndProjection  // the same and the projection
 };
 
 /// In which order the layers handed to a ScaleSink list the points (ScaleLayer::inputIndex).
