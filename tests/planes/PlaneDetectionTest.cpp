@@ -79,6 +79,72 @@ TEST(RegionGrowing, SeedNormalCriterionAndDeterminism) {
   EXPECT_EQ(assigned, 5u);
 }
 
+// Two terraces with the same normal, the upper 0.02 above the lower, side by side: the k-NN
+// edges span the step, so the angle alone makes one region; a step limit of 0.1 t = 0.01 (with
+// t = 0.1) splits them, and the lower terrace stays whole.
+TEST(RegionGrowing, StepLimitSeparatesParallelFacesOffsetByLessThanTheGraphSpan) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> pts;
+  ScaleFeatures f;
+  f.t = 0.1;
+  for (int i = 0; i < 2000; ++i) {
+    const double x = 2 * u(rng), y = u(rng);
+    pts.emplace_back(x, y, x < 1 ? 0.0 : 0.02);
+    f.normals.push_back(Vec3::UnitZ());
+    f.kMax.push_back(0.f);
+    f.kMin.push_back(0.f);
+    f.valid.push_back(1);
+  }
+  f.projections = pts;
+  const KnnGraph knn = buildKnnGraph(pts, 10);
+  EXPECT_EQ(growRegions(knn, f).regions.size(), 1u);
+  RegionGrowingOptions options;
+  options.maxStep = 0.1;
+  const Segmentation seg = growRegions(knn, f, options);
+  ASSERT_EQ(seg.regions.size(), 2u);
+  for (const auto& region : seg.regions)
+    for (const Index i : region) EXPECT_EQ(pts[i].x() < 1, pts[region[0]].x() < 1);
+  f.projections.clear();
+  EXPECT_THROW(growRegions(knn, f, options), OptionError);  // the limit needs the projections
+}
+
+// A flat patch and a cap of a sphere of radius 1 (sagitta ~0.1 over a width of 0.9): at t = 0.1
+// the filter with maxRms = 0.05 (RMS <= 0.005) keeps the patch and drops the cap; without it
+// both pass the alpha-shape test. The cap as a component is flagged non-planar.
+TEST(RegionFilter, PlanarityFilterDropsRegionsThatNoPlaneDescribes) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-0.45, 0.45);
+  std::vector<Vec3> pts;
+  Segmentation seg;
+  seg.regions.resize(2);
+  for (int i = 0; i < 3000; ++i) {
+    const double x = u(rng), y = u(rng);
+    const bool cap = i % 2;
+    pts.emplace_back(cap ? x + 3 : x, y, cap ? std::sqrt(1 - x * x - y * y) : 0.0);
+    seg.regions[std::size_t(cap)].push_back(Index(i));
+  }
+  seg.labels.resize(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) seg.labels[i] = int(i % 2);
+  EXPECT_EQ(filterRegions(pts, seg, 0.1).size(), 2u);
+  RegionFilterOptions planar;
+  planar.maxRms = 0.05;
+  const auto kept = filterRegions(pts, seg, 0.1, planar, {}, pts);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0], seg.regions[0]);
+  EXPECT_THROW(filterRegions(pts, seg, 0.1, planar), OptionError);  // needs the projections
+
+  RegionLevel level;
+  level.t = 0.1;
+  level.regions = seg.regions;
+  const RegionGraph graph = buildRegionGraph({level}, pts.size());
+  const std::vector<PlaneComponent> components = extractComponents(graph, pts);
+  ASSERT_EQ(components.size(), 2u);
+  EXPECT_TRUE(components[0].planar);
+  EXPECT_FALSE(components[1].planar);
+  EXPECT_DOUBLE_EQ(components[1].representativeScale, 0.1);
+}
+
 // The graph's distance to the k-th neighbour is knnRadii's (brute force), so the stack can take
 // its automatic t_min from it; a graph of k points or fewer has none.
 TEST(KnnGraph, KthDistanceIsTheKnnRadius) {

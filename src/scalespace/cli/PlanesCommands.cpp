@@ -346,6 +346,12 @@ void addPlanesCommand(CLI::App& app) {
                    model.components.size(), result.stackSeconds, t.segmentation, t.filtering,
                    args->stack.empty() ? " (during the stack)" : "", t.graph, t.components);
     }
+    std::size_t curved = 0;
+    for (const PlaneComponent& c : model.components) curved += !c.planar;
+    if (curved)
+      printWarnings({std::to_string(curved) +
+                     " component(s) are not described by their plane (RMS > 5% of their "
+                     "representative scale): components.json marks them \"planar\": false"});
     reportDone("planes", start, args->quiet);
   });
 }

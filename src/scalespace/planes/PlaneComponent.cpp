@@ -37,6 +37,8 @@ std::vector<PlaneComponent> extractComponents(const RegionGraph& graph,
     }
     const auto& points = componentPointsAt(graph, int(id), c.representativeLevel);
     c.plane = fitPlane(positions, points);
+    c.representativeScale = graph.levels[std::size_t(c.representativeLevel)].t;
+    c.planar = c.plane.valid && c.plane.rms <= options.maxRelativeRms * c.representativeScale;
     const double radius = options.alphaFactor * graph.levels[std::size_t(c.representativeLevel)].t;
     const AlphaShape shape =
         alphaShape2(projectOnPlane(c.plane, positions, points), radius * radius, options.outlines);

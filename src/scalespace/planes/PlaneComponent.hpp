@@ -17,14 +17,21 @@ struct PlaneComponent {
   /// The level where the component holds the most points (lowest such level on ties): its
   /// plane, area and outlines are computed there, where the region is the largest sample of it.
   int representativeLevel = 0;
-  std::size_t pointCount = 0;  // at the representative level
-  PlaneFit plane;              // in the cloud's relative coordinates
-  double area = 0.0;           // alpha shape (radius alphaFactor * t) at the representative level
+  std::size_t pointCount = 0;        // at the representative level
+  double representativeScale = 0.0;  // t of the representative level
+  PlaneFit plane;                    // in the cloud's relative coordinates
+  /// Whether the plane describes the component's points: plane.rms <= maxRelativeRms times the
+  /// representative scale (ComponentOptions). A chain of regions can drift from a plane into a
+  /// curved or folded set (each step keeping Jaccard > 0.5, Sec. 2.3.2); such a component is
+  /// kept, flagged, for the user to judge.
+  bool planar = true;
+  double area = 0.0;  // alpha shape (radius alphaFactor * t) at the representative level
   std::vector<std::vector<Vec3>> outlines;  // boundary loops of that alpha shape, in 3D
 };
 
 struct ComponentOptions {
-  double alphaFactor = 2.0;  // same alpha-shape radius as the region filter: alphaFactor * t
+  double alphaFactor = 2.0;      // same alpha-shape radius as the region filter: alphaFactor * t
+  double maxRelativeRms = 0.05;  // PlaneComponent::planar: rms <= 5% of the representative scale
   bool outlines = true;
 };
 
