@@ -91,9 +91,11 @@ void addGenerateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "generate",
       "sample an analytic surface (exact normals and curvatures as columns) or a "
-      "piecewise-planar scene of Table 2.1 (face labels as gt_face)");
+      "piecewise-planar scene (Table 2.1's, or house / yard in metres; face labels as gt_face, "
+      "house / yard also group labels as gt_group)");
   cmd->add_option("shape", args->shape,
-                  "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box")
+                  "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | "
+                  "house | yard")
       ->required();
   cmd->add_option("-n,--points", args->options.pointCount, "number of points")
       ->capture_default_str();

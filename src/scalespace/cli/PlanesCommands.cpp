@@ -24,7 +24,9 @@
 namespace scalespace::cli {
 
 bool generateScene(const std::string& name, const GenerateOptions& options, PointCloud& cloud) {
-  if (name != "tri" && name != "stairs" && name != "cubes" && name != "box") return false;
+  if (name != "tri" && name != "stairs" && name != "cubes" && name != "box" && name != "house" &&
+      name != "yard")
+    return false;
   if (options.pointCount == 0) throw OptionError("-n must be >= 1");
   SceneOptions scene;
   scene.pointCount = options.pointCount;
