@@ -13,8 +13,6 @@
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
 // --robust-tolerance / --robust-iterations set the stack's ScaleSpaceOptions::fit.robustTolerance /
 // robustIterations (default: the library's; 0 iterations = the plain APSS stack).
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set.h>
 #include <CGAL/property_map.h>
@@ -24,9 +22,9 @@
 #include <cstdlib>
 #include <map>
 #include <string>
-#include <tuple>
 #include <vector>
 
+#include "RansacPeer.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
@@ -37,17 +35,12 @@ using namespace scalespace;
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using bench::Detection;
+using bench::Kernel;
 using PointWithNormal = std::pair<Kernel::Point_3, Kernel::Vector_3>;
 using PwnVector = std::vector<PointWithNormal>;
 using PointMap = CGAL::First_of_pair_property_map<PointWithNormal>;
 using NormalMap = CGAL::Second_of_pair_property_map<PointWithNormal>;
-
-// A detection: disjoint point sets, one per plane.
-struct Detection {
-  std::vector<std::vector<Index>> planes;
-  double seconds = 0;
-};
 
 struct Scores {
   double recall = 0, precision = 0, coverage = 0, rms = 0;
@@ -97,40 +90,6 @@ PwnVector toPwn(const PointCloud& cloud) {
     out.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), Kernel::Vector_3(n.x(), n.y(), n.z()));
   }
   return out;
-}
-
-Detection runRansac(const PointCloud& cloud) {
-  // Efficient RANSAC reorders its input range: each point carries its original index.
-  using Item = std::tuple<Kernel::Point_3, Kernel::Vector_3, std::size_t>;
-  using Items = std::vector<Item>;
-  using ItemPointMap = CGAL::Nth_of_tuple_property_map<0, Item>;
-  using ItemNormalMap = CGAL::Nth_of_tuple_property_map<1, Item>;
-  using Traits =
-      CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, Items, ItemPointMap, ItemNormalMap>;
-  using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
-  using Plane = CGAL::Shape_detection::Plane<Traits>;
-  Items points;
-  points.reserve(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Vec3& p = cloud.positions()[i];
-    const Vec3& n = cloud.normals()[i];
-    points.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), Kernel::Vector_3(n.x(), n.y(), n.z()),
-                        i);
-  }
-  const auto start = std::chrono::steady_clock::now();
-  Ransac ransac;
-  ransac.set_input(points);
-  ransac.add_shape_factory<Plane>();
-  ransac.detect();  // documented defaults: epsilon and cluster epsilon 1 % of the bbox, ...
-  Detection d;
-  for (const auto& shape : ransac.shapes()) {
-    std::vector<Index> plane;
-    for (std::size_t i : shape->indices_of_assigned_points())
-      plane.push_back(Index(std::get<2>(points[i])));
-    d.planes.push_back(std::move(plane));
-  }
-  d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return d;
 }
 
 Detection runRegionGrowing(const PointCloud& cloud) {
@@ -269,7 +228,7 @@ int main(int argc, char** argv) {
       for (double v : cloud.findAttribute("gt_face")->values) gt.push_back(int(v));
       const int faces = int(sceneFaces(kind, opt).size());
       for (int method = 0; peers && method < 2; ++method) {
-        const Detection d = method == 0 ? runRansac(cloud) : runRegionGrowing(cloud);
+        const Detection d = method == 0 ? bench::runRansac(cloud) : runRegionGrowing(cloud);
         const Scores s = evaluate(d, cloud, gt, faces);
         std::printf("%s,%g,%s,%.3f,%.3f,%.3f,%.2e,%zu,%.2f\n", sceneKindName(kind), noise,
                     method == 0 ? "cgal_ransac" : "cgal_region_growing", s.recall, s.precision,

@@ -20,6 +20,17 @@ double maxPlaneDistance(const PointCloud& cloud, const std::vector<SceneFace>& f
   }
   return worst;
 }
+
+// Root mean square of the same distances (the noise's sigma along the normal).
+double rmsPlaneDistance(const PointCloud& cloud, const std::vector<SceneFace>& faces) {
+  const AttributeColumn* gt = cloud.findAttribute("gt_face");
+  double sumSq = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const SceneFace& f = faces[std::size_t(gt->values[i])];
+    sumSq += std::pow((cloud.absolutePosition(i) - f.triangles[0]).dot(f.normal), 2);
+  }
+  return std::sqrt(sumSq / double(cloud.size()));
+}
 }  // namespace
 
 TEST(SceneGenerator, EveryScenePointLiesOnItsLabelledFaceWithItsNormal) {
@@ -89,15 +100,8 @@ TEST(SceneGenerator, DeterministicAndNoiseScalesWithDiagonal) {
     ASSERT_EQ(a.absolutePosition(i), b.absolutePosition(i));
   opt.noise = 25e-5;
   const PointCloud noisy = generateScene(SceneKind::Box, opt);
-  const auto faces = sceneFaces(SceneKind::Box, opt);
-  const AttributeColumn* gt = noisy.findAttribute("gt_face");
-  double sumSq = 0;
-  for (std::size_t i = 0; i < noisy.size(); ++i) {
-    const SceneFace& f = faces[std::size_t(gt->values[i])];
-    sumSq += std::pow((noisy.absolutePosition(i) - f.triangles[0]).dot(f.normal), 2);
-  }
   const double sigma = 25e-5 * std::sqrt(3.0);  // unit box diagonal
-  EXPECT_NEAR(std::sqrt(sumSq / noisy.size()), sigma, 0.05 * sigma);
+  EXPECT_NEAR(rmsPlaneDistance(noisy, sceneFaces(SceneKind::Box, opt)), sigma, 0.05 * sigma);
   EXPECT_THROW(sceneKindFromName("sphere"), OptionError);
   EXPECT_EQ(sceneKindFromName("stairs"), SceneKind::Stairs);
 }
@@ -245,15 +249,8 @@ TEST(SceneGenerator, HouseDeterministicAndNoisy) {
   }
   opt.noise = 2.5e-4;
   const PointCloud noisy = generateScene(SceneKind::House, opt);
-  const auto faces = sceneFaces(SceneKind::House, opt);
-  const AttributeColumn* gt = noisy.findAttribute("gt_face");
-  double sumSq = 0;
-  for (std::size_t i = 0; i < noisy.size(); ++i) {
-    const SceneFace& f = faces[std::size_t(gt->values[i])];
-    sumSq += std::pow((noisy.absolutePosition(i) - f.triangles[0]).dot(f.normal), 2);
-  }
   const double sigma = 2.5e-4 * std::sqrt(14.0 * 14 + 10 * 10 + 5 * 5);  // bounding box diagonal
-  EXPECT_NEAR(std::sqrt(sumSq / double(noisy.size())), sigma, 0.05 * sigma);
+  EXPECT_NEAR(rmsPlaneDistance(noisy, sceneFaces(SceneKind::House, opt)), sigma, 0.05 * sigma);
   // The Table 2.1 scenes keep their columns: no group column.
   EXPECT_EQ(generateScene(SceneKind::Stairs, opt).findAttribute("gt_group"), nullptr);
 }
