@@ -233,9 +233,24 @@ void printMissedFaces(const Truth& truth, const Best& best, double tMin) {
                   truth.faceWidth[f], truth.faces[f].area(), best.face[f]);
 }
 
-void diagnose(const PlaneDetection& detection, const PlaneModel& model, const Truth& truth) {
+void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const PlaneModel& model,
+              const Truth& truth) {
   const RegionGraph& graph = detection.graph;
   for (std::size_t g = 0; g < truth.groupNames.size(); ++g) {
+    // The group's faces parallel to its largest one (treads; roof and tile tops) and the others
+    // (risers; tile sides): which of them the region holding most of the group takes.
+    // Stairs: no face has a group, every face is the ramp's.
+    const bool labelled = std::any_of(truth.faces.begin(), truth.faces.end(),
+                                      [&](const SceneFace& f) { return f.group == int(g); });
+    const SceneFace* main = nullptr;
+    for (const SceneFace& f : truth.faces)
+      if ((!labelled || f.group == int(g)) && (!main || f.area() > main->area())) main = &f;
+    const auto parallel = [&](Index i) {
+      return truth.faces[std::size_t(truth.face[i])].normal.dot(main->normal) > 0.999;
+    };
+    std::size_t parallelSize = 0;
+    for (std::size_t i = 0; i < truth.group.size(); ++i)
+      parallelSize += truth.group[i] == int(g) && parallel(Index(i));
     std::printf("# group '%s' (%zu points): per level, the region holding most of it\n",
                 truth.groupNames[g].c_str(), truth.groupSize[g]);
     for (int l = 0; l < model.scaleCount(); ++l) {
@@ -251,13 +266,18 @@ void diagnose(const PlaneDetection& detection, const PlaneModel& model, const Tr
         continue;
       }
       const auto& pts = regions[bestRegion].points;
+      std::size_t inParallel = 0;
+      for (Index i : pts) inParallel += truth.group[i] == int(g) && parallel(i);
       std::printf(
-          "#   l %2d t %.4g: region %zu pts (comp %d), holds %.2f of the group, %.2f of it in the "
-          "group, IoU %.2f; %s\n",
+          "#   l %2d t %.4g: region %zu pts (comp %d), holds %.2f of the group (%zu/%zu of its "
+          "faces parallel to the largest, %zu/%zu of the others), %.2f of it in the group, IoU "
+          "%.2f; %s\n",
           l, model.scales[std::size_t(l)], pts.size(),
           graph.componentOf[std::size_t(l)][bestRegion],
-          double(bestCommon) / double(truth.groupSize[g]), double(bestCommon) / double(pts.size()),
-          iou(bestCommon, pts.size(), truth.groupSize[g]), composition(pts, truth).c_str());
+          double(bestCommon) / double(truth.groupSize[g]), inParallel, parallelSize,
+          bestCommon - inParallel, truth.groupSize[g] - parallelSize,
+          double(bestCommon) / double(pts.size()), iou(bestCommon, pts.size(), truth.groupSize[g]),
+          composition(pts, truth).c_str());
     }
   }
   if (!truth.tileTops.empty()) {
@@ -305,9 +325,19 @@ void diagnose(const PlaneDetection& detection, const PlaneModel& model, const Tr
     std::printf("# largest component %zu: levels %d-%d, representative %d, rms/t %.3f\n", largest,
                 c.birthLevel, c.deathLevel, c.representativeLevel,
                 c.plane.rms / model.scales[std::size_t(c.representativeLevel)]);
+    std::printf(
+        "#   per level: points, Jaccard index with the previous level's region, highest point on "
+        "a vertical face (m above the ground), main faces\n");
     for (int l = c.birthLevel; l <= c.deathLevel; ++l) {
       const auto& pts = componentPointsAt(graph, int(largest), l);
-      std::printf("#   l %2d t %.4g: %zu pts; %s\n", l, model.scales[std::size_t(l)], pts.size(),
+      const double jaccard =
+          l > c.birthLevel ? jaccardIndex(componentPointsAt(graph, int(largest), l - 1), pts) : 1.0;
+      double zVertical = 0;
+      for (Index i : pts)
+        if (std::abs(truth.faces[std::size_t(truth.face[i])].normal.z()) < 0.1)
+          zVertical = std::max(zVertical, cloud.absolutePosition(i).z());
+      std::printf("#   l %2d t %.4g: %zu pts, J %.2f, z %.2f; %s\n", l,
+                  model.scales[std::size_t(l)], pts.size(), jaccard, zVertical,
                   composition(pts, truth).c_str());
     }
   }
@@ -357,8 +387,12 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
       detection.timings.filtering, result.segmentationWaitSeconds, detection.timings.graph,
       detection.timings.components);
   if (!diagnostics) return;
-  diagnose(detection, model, truth);
+  diagnose(cloud, detection, model, truth);
+  std::printf("# as regions of any scale:\n");
   printMissedFaces(truth, regionBest, tMin);
+  std::printf("# as components of persistence >= %d at their representative level:\n",
+              minPersistence);
+  printMissedFaces(truth, compBest, tMin);
   std::fflush(stdout);
 }
 
