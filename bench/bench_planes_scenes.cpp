@@ -258,14 +258,14 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
       const auto& regions = graph.levels[std::size_t(l)].regions;
       for (std::size_t r = 0; r < regions.size(); ++r) {
         std::size_t k = 0;
-        for (Index i : regions[r].points) k += truth.group[i] == int(g);
+        for (Index i : regions[r]) k += truth.group[i] == int(g);
         if (k > bestCommon) bestCommon = k, bestRegion = r;
       }
       if (bestCommon == 0) {
         std::printf("#   l %2d t %.4g: none\n", l, model.scales[std::size_t(l)]);
         continue;
       }
-      const auto& pts = regions[bestRegion].points;
+      const auto& pts = regions[bestRegion];
       std::size_t inParallel = 0;
       for (Index i : pts) inParallel += truth.group[i] == int(g) && parallel(i);
       std::printf(
@@ -294,17 +294,17 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
       std::vector<double> topBest(truth.faces.size(), 0);
       std::size_t inRegion = 0, inLarge = 0;
       std::vector<std::size_t> topRegionSizes;
-      for (const FilteredRegion& r : graph.levels[std::size_t(l)].regions) {
+      for (const std::vector<Index>& r : graph.levels[std::size_t(l)].regions) {
         std::map<int, std::size_t> faces;
         std::size_t tops = 0;
-        for (Index i : r.points)
+        for (Index i : r)
           if (isTop[std::size_t(truth.face[i])]) ++faces[truth.face[i]], ++tops;
         inRegion += tops;
-        if (r.points.size() > 1000) inLarge += tops;
-        if (2 * tops > r.points.size()) topRegionSizes.push_back(r.points.size());
+        if (r.size() > 1000) inLarge += tops;
+        if (2 * tops > r.size()) topRegionSizes.push_back(r.size());
         for (const auto& [f, k] : faces)
-          topBest[std::size_t(f)] = std::max(
-              topBest[std::size_t(f)], iou(k, r.points.size(), truth.faceSize[std::size_t(f)]));
+          topBest[std::size_t(f)] =
+              std::max(topBest[std::size_t(f)], iou(k, r.size(), truth.faceSize[std::size_t(f)]));
       }
       std::size_t found = 0;
       for (int f : truth.tileTops) found += topBest[std::size_t(f)] >= kMatchIoU;
@@ -357,8 +357,8 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
 
   Best regionBest(truth), compBest(truth), segBest(truth);
   for (int l = 0; l < detection.scaleCount(); ++l)
-    for (const FilteredRegion& r : detection.graph.levels[std::size_t(l)].regions)
-      score(r.points, truth, model.scales[std::size_t(l)], regionBest);
+    for (const std::vector<Index>& r : detection.graph.levels[std::size_t(l)].regions)
+      score(r, truth, model.scales[std::size_t(l)], regionBest);
   double worstRms = 0, largestRms = 0;
   std::size_t overRms = 0, overRmsAboveNoise = 0, largest = 0;
   const double sigma = noise * cloud.boundingBoxDiagonal();
