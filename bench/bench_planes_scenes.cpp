@@ -20,6 +20,7 @@
 // its regions, components and segmentation; its rms column is relative to epsilon. Usage:
 // bench_planes_scenes [--points N (300000)] [--scales M (50)] [--scene house|yard|stairs]
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
+//                            [--max-step F] [--max-rms F] (PlaneDetectionOptions, default 0)
 // --diagnose also prints, per group and level, the region holding most of the group; per level
 // the tile tops found and where their points went; the faces of the largest component along its
 // life; the counted faces not found.
@@ -343,13 +344,14 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
   }
 }
 
-// Our pipeline with the defaults of `scalespace planes`.
+// Our pipeline with the defaults of `scalespace planes` (and the detection options given).
 void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, double noise,
-             int scales, int minPersistence, bool diagnostics, double& tMinOut) {
+             int scales, int minPersistence, bool diagnostics, double& tMinOut,
+             const PlaneDetectionOptions& options) {
   ScaleSpaceOptions stack;
   stack.fit.robust = true;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
   stack.series.count = scales;
-  const StackPlaneDetection result = detectPlanesInCloud(cloud, stack);
+  const StackPlaneDetection result = detectPlanesInCloud(cloud, stack, options);
   const PlaneDetection& detection = result.detection;
   const PlaneModel model = makePlaneModel(detection);
   const double tMin = model.scales.front();
@@ -434,6 +436,7 @@ int main(int argc, char** argv) {
   double onlyNoise = -1;
   std::string onlyScene;
   bool peers = true, diagnostics = false;
+  PlaneDetectionOptions detection;
   const std::vector<double> noiseLevels{0.0, 2.5e-4};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -448,6 +451,10 @@ int main(int argc, char** argv) {
       onlyNoise = std::atof(argv[++i]);
     } else if (a == "--min-persistence" && hasValue) {
       minPersistence = std::atoi(argv[++i]);
+    } else if (a == "--max-step" && hasValue) {
+      detection.growing.maxStep = std::atof(argv[++i]);
+    } else if (a == "--max-rms" && hasValue) {
+      detection.maxRegionRms = std::atof(argv[++i]);
     } else if (a == "--no-ransac") {
       peers = false;
     } else if (a == "--diagnose") {
@@ -474,7 +481,8 @@ int main(int argc, char** argv) {
       const PointCloud cloud = generateScene(kind, options);
       const Truth truth = makeTruth(kind, options, cloud);
       double tMin = 0;
-      runOurs(cloud, truth, sceneKindName(kind), noise, scales, minPersistence, diagnostics, tMin);
+      runOurs(cloud, truth, sceneKindName(kind), noise, scales, minPersistence, diagnostics, tMin,
+              detection);
       if (peers) runPeer(cloud, truth, sceneKindName(kind), noise, tMin, diagnostics);
     }
   }
