@@ -353,7 +353,8 @@ void addPlanesCommand(CLI::App& app) {
     if (curved)
       printWarnings({std::to_string(curved) +
                      " component(s) are not described by their plane (RMS > 5% of their "
-                     "representative scale): components.json marks them \"planar\": false"});
+                     "representative scale and > 2x the typical RMS): components.json marks them "
+                     "\"planar\": false"});
     reportDone("planes", start, args->quiet);
   });
 }

@@ -89,11 +89,14 @@ FitPointsSummary fitPoints(const SurfaceSamples& samples, const FitQueries& quer
   const std::vector<Vec3>& points = spatial ? sorted : queries.points;
   auto queryOf = [&](std::size_t k) -> std::size_t { return spatial ? order[k] : k; };
   const bool oneScale = queries.scales.size() == 1;
-  auto fitOptionsOf = [&](std::size_t q) {
-    FitOptions fit = options.fit;
-    if (queries.convergedAtFirstStep)
-      fit.expectFirstStepConverged = (*queries.convergedAtFirstStep)[q] != 0;
-    return fit;
+  // A point's hint, when given, sets FitOptions::expectFirstStepConverged: one of two copies made
+  // here, not a copy per fit.
+  FitOptions expectConverged = options.fit, expectNot = options.fit;
+  expectConverged.expectFirstStepConverged = true;
+  expectNot.expectFirstStepConverged = false;
+  auto fitOptionsOf = [&](std::size_t q) -> const FitOptions& {
+    if (!queries.convergedAtFirstStep) return options.fit;
+    return (*queries.convergedAtFirstStep)[q] ? expectConverged : expectNot;
   };
 
   tbb::enumerable_thread_specific<Tally> tallies;

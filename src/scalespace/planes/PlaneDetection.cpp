@@ -8,25 +8,23 @@
 namespace scalespace {
 
 namespace {
+RegionFilterOptions filterOptionsOf(const PlaneDetectionOptions& options) {
+  RegionFilterOptions filter;
+  filter.alphaFactor = options.alphaFactor;
+  filter.maxRms = options.maxRegionRms;
+  return filter;
+}
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 }  // namespace
 
 void validatePlaneDetectionOptions(const PlaneDetectionOptions& options) {
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw OptionError(what);
-  };
-  const double angle = options.growing.maxAngleDegrees, step = options.growing.maxStep;
-  require(angle > 0 && angle < 180, "RegionGrowingOptions::maxAngleDegrees must be in (0, 180)");
-  require(std::isfinite(step) && step >= 0,
-          "RegionGrowingOptions::maxStep must be finite and >= 0");
-  require(std::isfinite(options.maxRegionRms) && options.maxRegionRms >= 0,
-          "RegionFilterOptions::maxRms must be finite and >= 0");
-  require(std::isfinite(options.alphaFactor) && options.alphaFactor > 0,
-          "RegionFilterOptions::alphaFactor must be positive");
-  require(options.minJaccard >= 0 && options.minJaccard < 1,
-          "PlaneDetectionOptions::minJaccard must be in [0, 1)");
+  validateRegionGrowingOptions(options.growing);
+  validateRegionFilterOptions(filterOptionsOf(options));
+  if (!(options.minJaccard >= 0 && options.minJaccard < 1))
+    throw OptionError("PlaneDetectionOptions::minJaccard must be in [0, 1)");
 }
 
 RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
@@ -36,12 +34,10 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
   const Segmentation seg = growRegions(knn, scale, options.growing);
   timings.segmentation += secondsSince(start);
   start = std::chrono::steady_clock::now();
-  RegionFilterOptions filter;
-  filter.alphaFactor = options.alphaFactor;
-  filter.maxRms = options.maxRegionRms;
   RegionLevel level;
   level.t = scale.t;
-  level.regions = filterRegions(positions, seg, scale.t, filter, {}, scale.projections);
+  level.regions =
+      filterRegions(positions, seg, scale.t, filterOptionsOf(options), {}, scale.projections);
   timings.filtering += secondsSince(start);
   return level;
 }

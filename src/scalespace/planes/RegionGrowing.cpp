@@ -58,16 +58,27 @@ struct SeedNormalAndStepCriterion {
 };
 }  // namespace
 
+void validateRegionGrowingOptions(const RegionGrowingOptions& options) {
+  if (!(options.maxAngleDegrees > 0 && options.maxAngleDegrees < 180))
+    throw OptionError("RegionGrowingOptions::maxAngleDegrees must be in (0, 180)");
+  if (!(options.maxStep >= 0) || !std::isfinite(options.maxStep))
+    throw OptionError("RegionGrowingOptions::maxStep must be finite and >= 0");
+}
+
+void validateRegionFilterOptions(const RegionFilterOptions& options) {
+  if (!(options.alphaFactor > 0) || !std::isfinite(options.alphaFactor))
+    throw OptionError("RegionFilterOptions::alphaFactor must be positive");
+  if (!(options.maxRms >= 0) || !std::isfinite(options.maxRms))
+    throw OptionError("RegionFilterOptions::maxRms must be finite and >= 0");
+}
+
 Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
                          const RegionGrowingOptions& options) {
   const std::size_t n = graph.size();
   if (scale.normals.size() != n || scale.kMax.size() != n || scale.kMin.size() != n ||
       scale.valid.size() != n)
     throw OptionError("region growing: the scale features and the neighbour graph differ in size");
-  if (!(options.maxAngleDegrees > 0 && options.maxAngleDegrees < 180))
-    throw OptionError("RegionGrowingOptions::maxAngleDegrees must be in (0, 180)");
-  if (!(options.maxStep >= 0) || !std::isfinite(options.maxStep))
-    throw OptionError("RegionGrowingOptions::maxStep must be finite and >= 0");
+  validateRegionGrowingOptions(options);
   if (options.maxStep > 0 && scale.projections.size() != n)
     throw OptionError(
         "RegionGrowingOptions::maxStep needs the projections of the scale (ScaleFeatures)");
@@ -94,10 +105,7 @@ std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions
                                               const ProgressCallback& progress,
                                               const std::vector<Vec3>& projections) {
   if (!(t > 0)) throw OptionError("region filter: the scale t must be positive");
-  if (!(options.alphaFactor > 0))
-    throw OptionError("RegionFilterOptions::alphaFactor must be positive");
-  if (!(options.maxRms >= 0) || !std::isfinite(options.maxRms))
-    throw OptionError("RegionFilterOptions::maxRms must be finite and >= 0");
+  validateRegionFilterOptions(options);
   if (options.maxRms > 0 && projections.size() != positions.size())
     throw OptionError("RegionFilterOptions::maxRms needs the projections of the scale");
   const double maxRms = options.maxRms * t;

@@ -19,6 +19,9 @@ struct RegionGrowingOptions {
   double maxStep = 0.0;
 };
 
+/// OptionError naming the field unless maxAngleDegrees is in (0, 180) and maxStep finite, >= 0.
+void validateRegionGrowingOptions(const RegionGrowingOptions& options);
+
 /// Seeds by decreasing planarity 1/(k1^2 + k2^2), i.e. increasing k1^2 + k2^2 (stable, index
 /// tie-break); a region grows through the graph over unassigned valid points whose normal is
 /// within theta of the seed's normal (and, with maxStep, whose projection is at most maxStep t
@@ -36,6 +39,9 @@ struct RegionFilterOptions {
   /// Sec. 2.3.1: docs/THESIS_NOTES.md, planarity filter). 0: the thesis' filter.
   double maxRms = 0.0;
 };
+
+/// OptionError naming the field unless alphaFactor > 0 and maxRms finite, >= 0.
+void validateRegionFilterOptions(const RegionFilterOptions& options);
 
 /// Keeps the regions (their increasing point lists) with sqrt(alpha-shape area) >= alphaFactor * t
 /// (and, with maxRms, the projections' plane RMS <= maxRms t)
