@@ -1,0 +1,124 @@
+#pragma once
+// Minimal-curvature lines on the APSS (Sec. 3.3): streamlines of the direction of the principal
+// curvature of smaller magnitude, traced from Poisson-disk seeds by the projected Euler scheme of
+// Eq. 3.2, q_{n+1} = phi(q_n + delta v_min(q_n)), phi the MLS projection (Eq. 1.12) and v_min read
+// from the W3 shape operator (Eq. 1.38) at the projected point.
+//
+// What the thesis leaves open, decided here (docs/THESIS_NOTES.md, "Curvature lines"):
+// - kappa1 is the principal curvature of larger magnitude, kappa2 the other (|kappa1| >= |kappa2|),
+//   v_min the direction of kappa2. A direction field has no sign: each step keeps the sign that
+//   continues the previous step (v . v_prev >= 0).
+// - A line is traced both ways from its seed; each way stops at the first of: an invalid fit (too
+//   few neighbours, degenerate), a near-umbilic point (StopReason::Umbilic), a turn sharper than
+//   maxTurnDegrees in one step, a step that does not move (the projection pulled it back), coming
+//   within collisionFraction * delta of a vertex of another line, closing on itself, or maxSteps.
+// - Coarse scales fit on the Poisson-disk level of the pyramid for that scale (Sec. 1.5.2): the
+//   samples lie >= 2 alpha t apart, so a fit reads a bounded number of them whatever t.
+// - All ways advance together, one step per round, so that each round is one call of the shared
+//   fit driver (fit/FitPoints); collisions are decided from the vertices of earlier rounds and,
+//   within a round, in favour of the line with the smaller id: the result does not depend on the
+//   thread count.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/Types.hpp"
+#include "scalespace/fit/LocalFit.hpp"
+
+namespace scalespace {
+
+struct CurvatureLineOptions {
+  /// The scale t (support radius of the fits), > 0.
+  double scale = 0;
+  /// Seeds: Poisson-disk sample of the cloud with disk radius beta t, i.e. seeds >= 2 beta t
+  /// apart (Sec. 3.3 and Sec. 1.5.2's convention for disk radii).
+  double beta = 0.5;
+  /// Step length delta = gamma t (Eq. 3.2).
+  double gamma = 0.5;
+  /// The fits: W3 with MLS projection by default (Eq. 1.12, 1.38). Must be an estimator with
+  /// principal directions (W3, W2, Quadric, Jet) and mls on.
+  FitOptions fit = defaultFitOptions();
+  /// Pyramid disk radius alpha t (Sec. 1.5.2); 0 fits on every input point.
+  double alpha = 0.1;
+  /// Near-umbilic stop: the direction of kappa2 is not defined where |kappa1| ~ |kappa2|. A
+  /// vertex is near-umbilic when (|kappa1| - |kappa2|) t < minAnisotropy (flat or spherical at
+  /// this scale) or |kappa2| > (1 - minCurvatureGap) |kappa1|.
+  double minAnisotropy = 0.02;
+  double minCurvatureGap = 0.1;
+  /// Stop a way when one step turns by more than this (the field jumped: crossing an umbilic).
+  double maxTurnDegrees = 45;
+  /// Stop a way within collisionFraction * delta of another line's vertex (lines of one scale
+  /// stay apart; a seed next to an existing line makes no line).
+  double collisionFraction = 0.5;
+  /// Most steps per way.
+  int maxSteps = 2000;
+  std::uint64_t seed = 1;
+
+  static FitOptions defaultFitOptions() {
+    FitOptions fit;
+    fit.estimator = EstimatorKind::W3;
+    fit.mls = true;
+    return fit;
+  }
+};
+
+/// Why one way of a line ended.
+enum class LineStop : std::uint8_t {
+  InvalidFit,  // too few neighbours or a degenerate fit
+  Umbilic,     // |kappa1| ~ |kappa2|: no minimal direction
+  Turn,        // turned more than maxTurnDegrees in one step
+  Stalled,     // the projection undid the step (moved < delta / 10)
+  Collision,   // reached another line
+  Loop,        // closed on itself
+  MaxSteps
+};
+const char* lineStopName(LineStop stop);
+
+struct CurvatureLineVertex {
+  Vec3 position = Vec3::Zero();  // on the APSS (projected), same frame as the cloud
+  Vec3 tangent = Vec3::Zero();   // unit v_min, oriented along the line
+  Vec3 normal = Vec3::Zero();
+  double kappa1 = 0;  // principal curvature of larger magnitude (signed: > 0 convex)
+  double kappa2 = 0;  // the other
+  double geometricVariation = 0;  // nu of the fit (LocalFit::geometricVariation)
+};
+
+struct CurvatureLine {
+  std::vector<CurvatureLineVertex> vertices;  // in order along the line
+  Index seed = 0;                             // input point the line started from
+  LineStop stopBackward = LineStop::MaxSteps, stopForward = LineStop::MaxSteps;
+  bool closed = false;  // the last vertex joins the first
+  double length() const;
+};
+
+struct CurvatureLineSet {
+  double scale = 0;
+  std::vector<CurvatureLine> lines;  // lines of >= 2 vertices, by increasing seed index
+  std::size_t seeds = 0;             // seeds drawn
+  std::size_t samples = 0;           // pyramid samples the fits read
+  std::size_t fits = 0;
+  /// How many ways ended for each reason (indexed by LineStop).
+  std::vector<std::size_t> stops;
+  /// |kappa1| at every projected seed with a valid fit (an area-uniform sample of the surface at
+  /// this scale; the feature curves take its percentiles).
+  std::vector<double> seedKappa1;
+  double seconds = 0;
+};
+
+/// OptionError naming the field unless the options can run (scale, beta, gamma > 0 and finite,
+/// an estimator with principal directions and mls, thresholds in range).
+void validateCurvatureLineOptions(const CurvatureLineOptions& options);
+
+/// The pyramid samples for scale t (alpha > 0): a Poisson-disk subset of the input points with
+/// separation 2 alpha t, all points when alpha = 0.
+std::vector<Index> lineSamples(const std::vector<Vec3>& positions, double alpha, double t,
+                               std::uint64_t seed);
+
+/// Traces the minimal-curvature lines of `cloud` (oriented normals required) at one scale.
+/// Throws OptionError on bad options or a cloud without normals, Cancelled on request.
+CurvatureLineSet traceCurvatureLines(const PointCloud& cloud, const CurvatureLineOptions& options,
+                                     const ProgressCallback& progress = {});
+
+}  // namespace scalespace

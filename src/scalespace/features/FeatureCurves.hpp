@@ -1,0 +1,91 @@
+#pragma once
+// Feature curves by multi-scale voting of salient minimal-curvature lines (Sec. 3.4.1):
+//   1. minimal-curvature lines (features/CurvatureLines) at `scaleCount` scales spread linearly
+//      over [e, 3 e], e the mean spacing (see FeatureCurveOptions::spacing);
+//   2. salient vertices: |kappa1| > (1 + salientThreshold) K, K the 90th percentile of |kappa1| at
+//      that scale (docs/THESIS_NOTES.md, "Salient filter", for this reading of the thesis'
+//      "||kappa1| - K| / K > 0.5");
+//   3. each salient vertex votes for the target points (cloud points or mesh vertices) within e,
+//      with weight (1 - (d/e)^2)^2, signed by kappa1 (convex +, concave -);
+//   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
+//      exceed v = voteThreshold * V_max in magnitude, between points of the same sign.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/Types.hpp"
+#include "scalespace/features/CurvatureLines.hpp"
+
+namespace scalespace {
+
+struct FeatureCurveOptions {
+  /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance
+  /// to the spacingNeighbors-th nearest neighbour (the thesis uses the median edge length of a
+  /// mesh input; callers with a mesh pass it here).
+  double spacing = 0;
+  int spacingNeighbors = 16;
+  int scaleCount = 5;
+  double minScaleFactor = 1, maxScaleFactor = 3;  // scales in [1 e, 3 e]
+  /// Line tracing at each scale (scale is set per scale; the rest is used as given).
+  CurvatureLineOptions lines;
+  double salientPercentile = 0.9;  // K
+  double salientThreshold = 0.5;
+  double voteRadiusFactor = 1;  // votes reach points within voteRadiusFactor * e
+  double voteThreshold = 0.05;  // v = voteThreshold * V_max
+  /// k of the k-NN graph the regions grow on (point inputs).
+  int graphNeighbors = 10;
+};
+
+struct FeatureCurve {
+  std::vector<Index> points;  // target points, increasing
+  int convexity = 0;          // +1 convex, -1 concave
+  double length = 0;          // estimated: the MST of a Poisson-disk thinning at 2 e
+  std::uint32_t scaleMask = 0;  // bit s set when scale s voted for one of its points
+};
+
+struct FeatureCurveScale {
+  double scale = 0;
+  double salientBound = 0;  // K
+  std::size_t lines = 0, vertices = 0, salientVertices = 0;
+};
+
+struct FeatureCurveResult {
+  double spacing = 0;
+  std::vector<FeatureCurveScale> scales;
+  std::vector<double> votes;      // per target point
+  std::vector<int> curveId;       // per target point, -1 none
+  std::vector<std::int8_t> convexity;  // per target point: +1, -1, 0
+  std::vector<FeatureCurve> curves;
+  double maxVote = 0;  // V_max
+  /// The salient line vertices of every scale, for drawing: positions and their scale index.
+  std::vector<CurvatureLineSet> lineSets;
+  double seconds = 0;
+};
+
+/// OptionError naming the field unless the options can run.
+void validateFeatureCurveOptions(const FeatureCurveOptions& options);
+
+/// The mean distance to the k-th nearest other point (the default spacing e).
+double meanKthNeighborDistance(const std::vector<Vec3>& positions, int k);
+
+/// Feature curves of a cloud with oriented normals, labelling the cloud's own points (regions on
+/// its k-NN graph).
+FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCurveOptions& options,
+                                       const ProgressCallback& progress = {});
+
+/// The same with the votes cast on `targets` (e.g. mesh vertices, in the cloud's frame) and the
+/// regions grown on `targetGraph` (e.g. the mesh edges: buildMeshEdgeGraph).
+FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCurveOptions& options,
+                                       const std::vector<Vec3>& targets,
+                                       const KnnGraph& targetGraph,
+                                       const ProgressCallback& progress = {});
+
+/// The undirected edge graph of a triangle mesh over `vertexCount` vertices (each neighbour once,
+/// increasing), in KnnGraph's compressed rows.
+KnnGraph buildMeshEdgeGraph(std::size_t vertexCount,
+                            const std::vector<std::array<Index, 3>>& triangles);
+
+}  // namespace scalespace
