@@ -14,10 +14,11 @@
 //   within collisionFraction * delta of a vertex of another line, closing on itself, or maxSteps.
 // - Coarse scales fit on the Poisson-disk level of the pyramid for that scale (Sec. 1.5.2): the
 //   samples lie >= 2 alpha t apart, so a fit reads a bounded number of them whatever t.
-// - All ways advance together, one step per round, so that each round is one call of the shared
-//   fit driver (fit/FitPoints); collisions are decided from the vertices of earlier rounds and,
-//   within a round, in favour of the line with the smaller id: the result does not depend on the
-//   thread count.
+// - Lines are what a sequential tracer gives (Kalogerakis 2009: seeds in a seeded random order,
+//   each line traced until it meets an earlier one; a seed on an earlier line starts none), but
+//   they are traced in batches whose steps are each one call of the shared fit driver
+//   (fit/FitPoints), then cut where they meet an earlier line of their batch. The result does not
+//   depend on the thread count.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -80,8 +81,8 @@ struct CurvatureLineVertex {
   Vec3 position = Vec3::Zero();  // on the APSS (projected), same frame as the cloud
   Vec3 tangent = Vec3::Zero();   // unit v_min, oriented along the line
   Vec3 normal = Vec3::Zero();
-  double kappa1 = 0;  // principal curvature of larger magnitude (signed: > 0 convex)
-  double kappa2 = 0;  // the other
+  double kappa1 = 0;              // principal curvature of larger magnitude (signed: > 0 convex)
+  double kappa2 = 0;              // the other
   double geometricVariation = 0;  // nu of the fit (LocalFit::geometricVariation)
 };
 
@@ -95,14 +96,15 @@ struct CurvatureLine {
 
 struct CurvatureLineSet {
   double scale = 0;
-  std::vector<CurvatureLine> lines;  // lines of >= 2 vertices, by increasing seed index
+  std::vector<CurvatureLine> lines;  // lines of >= 2 vertices, in tracing order
   std::size_t seeds = 0;             // seeds drawn
   std::size_t samples = 0;           // pyramid samples the fits read
   std::size_t fits = 0;
   /// How many ways ended for each reason (indexed by LineStop).
   std::vector<std::size_t> stops;
-  /// |kappa1| at every projected seed with a valid fit (an area-uniform sample of the surface at
-  /// this scale; the feature curves take its percentiles).
+  /// |kappa1| at every projected seed with a minimal direction (valid fit, not near-umbilic): an
+  /// area-uniform sample of the curved part of the surface at this scale (the feature curves take
+  /// its percentiles).
   std::vector<double> seedKappa1;
   double seconds = 0;
 };

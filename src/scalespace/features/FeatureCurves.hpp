@@ -2,13 +2,15 @@
 // Feature curves by multi-scale voting of salient minimal-curvature lines (Sec. 3.4.1):
 //   1. minimal-curvature lines (features/CurvatureLines) at `scaleCount` scales spread linearly
 //      over [e, 3 e], e the mean spacing (see FeatureCurveOptions::spacing);
-//   2. salient vertices: |kappa1| > (1 + salientThreshold) K, K the 90th percentile of |kappa1| at
-//      that scale (docs/THESIS_NOTES.md, "Salient filter", for this reading of the thesis'
-//      "||kappa1| - K| / K > 0.5");
+//   2. salient vertices: |kappa1| > (1 - salientThreshold) K, K the 90th percentile of |kappa1| at
+//      that scale over the seeds with a minimal direction (docs/THESIS_NOTES.md, "Salient filter",
+//      for this reading of the thesis' "||kappa1| - K| / K > 0.5");
 //   3. each salient vertex votes for the target points (cloud points or mesh vertices) within e,
 //      with weight (1 - (d/e)^2)^2, signed by kappa1 (convex +, concave -);
 //   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
-//      exceed v = voteThreshold * V_max in magnitude, between points of the same sign.
+//      exceed v = voteThreshold * V_max in magnitude, between points of the same sign;
+//   5. (not in the thesis) regions smaller than minCurveExtent * e across are dropped: specks of
+//      one to a few points where a line grazed a corner.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -35,14 +37,17 @@ struct FeatureCurveOptions {
   double salientThreshold = 0.5;
   double voteRadiusFactor = 1;  // votes reach points within voteRadiusFactor * e
   double voteThreshold = 0.05;  // v = voteThreshold * V_max
+  /// Curves whose points span less than this times e (bounding-box diagonal) are dropped; 0
+  /// keeps every region (the thesis).
+  double minCurveExtent = 1;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
 };
 
 struct FeatureCurve {
-  std::vector<Index> points;  // target points, increasing
-  int convexity = 0;          // +1 convex, -1 concave
-  double length = 0;          // estimated: the MST of a Poisson-disk thinning at 2 e
+  std::vector<Index> points;    // target points, increasing
+  int convexity = 0;            // +1 convex, -1 concave
+  double length = 0;            // estimated: the MST of a Poisson-disk thinning at 2 e
   std::uint32_t scaleMask = 0;  // bit s set when scale s voted for one of its points
 };
 
@@ -55,9 +60,10 @@ struct FeatureCurveScale {
 struct FeatureCurveResult {
   double spacing = 0;
   std::vector<FeatureCurveScale> scales;
-  std::vector<double> votes;      // per target point
-  std::vector<int> curveId;       // per target point, -1 none
-  std::vector<std::int8_t> convexity;  // per target point: +1, -1, 0
+  std::vector<double> votes;  // per target point
+  std::vector<int> curveId;   // per target point, -1 none
+  std::vector<std::int8_t>
+      convexity;  // per target point: +1 / -1 in a convex / concave curve, else 0
   std::vector<FeatureCurve> curves;
   double maxVote = 0;  // V_max
   /// The salient line vertices of every scale, for drawing: positions and their scale index.

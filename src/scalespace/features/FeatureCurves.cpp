@@ -1,0 +1,285 @@
+#include "scalespace/features/FeatureCurves.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/RegionGrower.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/scales/PoissonDiskSampler.hpp"
+
+namespace scalespace {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw OptionError(message);
+}
+
+/// The region grower's criterion (core/RegionGrower.hpp): a curve joins points of its seed's sign.
+struct SameSign {
+  const std::vector<std::int8_t>& sign;
+  std::int8_t payload(Index point) const { return sign[point]; }
+  bool accept(std::int8_t seed, std::int8_t, std::int8_t candidate) const {
+    return candidate == seed;
+  }
+};
+
+/// The p-quantile (nearest rank) of `values`; 0 when empty.
+double quantile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  const std::size_t k =
+      std::min(values.size() - 1, std::size_t(std::floor(p * double(values.size() - 1) + 0.5)));
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+  return values[k];
+}
+
+/// Length of a curve given as a band of points: the minimum spanning tree of a Poisson-disk
+/// thinning of the band at `separation` (Prim on the complete graph). With the separation larger
+/// than the band's width the samples form a chain along the curve, so the tree follows it.
+double bandLength(const std::vector<Vec3>& positions, const std::vector<Index>& points,
+                  double separation) {
+  const std::vector<Index> kept = poissonDiskSample(positions, points, separation, 7);
+  const std::size_t m = kept.size();
+  if (m < 2) return 0;
+  std::vector<double> best(m, std::numeric_limits<double>::infinity());
+  std::vector<std::uint8_t> inTree(m, 0);
+  double total = 0;
+  std::size_t current = 0;
+  inTree[0] = 1;
+  for (std::size_t added = 1; added < m; ++added) {
+    std::size_t next = m;
+    for (std::size_t j = 0; j < m; ++j) {
+      if (inTree[j]) continue;
+      best[j] = std::min(best[j], (positions[kept[j]] - positions[kept[current]]).norm());
+      if (next == m || best[j] < best[next]) next = j;
+    }
+    total += best[next];
+    inTree[next] = 1;
+    current = next;
+  }
+  return total;
+}
+
+}  // namespace
+
+void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
+  require(std::isfinite(o.spacing) && o.spacing >= 0,
+          "FeatureCurveOptions::spacing must be finite and >= 0 (0 = from the cloud)");
+  require(o.spacingNeighbors >= 1 && std::size_t(o.spacingNeighbors) <= kMaxNeighborCount,
+          "FeatureCurveOptions::spacingNeighbors must be in [1, " +
+              std::to_string(kMaxNeighborCount) + "]");
+  require(o.scaleCount >= 1 && o.scaleCount <= 32,
+          "FeatureCurveOptions::scaleCount must be in [1, 32]");
+  require(std::isfinite(o.minScaleFactor) && std::isfinite(o.maxScaleFactor) &&
+              o.minScaleFactor > 0 && o.maxScaleFactor >= o.minScaleFactor,
+          "FeatureCurveOptions::minScaleFactor and maxScaleFactor must be finite with 0 < min <= "
+          "max");
+  require(
+      std::isfinite(o.salientPercentile) && o.salientPercentile >= 0 && o.salientPercentile <= 1,
+      "FeatureCurveOptions::salientPercentile must be in [0, 1]");
+  require(std::isfinite(o.salientThreshold) && o.salientThreshold >= 0,
+          "FeatureCurveOptions::salientThreshold must be finite and >= 0");
+  require(std::isfinite(o.voteRadiusFactor) && o.voteRadiusFactor > 0,
+          "FeatureCurveOptions::voteRadiusFactor must be finite and > 0");
+  require(std::isfinite(o.voteThreshold) && o.voteThreshold >= 0 && o.voteThreshold < 1,
+          "FeatureCurveOptions::voteThreshold must be in [0, 1)");
+  require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
+          "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
+  require(o.graphNeighbors >= 1 && std::size_t(o.graphNeighbors) <= kMaxNeighborCount,
+          "FeatureCurveOptions::graphNeighbors must be in [1, " +
+              std::to_string(kMaxNeighborCount) + "]");
+  CurvatureLineOptions lines = o.lines;
+  lines.scale = 1;  // set per scale
+  validateCurvatureLineOptions(lines);
+}
+
+double meanKthNeighborDistance(const std::vector<Vec3>& positions, int k) {
+  require(k >= 1, "meanKthNeighborDistance: k must be >= 1");
+  if (positions.size() < 2) return 0;
+  const std::size_t kk = std::min<std::size_t>(std::size_t(k), positions.size() - 1);
+  const auto index = makeSpatialIndex(positions);
+  std::vector<double> distance(positions.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024), [&](const auto& r) {
+    std::vector<Neighbor> found;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      index->knnSearch(positions[i], kk + 1, found);
+      distance[i] = std::sqrt(found.back().distSq);
+    }
+  });
+  double sum = 0;  // in index order: the same for any thread count
+  for (const double d : distance) sum += d;
+  return sum / double(distance.size());
+}
+
+KnnGraph buildMeshEdgeGraph(std::size_t vertexCount,
+                            const std::vector<std::array<Index, 3>>& triangles) {
+  std::vector<std::vector<Index>> adjacent(vertexCount);
+  for (const auto& tri : triangles)
+    for (int c = 0; c < 3; ++c) {
+      const Index a = tri[c], b = tri[(c + 1) % 3];
+      require(a < vertexCount && b < vertexCount,
+              "buildMeshEdgeGraph: a triangle references vertex " + std::to_string(std::max(a, b)) +
+                  " of " + std::to_string(vertexCount));
+      if (a == b) continue;
+      adjacent[a].push_back(b);
+      adjacent[b].push_back(a);
+    }
+  KnnGraph graph;
+  graph.offsets.assign(vertexCount + 1, 0);
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    auto& list = adjacent[v];
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    graph.offsets[v + 1] = graph.offsets[v] + list.size();
+  }
+  graph.neighbors.reserve(graph.offsets.back());
+  for (const auto& list : adjacent)
+    graph.neighbors.insert(graph.neighbors.end(), list.begin(), list.end());
+  return graph;
+}
+
+FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCurveOptions& options,
+                                       const ProgressCallback& progress) {
+  validateFeatureCurveOptions(options);
+  const KnnGraph graph = buildKnnGraph(cloud.positions(), std::size_t(options.graphNeighbors));
+  return detectFeatureCurves(cloud, options, cloud.positions(), graph, progress);
+}
+
+FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCurveOptions& options,
+                                       const std::vector<Vec3>& targets,
+                                       const KnnGraph& targetGraph,
+                                       const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  validateFeatureCurveOptions(options);
+  require(cloud.hasNormals(),
+          "detectFeatureCurves: the cloud has no normals (the APSS fits need oriented normals)");
+  require(targetGraph.size() == targets.size(),
+          "detectFeatureCurves: the target graph has " + std::to_string(targetGraph.size()) +
+              " vertices for " + std::to_string(targets.size()) + " targets");
+  require(cloud.size() >= 2, "detectFeatureCurves: the cloud needs at least 2 points");
+
+  FeatureCurveResult result;
+  result.spacing = options.spacing > 0
+                       ? options.spacing
+                       : meanKthNeighborDistance(cloud.positions(), options.spacingNeighbors);
+  const double e = result.spacing;
+  require(e > 0, "detectFeatureCurves: every point is at the same position (spacing 0)");
+
+  // 1-2. Lines per scale and their salient vertices (Sec. 3.4.1).
+  std::vector<Vec3> salient;
+  std::vector<std::int8_t> salientSign;
+  std::vector<std::uint8_t> salientScale;
+  const int count = options.scaleCount;
+  for (int s = 0; s < count; ++s) {
+    const double f = count == 1 ? 0 : double(s) / (count - 1);
+    CurvatureLineOptions lineOptions = options.lines;
+    lineOptions.scale =
+        e * (options.minScaleFactor + (options.maxScaleFactor - options.minScaleFactor) * f);
+    ProgressCallback scaleProgress;
+    if (progress)
+      scaleProgress = [&](double fraction, std::string_view stage) {
+        return progress(0.9 * (s + std::min(fraction, 1.0)) / count, stage);
+      };
+    CurvatureLineSet lines = traceCurvatureLines(cloud, lineOptions, scaleProgress);
+    FeatureCurveScale summary;
+    summary.scale = lineOptions.scale;
+    summary.salientBound = quantile(lines.seedKappa1, options.salientPercentile);
+    summary.lines = lines.lines.size();
+    const double bound = (1 - options.salientThreshold) * summary.salientBound;
+    for (const CurvatureLine& line : lines.lines)
+      for (const CurvatureLineVertex& v : line.vertices) {
+        ++summary.vertices;
+        if (!(std::abs(v.kappa1) > bound)) continue;
+        ++summary.salientVertices;
+        salient.push_back(v.position);
+        salientSign.push_back(v.kappa1 > 0 ? 1 : -1);
+        salientScale.push_back(std::uint8_t(s));
+      }
+    result.scales.push_back(summary);
+    result.lineSets.push_back(std::move(lines));
+  }
+
+  // 3. Votes: each target sums the weights of the salient vertices within the vote radius.
+  const double radius = options.voteRadiusFactor * e;
+  const std::size_t n = targets.size();
+  result.votes.assign(n, 0);
+  std::vector<std::uint32_t> voters(n, 0);
+  if (progress && !progress(0.9, "voting")) throw Cancelled();
+  if (!salient.empty()) {
+    const auto index = makeSpatialIndex(salient);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      std::vector<Neighbor> found;
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        index->radiusSearch(targets[i], radius, found);
+        // Summed in vertex order: the same total for any thread count.
+        std::sort(found.begin(), found.end(),
+                  [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
+        double sum = 0;
+        std::uint32_t mask = 0;
+        for (const Neighbor& nb : found) {
+          const double w = 1 - nb.distSq / (radius * radius);
+          sum += salientSign[nb.index] * w * w;
+          mask |= std::uint32_t(1) << salientScale[nb.index];
+        }
+        result.votes[i] = sum;
+        voters[i] = mask;
+      }
+    });
+  }
+  for (const double v : result.votes) result.maxVote = std::max(result.maxVote, std::abs(v));
+
+  // 4. Regions of same-sign votes above v = voteThreshold * V_max, seeded by decreasing |vote|.
+  const double threshold = options.voteThreshold * result.maxVote;
+  std::vector<std::uint8_t> eligible(n, 0);
+  result.convexity.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (result.maxVote > 0 && std::abs(result.votes[i]) > threshold) {
+      eligible[i] = 1;
+      result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
+    }
+  std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
+    return eligible[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
+  });
+  Segmentation seg =
+      growRegionsFromSeeds(targetGraph, std::move(seeds), eligible, SameSign{result.convexity});
+  // Specks below the minimum extent are dropped; the others keep their order (by decreasing
+  // strongest vote) and are renumbered.
+  std::vector<int> renumber(seg.regions.size(), -1);
+  std::vector<std::vector<Index>> kept;
+  for (std::size_t c = 0; c < seg.regions.size(); ++c) {
+    Vec3 lo = targets[seg.regions[c].front()], hi = lo;
+    for (const Index p : seg.regions[c]) {
+      lo = lo.cwiseMin(targets[p]);
+      hi = hi.cwiseMax(targets[p]);
+    }
+    if ((hi - lo).norm() < options.minCurveExtent * e) continue;
+    renumber[c] = int(kept.size());
+    kept.push_back(std::move(seg.regions[c]));
+  }
+  result.curveId = std::move(seg.labels);
+  for (std::size_t i = 0; i < n; ++i)
+    if (result.curveId[i] >= 0) {
+      result.curveId[i] = renumber[std::size_t(result.curveId[i])];
+      if (result.curveId[i] < 0) result.convexity[i] = 0;
+    }
+  result.curves.resize(kept.size());
+  tbb::parallel_for(std::size_t(0), kept.size(), [&](std::size_t c) {
+    FeatureCurve& curve = result.curves[c];
+    curve.points = std::move(kept[c]);
+    curve.convexity = result.convexity[curve.points.front()];
+    for (const Index p : curve.points) curve.scaleMask |= voters[p];
+    curve.length = bandLength(targets, curve.points, 2 * e);
+  });
+  if (progress && !progress(1, "feature curves")) throw Cancelled();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scalespace

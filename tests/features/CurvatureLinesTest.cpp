@@ -1,0 +1,196 @@
+// Curvature lines (Sec. 3.3) on surfaces whose lines are known: the rulings of a cylinder, the
+// parallels of a torus; none on a sphere or a plane (umbilic everywhere); options checked.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "scalespace/core/AnalyticSurface.hpp"
+#include "scalespace/core/Error.hpp"
+#include "scalespace/features/CurvatureLines.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+double angleDegrees(const Vec3& a, const Vec3& b) {
+  const double c = std::abs(a.normalized().dot(b.normalized()));
+  return std::acos(std::min(1.0, c)) * 180 / M_PI;
+}
+
+PointCloud surface(SurfaceShape shape, std::size_t count, double ball = 0) {
+  SurfaceSampleOptions options;
+  options.shape = shape;
+  options.count = count;
+  options.ballRadius = ball;
+  return sampleSurface(options);
+}
+
+CurvatureLineOptions atScale(double t) {
+  CurvatureLineOptions options;
+  options.scale = t;
+  return options;
+}
+
+std::size_t vertexCount(const CurvatureLineSet& set) {
+  std::size_t n = 0;
+  for (const auto& line : set.lines) n += line.vertices.size();
+  return n;
+}
+
+}  // namespace
+
+TEST(CurvatureLines, OnACylinderTheLinesAreItsRulings) {
+  // Radius 1, axis y through (0, 0, -1); a patch within 1 of the origin.
+  const PointCloud cloud = surface(SurfaceShape::Cylinder, 40000);
+  const CurvatureLineSet set = traceCurvatureLines(cloud, atScale(0.1));
+  ASSERT_GT(set.lines.size(), 10u);
+  double worst = 0;
+  std::size_t checked = 0;
+  for (const auto& line : set.lines) {
+    EXPECT_FALSE(line.closed);
+    for (std::size_t i = 0; i < line.vertices.size(); ++i) {
+      const CurvatureLineVertex& v = line.vertices[i];
+      // The patch ends at distance 1 from the origin: nearer than t to its border a fit sees a
+      // one-sided neighbourhood.
+      if (v.position.norm() > 1 - 1.5 * 0.1) continue;
+      // On the surface, with the cylinder's curvatures (kappa1 = 1 convex, kappa2 = 0).
+      EXPECT_NEAR(std::hypot(v.position.x(), v.position.z() + 1), 1.0, 1e-3);
+      EXPECT_NEAR(v.kappa1, 1.0, 0.1);
+      EXPECT_NEAR(v.kappa2, 0.0, 0.1);
+      worst = std::max(worst, angleDegrees(v.tangent, Vec3::UnitY()));
+      if (i > 0) {  // the tangent follows the line, oriented forward
+        const Vec3 chord = line.vertices[i].position - line.vertices[i - 1].position;
+        EXPECT_GT(chord.dot(v.tangent), 0);
+        EXPECT_NEAR(chord.norm(), 0.05, 0.005);  // delta = gamma t
+      }
+      ++checked;
+    }
+  }
+  EXPECT_LT(worst, 1.0) << checked << " vertices";
+}
+
+TEST(CurvatureLines, OnATorusTheLinesAreItsParallelsAndClose) {
+  // Major radius 2, minor 0.5, axis z through (-2, 0, -0.5).
+  const PointCloud cloud = surface(SurfaceShape::Torus, 150000);
+  const CurvatureLineSet set = traceCurvatureLines(cloud, atScale(0.12));
+  ASSERT_GT(set.lines.size(), 5u);
+  const Vec3 centre(-2, 0, -0.5);
+  double worst = 0;
+  std::size_t closed = 0;
+  for (const auto& line : set.lines) {
+    closed += line.closed;
+    for (const CurvatureLineVertex& v : line.vertices) {
+      const Vec3 p = v.position - centre;
+      const Vec3 parallel(-p.y(), p.x(), 0);
+      worst = std::max(worst, angleDegrees(v.tangent, parallel));
+      EXPECT_NEAR(v.kappa1, 2.0, 0.3);  // around the tube (t / r = 0.24 biases it)
+    }
+  }
+  EXPECT_LT(worst, 2.0);
+  EXPECT_GT(closed, 0u) << "a parallel is a closed curve";
+}
+
+TEST(CurvatureLines, UmbilicSurfacesHaveNoLines) {
+  for (const SurfaceShape shape : {SurfaceShape::Sphere}) {
+    const CurvatureLineSet set = traceCurvatureLines(surface(shape, 30000), atScale(0.15));
+    EXPECT_EQ(set.lines.size(), 0u);
+    EXPECT_GT(set.stops[std::size_t(LineStop::Umbilic)], 0u);
+    EXPECT_EQ(set.seedKappa1.size(), 0u) << "no seed has a minimal direction";
+  }
+  // A plane: a square of points with normals +z.
+  PointCloud plane;
+  std::vector<Vec3> positions, normals;
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j) {
+      positions.emplace_back(0.01 * i, 0.01 * j, 0);
+      normals.emplace_back(0, 0, 1);
+    }
+  plane.setRelativePositions(positions, Vec3::Zero());
+  plane.setNormals(normals);
+  EXPECT_EQ(traceCurvatureLines(plane, atScale(0.05)).lines.size(), 0u);
+}
+
+TEST(CurvatureLines, LinesOfOneScaleKeepApart) {
+  const PointCloud cloud = surface(SurfaceShape::Cylinder, 40000);
+  CurvatureLineOptions options = atScale(0.1);
+  const CurvatureLineSet set = traceCurvatureLines(cloud, options);
+  const double minDistance = options.collisionFraction * options.gamma * options.scale;
+  // Every vertex of a line is at least the collision distance from the vertices of earlier lines,
+  // except the vertex that stopped on them (at most one per way).
+  for (std::size_t a = 0; a < set.lines.size(); ++a) {
+    std::size_t close = 0;
+    for (const auto& va : set.lines[a].vertices)
+      for (std::size_t b = 0; b < a; ++b)
+        for (const auto& vb : set.lines[b].vertices)
+          if ((va.position - vb.position).norm() < 0.999 * minDistance) ++close;
+    EXPECT_EQ(close, 0u) << "line " << a;
+  }
+}
+
+TEST(CurvatureLines, SameResultForAnyThreadCount) {
+  const PointCloud cloud = surface(SurfaceShape::Torus, 30000);
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return traceCurvatureLines(cloud, atScale(0.15));
+  };
+  const CurvatureLineSet one = run(1), many = run(4);
+  ASSERT_EQ(one.lines.size(), many.lines.size());
+  ASSERT_EQ(vertexCount(one), vertexCount(many));
+  for (std::size_t l = 0; l < one.lines.size(); ++l)
+    for (std::size_t v = 0; v < one.lines[l].vertices.size(); ++v) {
+      EXPECT_EQ(one.lines[l].vertices[v].position, many.lines[l].vertices[v].position);
+      EXPECT_EQ(one.lines[l].vertices[v].kappa1, many.lines[l].vertices[v].kappa1);
+    }
+}
+
+TEST(CurvatureLines, CoarseScalesReadThePyramid) {
+  const PointCloud cloud = surface(SurfaceShape::Cylinder, 40000);
+  CurvatureLineOptions options = atScale(0.3);
+  const CurvatureLineSet pyramid = traceCurvatureLines(cloud, options);
+  options.alpha = 0;
+  const CurvatureLineSet full = traceCurvatureLines(cloud, options);
+  EXPECT_EQ(full.samples, cloud.size());
+  EXPECT_LT(pyramid.samples, cloud.size() / 4);
+  ASSERT_GT(pyramid.lines.size(), 0u);
+  double worst = 0;
+  for (const auto& line : pyramid.lines)
+    for (const auto& v : line.vertices)
+      if (v.position.norm() < 1 - 1.5 * options.scale)  // away from the patch's border
+        worst = std::max(worst, angleDegrees(v.tangent, Vec3::UnitY()));
+  EXPECT_LT(worst, 1.0);
+}
+
+TEST(CurvatureLines, InvalidOptionsAndInputsAreRefused) {
+  const PointCloud cloud = surface(SurfaceShape::Cylinder, 2000);
+  auto refused = [&](auto change, const char* field) {
+    CurvatureLineOptions options = atScale(0.1);
+    change(options);
+    try {
+      traceCurvatureLines(cloud, options);
+      ADD_FAILURE() << field << " accepted";
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  refused([](auto& o) { o.scale = 0; }, "CurvatureLineOptions::scale");
+  refused([](auto& o) { o.scale = NAN; }, "CurvatureLineOptions::scale");
+  refused([](auto& o) { o.beta = -1; }, "CurvatureLineOptions::beta");
+  refused([](auto& o) { o.gamma = INFINITY; }, "CurvatureLineOptions::gamma");
+  refused([](auto& o) { o.alpha = 0.7; }, "CurvatureLineOptions::alpha");
+  refused([](auto& o) { o.fit.estimator = EstimatorKind::W1; }, "fit.estimator");
+  refused([](auto& o) { o.fit.mls = false; }, "fit.mls");
+  refused([](auto& o) { o.maxSteps = 0; }, "CurvatureLineOptions::maxSteps");
+  refused([](auto& o) { o.maxTurnDegrees = 0; }, "CurvatureLineOptions::maxTurnDegrees");
+  PointCloud noNormals;
+  noNormals.setRelativePositions(cloud.positions(), Vec3::Zero());
+  EXPECT_THROW(traceCurvatureLines(noNormals, atScale(0.1)), OptionError);
+  // Cancelled through the progress callback.
+  EXPECT_THROW(
+      traceCurvatureLines(cloud, atScale(0.1), [](double, std::string_view) { return false; }),
+      Cancelled);
+  // An empty cloud and a scale far beyond it give no lines, no crash.
+  PointCloud empty;
+  empty.setNormals({});
+  EXPECT_EQ(traceCurvatureLines(empty, atScale(0.1)).lines.size(), 0u);
+}

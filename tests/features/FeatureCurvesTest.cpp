@@ -1,0 +1,225 @@
+// Feature curves by multi-scale voting (Sec. 3.4.1): the 12 edges of a cube are one convex curve;
+// a box standing on a ground plane adds its footprint as a separate concave curve; flat faces stay
+// unlabelled; the mesh-vertex protocol labels vertices; options are checked.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <set>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/features/FeatureCurves.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+/// Points drawn uniformly on axis-aligned rectangles (exact normals), `density` per unit area.
+struct RectangleSampler {
+  std::mt19937_64 random{5};
+  std::vector<Vec3> positions, normals;
+  // The rectangle origin + u a + v b (a, b in [0, 1]), normal n.
+  void add(const Vec3& origin, const Vec3& a, const Vec3& b, const Vec3& n, double density,
+           const std::function<bool(const Vec3&)>& keep = {}) {
+    std::uniform_real_distribution<double> uniform(0, 1);
+    const auto count = std::size_t(density * a.cross(b).norm());
+    for (std::size_t i = 0; i < count; ++i) {
+      const Vec3 p = origin + uniform(random) * a + uniform(random) * b;
+      if (keep && !keep(p)) continue;
+      positions.push_back(p);
+      normals.push_back(n);
+    }
+  }
+  PointCloud cloud() const {
+    PointCloud c;
+    c.setRelativePositions(positions, Vec3::Zero());
+    c.setNormals(normals);
+    return c;
+  }
+};
+
+/// The faces of the box [0,1]^3 (without its bottom when `bottom` is false).
+void addBox(RectangleSampler& s, double density, bool bottom) {
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  s.add(Vec3(0, 0, 1), x, y, z, density);
+  if (bottom) s.add(Vec3(0, 0, 0), x, y, -z, density);
+  s.add(Vec3(0, 0, 0), x, z, -y, density);
+  s.add(Vec3(0, 1, 0), x, z, y, density);
+  s.add(Vec3(0, 0, 0), y, z, -x, density);
+  s.add(Vec3(1, 0, 0), y, z, x, density);
+}
+
+/// Distance from p to the segment [a, b].
+double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + s * ab)).norm();
+}
+
+struct Edge {
+  Vec3 a, b;
+};
+
+std::vector<Edge> cubeEdges() {
+  std::vector<Edge> edges;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int u = 0; u < 2; ++u)
+      for (int v = 0; v < 2; ++v) {
+        Vec3 a = Vec3::Zero();
+        a[(axis + 1) % 3] = u;
+        a[(axis + 2) % 3] = v;
+        Vec3 b = a;
+        b[axis] = 1;
+        edges.push_back({a, b});
+      }
+  return edges;
+}
+
+/// Of the points within `band` of the middle 80% of an edge, the fraction labelled with `sign`,
+/// and the curve ids they carry.
+struct EdgeLabels {
+  double fraction = 0;
+  std::set<int> curves;
+};
+EdgeLabels labelsAlong(const std::vector<Vec3>& points, const FeatureCurveResult& r, const Edge& e,
+                       double band, int sign) {
+  const Vec3 a = e.a + 0.1 * (e.b - e.a), b = e.a + 0.9 * (e.b - e.a);
+  std::size_t near = 0, labelled = 0;
+  EdgeLabels out;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (segmentDistance(points[i], a, b) > band) continue;
+    ++near;
+    if (r.convexity[i] == sign && r.curveId[i] >= 0) {
+      ++labelled;
+      out.curves.insert(r.curveId[i]);
+    }
+  }
+  out.fraction = near ? double(labelled) / double(near) : 0;
+  return out;
+}
+
+}  // namespace
+
+TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
+  RectangleSampler s;
+  addBox(s, 8000, true);
+  const PointCloud cloud = s.cloud();
+  const FeatureCurveResult r = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  ASSERT_EQ(r.scales.size(), 5u);
+  const double e = r.spacing;
+  for (const Edge& edge : cubeEdges()) {
+    const EdgeLabels l = labelsAlong(cloud.positions(), r, edge, 0.5 * e, +1);
+    EXPECT_GT(l.fraction, 0.9) << edge.a.transpose() << " -> " << edge.b.transpose();
+  }
+  // Nothing concave; face centres (beyond 4 e of every edge) unlabelled.
+  std::size_t concave = 0, flatLabelled = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    concave += r.convexity[i] < 0;
+    double nearest = 1e9;
+    for (const Edge& edge : cubeEdges())
+      nearest = std::min(nearest, segmentDistance(cloud.positions()[i], edge.a, edge.b));
+    if (nearest > 4 * e) flatLabelled += r.curveId[i] >= 0;
+  }
+  EXPECT_EQ(concave, 0u);
+  EXPECT_EQ(flatLabelled, 0u);
+  // The edges meet at the corners: one curve of 12 edges, length ~12.
+  ASSERT_GE(r.curves.size(), 1u);
+  const FeatureCurve& largest = *std::max_element(r.curves.begin(), r.curves.end(),
+                                                  [](const FeatureCurve& a, const FeatureCurve& b) {
+                                                    return a.points.size() < b.points.size();
+                                                  });
+  EXPECT_EQ(largest.convexity, 1);
+  EXPECT_NEAR(largest.length, 12.0, 3.0);
+  EXPECT_EQ(largest.scaleMask, 0x1Fu) << "every scale voted";
+}
+
+TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
+  RectangleSampler s;
+  addBox(s, 8000, false);
+  // Ground [-1, 2]^2 at z = 0, without the footprint of the box.
+  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
+        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+  const PointCloud cloud = s.cloud();
+  const FeatureCurveResult r = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  const double e = r.spacing;
+  std::set<int> footprintCurves, convexCurves;
+  for (const Edge& edge : cubeEdges()) {
+    const bool footprint = edge.a.z() == 0 && edge.b.z() == 0;
+    const EdgeLabels l = labelsAlong(cloud.positions(), r, edge, 0.5 * e, footprint ? -1 : +1);
+    EXPECT_GT(l.fraction, 0.9) << (footprint ? "footprint " : "convex ") << edge.a.transpose()
+                               << " -> " << edge.b.transpose();
+    (footprint ? footprintCurves : convexCurves).insert(l.curves.begin(), l.curves.end());
+  }
+  EXPECT_EQ(footprintCurves.size(), 1u) << "the footprint is one closed concave curve";
+  for (const int c : footprintCurves) {
+    EXPECT_EQ(r.curves[std::size_t(c)].convexity, -1);
+    EXPECT_EQ(convexCurves.count(c), 0u);
+    EXPECT_NEAR(r.curves[std::size_t(c)].length, 4.0, 1.0);
+  }
+}
+
+TEST(FeatureCurves, SameResultForAnyThreadCount) {
+  RectangleSampler s;
+  addBox(s, 3000, true);
+  const PointCloud cloud = s.cloud();
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return detectFeatureCurves(cloud, FeatureCurveOptions{});
+  };
+  const FeatureCurveResult one = run(1), many = run(4);
+  EXPECT_EQ(one.votes, many.votes);
+  EXPECT_EQ(one.curveId, many.curveId);
+}
+
+TEST(FeatureCurves, MeshVerticesAreLabelledOnTheMeshEdges) {
+  RectangleSampler s;
+  addBox(s, 8000, true);
+  const PointCloud cloud = s.cloud();
+  // A cube mesh of 8 vertices and 12 triangles: the vertices are corners, all on convex edges.
+  const std::vector<Vec3> vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                      {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const std::vector<std::array<Index, 3>> triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7},
+                                                       {0, 1, 5}, {0, 5, 4}, {1, 2, 6}, {1, 6, 5},
+                                                       {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  const KnnGraph graph = buildMeshEdgeGraph(vertices.size(), triangles);
+  EXPECT_EQ(graph.neighbors.size(), 36u);  // 18 edges, both ways
+  const FeatureCurveResult r = detectFeatureCurves(cloud, FeatureCurveOptions{}, vertices, graph);
+  ASSERT_EQ(r.curveId.size(), 8u);
+  for (std::size_t v = 0; v < 8; ++v) {
+    EXPECT_EQ(r.convexity[v], 1);
+    EXPECT_EQ(r.curveId[v], 0);
+  }
+  EXPECT_THROW(buildMeshEdgeGraph(3, {{0, 1, 5}}), OptionError);
+}
+
+TEST(FeatureCurves, InvalidOptionsAreRefused) {
+  RectangleSampler s;
+  addBox(s, 500, true);
+  const PointCloud cloud = s.cloud();
+  auto refused = [&](auto change, const char* field) {
+    FeatureCurveOptions options;
+    change(options);
+    try {
+      detectFeatureCurves(cloud, options);
+      ADD_FAILURE() << field << " accepted";
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  refused([](auto& o) { o.spacing = -1; }, "FeatureCurveOptions::spacing");
+  refused([](auto& o) { o.scaleCount = 0; }, "FeatureCurveOptions::scaleCount");
+  refused([](auto& o) { o.scaleCount = 40; }, "FeatureCurveOptions::scaleCount");
+  refused([](auto& o) { o.maxScaleFactor = 0.5; }, "FeatureCurveOptions::minScaleFactor");
+  refused([](auto& o) { o.salientPercentile = 2; }, "FeatureCurveOptions::salientPercentile");
+  refused([](auto& o) { o.voteThreshold = 1; }, "FeatureCurveOptions::voteThreshold");
+  refused([](auto& o) { o.graphNeighbors = 0; }, "FeatureCurveOptions::graphNeighbors");
+  refused([](auto& o) { o.lines.gamma = 0; }, "CurvatureLineOptions::gamma");
+  // All points at one place: a clear error, not a division by zero.
+  PointCloud same;
+  same.setRelativePositions(std::vector<Vec3>(10, Vec3(1, 2, 3)), Vec3::Zero());
+  same.setNormals(std::vector<Vec3>(10, Vec3::UnitZ()));
+  EXPECT_THROW(detectFeatureCurves(same, FeatureCurveOptions{}), OptionError);
+}
