@@ -70,6 +70,24 @@ TEST(CurvatureLines, OnACylinderTheLinesAreItsRulings) {
   EXPECT_LT(worst, 1.0) << checked << " vertices";
 }
 
+TEST(CurvatureLines, LinesStopAtTheBorderOfTheData) {
+  // The cylinder patch ends 1 from the origin: beyond, the APSS extrapolates.
+  const PointCloud cloud = surface(SurfaceShape::Cylinder, 40000);
+  CurvatureLineOptions options = atScale(0.1);
+  const CurvatureLineSet set = traceCurvatureLines(cloud, options);
+  EXPECT_GT(set.stops[std::size_t(LineStop::Border)], 0u);
+  double farthest = 0;
+  for (const auto& line : set.lines)
+    for (const auto& v : line.vertices) farthest = std::max(farthest, v.position.norm());
+  EXPECT_LT(farthest, 1.0);
+  // Without the test, lines run past it.
+  options.borderOffset = 0;
+  farthest = 0;
+  for (const auto& line : traceCurvatureLines(cloud, options).lines)
+    for (const auto& v : line.vertices) farthest = std::max(farthest, v.position.norm());
+  EXPECT_GT(farthest, 1.0);
+}
+
 TEST(CurvatureLines, OnATorusTheLinesAreItsParallelsAndClose) {
   // Major radius 2, minor 0.5, axis z through (-2, 0, -0.5).
   const PointCloud cloud = surface(SurfaceShape::Torus, 150000);

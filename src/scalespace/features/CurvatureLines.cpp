@@ -27,6 +27,8 @@ const char* lineStopName(LineStop stop) {
       return "turn";
     case LineStop::Stalled:
       return "stalled";
+    case LineStop::Border:
+      return "border";
     case LineStop::Collision:
       return "collision";
     case LineStop::Loop:
@@ -161,6 +163,8 @@ void validateCurvatureLineOptions(const CurvatureLineOptions& o) {
           "CurvatureLineOptions::minAnisotropy must be finite and >= 0");
   require(std::isfinite(o.minCurvatureGap) && o.minCurvatureGap >= 0 && o.minCurvatureGap <= 1,
           "CurvatureLineOptions::minCurvatureGap must be in [0, 1]");
+  require(std::isfinite(o.borderOffset) && o.borderOffset >= 0,
+          "CurvatureLineOptions::borderOffset must be finite and >= 0");
   require(std::isfinite(o.maxTurnDegrees) && o.maxTurnDegrees > 0 && o.maxTurnDegrees <= 180,
           "CurvatureLineOptions::maxTurnDegrees must be in (0, 180]");
   require(std::isfinite(o.collisionFraction) && o.collisionFraction >= 0,
@@ -229,6 +233,7 @@ class LineTracer {
                                 const std::vector<Vec3>& seedPositions) {
     const std::vector<LocalFit> fits = fit(seedPositions);
     std::vector<Start> starts;
+    std::vector<Neighbor> found;
     for (std::size_t s = 0; s < seeds.size(); ++s) {
       const LocalFit& f = fits[s];
       if (!f.valid) {
@@ -241,10 +246,26 @@ class LineTracer {
         continue;
       }
       result_.seedKappa1.push_back(std::abs(m.kappa1));
+      if (atBorder(f.projection, f.normal, found)) {
+        ++result_.stops[std::size_t(LineStop::Border)];
+        continue;
+      }
       if (nearEarlierLine(f.projection)) continue;
       starts.push_back({seeds[s], makeVertex(f, m, m.direction)});
     }
     return starts;
+  }
+
+  /// The border test of CurvatureLineOptions::borderOffset.
+  bool atBorder(const Vec3& p, const Vec3& normal, std::vector<Neighbor>& found) const {
+    if (options_.borderOffset <= 0) return false;
+    samples_.index.radiusSearch(p, t_, found);
+    if (found.empty()) return true;
+    Vec3 centroid = Vec3::Zero();
+    for (const Neighbor& nb : found) centroid += samples_.positions[nb.index];
+    Vec3 offset = centroid / double(found.size()) - p;
+    offset -= offset.dot(normal) * normal;
+    return offset.norm() > options_.borderOffset * t_;
   }
 
   bool nearEarlierLine(const Vec3& p) const {
@@ -283,10 +304,12 @@ class LineTracer {
       }
       const std::vector<LocalFit> fits = fit(queries);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active.size(), 64), [&](const auto& r) {
+        std::vector<Neighbor> found;
         for (std::size_t a = r.begin(); a != r.end(); ++a) {
           const std::size_t id = active[a];
           const Way& w = ways[id];
-          const LineStop stop = stepOutcome(fits[a], last(w).position, heading(w), candidate[id]);
+          const LineStop stop =
+              stepOutcome(fits[a], last(w).position, heading(w), candidate[id], found);
           outcome[id] = stop == LineStop::MaxSteps ? 0 : std::uint8_t(1 + int(stop));
           if (outcome[id] || collision_ <= 0) continue;
           const Vec3& p = candidate[id].position;
@@ -326,9 +349,10 @@ class LineTracer {
 
   /// What one step gives: MaxSteps (meaning "go on") and the new vertex, or why the way stops.
   LineStop stepOutcome(const LocalFit& f, const Vec3& from, const Vec3& previous,
-                       CurvatureLineVertex& vertex) const {
+                       CurvatureLineVertex& vertex, std::vector<Neighbor>& found) const {
     if (!f.valid) return LineStop::InvalidFit;
     if ((f.projection - from).norm() < 0.1 * delta_) return LineStop::Stalled;
+    if (atBorder(f.projection, f.normal, found)) return LineStop::Border;
     const MinimalDirection m = minimalDirection(f);
     if (nearUmbilic(m, t_, options_)) return LineStop::Umbilic;
     const Vec3 tangent = m.direction.dot(previous) >= 0 ? m.direction : Vec3(-m.direction);

@@ -48,6 +48,11 @@ struct CurvatureLineOptions {
   /// this scale) or |kappa2| > (1 - minCurvatureGap) |kappa1|.
   double minAnisotropy = 0.02;
   double minCurvatureGap = 0.1;
+  /// Stop a way at the border of the data (a scan's edge, a hole): where the centroid of the
+  /// samples within t of the vertex is more than borderOffset t from it along the surface (half
+  /// a disc puts it 0.42 t away; a full one near 0). Beyond the border the APSS extrapolates and
+  /// a one-sided neighbourhood biases the curvatures. 0 never stops there.
+  double borderOffset = 0.2;
   /// Stop a way when one step turns by more than this (the field jumped: crossing an umbilic).
   double maxTurnDegrees = 45;
   /// Stop a way within collisionFraction * delta of another line's vertex (lines of one scale
@@ -71,6 +76,7 @@ enum class LineStop : std::uint8_t {
   Umbilic,     // |kappa1| ~ |kappa2|: no minimal direction
   Turn,        // turned more than maxTurnDegrees in one step
   Stalled,     // the projection undid the step (moved < delta / 10)
+  Border,      // reached the border of the data (borderOffset)
   Collision,   // reached another line
   Loop,        // closed on itself
   MaxSteps
