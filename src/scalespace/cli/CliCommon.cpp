@@ -129,6 +129,10 @@ void checkOutput(const std::string& output, OutputKind kind,
       if (ext != ".csv")
         throw OptionError("output " + output + ": this output is CSV text; name it *.csv");
       break;
+    case OutputKind::Lines:
+      if (ext != ".ply" && ext != ".obj")
+        throw OptionError("output " + output + ": lines are written as .ply or .obj");
+      break;
     case OutputKind::Stack:
       checkStackDestination(output);
       break;

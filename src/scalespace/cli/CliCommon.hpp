@@ -33,7 +33,8 @@ enum class OutputKind {
   Png,          // an image (.png)
   Csv,          // a table (.csv)
   Stack,        // a scale stack folder: replaces only an earlier stack
-  PlanesResult  // the planes' folder: new, empty, or an earlier result
+  PlanesResult, // the planes' folder: new, empty, or an earlier result
+  Lines         // polylines (.ply with edges, .obj)
 };
 
 /// Checks an output before any work, so that a long run never fails at its end: the output is

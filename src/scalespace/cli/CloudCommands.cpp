@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/FeatureCommands.hpp"
 #include "scalespace/cli/PlanesCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/cli/ScalesCommands.hpp"
@@ -330,6 +331,7 @@ void addCloudCommands(CLI::App& app) {
   addCurvatureCommand(app);
   addScalesCommands(app);
   addPlanesCommands(app);
+  addFeatureCommands(app);
 }
 
 }  // namespace scalespace::cli

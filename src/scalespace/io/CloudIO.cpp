@@ -5,6 +5,7 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/AtomicFile.hpp"
+#include "scalespace/io/CloudBuilder.hpp"
 #include "scalespace/io/LasFormat.hpp"
 #include "scalespace/io/MeshFormat.hpp"
 #include "scalespace/io/PcdFormat.hpp"
@@ -102,6 +103,32 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
       return readPcd(data, path, options, report);
   }
   throw OptionError(path + ": unknown format");
+}
+
+bool isMeshPath(const std::string& path) {
+  try {
+    const CloudFormat format = formatFromPath(path);
+    return format == CloudFormat::Off || format == CloudFormat::Obj;
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+TriangleMesh readTriangleMesh(const std::string& path) {
+  if (!isMeshPath(path))
+    throw FileError(path, "", "is not a mesh file", "give an .off or .obj file");
+  const std::string data = readWholeFile(path);
+  TriangleMesh mesh = formatFromPath(path) == CloudFormat::Off ? parseOff(data, path)
+                                                               : parseObj(data, path);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    if (!isUsablePosition(mesh.vertices[v]))
+      throw FileError(path, lineWhere(mesh.vertexLines[v]),
+                      "vertex " + std::to_string(v + 1) +
+                          " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
+                      "fix or remove that vertex");
+  if (mesh.triangles.empty())
+    throw FileError(path, "", "the mesh has no faces", "give a mesh with triangles or polygons");
+  return mesh;
 }
 
 void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOptions& options) {

@@ -24,6 +24,7 @@
 #include <string>
 
 #include "scalespace/core/PointCloud.hpp"
+#include "scalespace/io/MeshFormat.hpp"
 #include "scalespace/io/ReadOptions.hpp"
 
 namespace scalespace {
@@ -47,5 +48,13 @@ struct WriteOptions {
 /// Writes `cloud` atomically (writeFileAtomically). OFF/OBJ cannot be written (a point cloud has no
 /// faces): OptionError.
 void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOptions& options = {});
+
+/// True for the extensions of the mesh formats (.off, .obj), whose faces readTriangleMesh reads.
+bool isMeshPath(const std::string& path);
+
+/// The triangles of an OFF or OBJ file (polygons as fans) with its vertices and vertex normals
+/// when it has usable ones. FileError naming the file (and the line) for another format, a vertex
+/// with a NaN, infinite or absurd coordinate, or no triangle.
+TriangleMesh readTriangleMesh(const std::string& path);
 
 }  // namespace scalespace

@@ -1,0 +1,349 @@
+#include "scalespace/cli/FeatureCommands.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/ProgressBar.hpp"
+#include "scalespace/core/Error.hpp"
+#include "scalespace/features/CurvatureLines.hpp"
+#include "scalespace/features/FeatureCurves.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
+
+namespace scalespace::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Every line of `sets` as one polyline set with the per-vertex attributes of Sec. 3.3:
+/// line id, scale, kappa1, kappa2, |kappa1| - |kappa2|, nu, tangent (and the normal).
+PolylineSet toPolylines(const std::vector<CurvatureLineSet>& sets, const Vec3& origin) {
+  std::vector<Vec3> positions, normals;
+  std::vector<double> columns[9];
+  PolylineSet out;
+  std::size_t id = 0;
+  for (const CurvatureLineSet& set : sets)
+    for (const CurvatureLine& line : set.lines) {
+      for (const CurvatureLineVertex& v : line.vertices) {
+        positions.push_back(v.position);
+        normals.push_back(v.normal);
+        const double values[9] = {double(id),
+                                  set.scale,
+                                  v.kappa1,
+                                  v.kappa2,
+                                  std::abs(v.kappa1) - std::abs(v.kappa2),
+                                  v.geometricVariation,
+                                  v.tangent.x(),
+                                  v.tangent.y(),
+                                  v.tangent.z()};
+        for (int c = 0; c < 9; ++c) columns[c].push_back(values[c]);
+      }
+      out.offsets.push_back(positions.size());
+      out.closed.push_back(line.closed ? 1 : 0);
+      ++id;
+    }
+  out.vertices.setRelativePositions(std::move(positions), origin);
+  out.vertices.setNormals(std::move(normals));
+  const char* names[9] = {"line_id", "scale", "k1", "k2", "k_gap", "nu", "tx", "ty", "tz"};
+  for (int c = 0; c < 9; ++c) {
+    AttributeColumn& column =
+        out.vertices.addAttribute(names[c], c == 0 ? ScalarType::Int32 : ScalarType::Float32);
+    column.values = std::move(columns[c]);
+  }
+  return out;
+}
+
+nlohmann::json stopCounts(const CurvatureLineSet& set) {
+  nlohmann::json stops = nlohmann::json::object();
+  for (std::size_t s = 0; s < set.stops.size(); ++s)
+    stops[lineStopName(LineStop(s))] = set.stops[s];
+  return stops;
+}
+
+// ------------------------------------------------------------------------------------- lines
+void addLinesCommand(CLI::App& app) {
+  struct Args {
+    InputOptions input;
+    std::string output;
+    double scale = 0, tMin = 0, tMax = 0;
+    int scales = 0;
+    CurvatureLineOptions lines;
+    bool robust = false, ascii = false, quiet = false;
+    int threads = 0;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "lines", "minimal-curvature lines on the APSS at one or several scales (Sec. 3.3)");
+  addInputOptions(*cmd, args->input);
+  cmd->add_option("-o,--output", args->output, "output polylines (.ply with edges, or .obj)")
+      ->required();
+  auto* scale = cmd->add_option("--scale", args->scale, "scale t in the cloud's units");
+  auto* scales = cmd->add_option(
+      "--scales", args->scales,
+      "M scales, log-spaced from --tmin (default: the mean distance to the 16th neighbour) to "
+      "--tmax (default: 10% of the bounding-box diagonal)");
+  scale->excludes(scales);
+  cmd->add_option("--tmin", args->tMin, "smallest scale with --scales");
+  cmd->add_option("--tmax", args->tMax, "largest scale with --scales");
+  cmd->add_option("--beta", args->lines.beta, "seeds: Poisson-disk radius beta t")
+      ->capture_default_str();
+  cmd->add_option("--gamma", args->lines.gamma, "step delta = gamma t (Eq. 3.2)")
+      ->capture_default_str();
+  cmd->add_option("--alpha", args->lines.alpha,
+                  "fits read the Poisson-disk level of radius alpha t (Sec. 1.5.2; 0 = all points)")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", args->lines.maxSteps, "most steps each way")
+      ->capture_default_str();
+  cmd->add_flag("--robust", args->robust, "robust re-weighting (RIMLS) in the fits");
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    ThreadScope threads(args->threads);
+    if (args->scale <= 0 && args->scales <= 0)
+      throw OptionError("give the scale: --scale T, or --scales M for M scales");
+    if (args->scales > 0) validateScaleCount(args->scales);
+    CurvatureLineOptions options = args->lines;
+    options.fit.robust = args->robust;
+    options.scale = args->scale > 0 ? args->scale : 1;
+    validateCurvatureLineOptions(options);  // before the read
+    checkOutput(args->output, OutputKind::Lines, {args->input.path});
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    ensureNormals(cloud, args->quiet);
+
+    std::vector<double> ts{args->scale};
+    if (args->scales > 0) {
+      const double lo = args->tMin > 0 ? args->tMin : meanKthNeighborDistance(cloud.positions(), 16);
+      const double hi = args->tMax > 0 ? args->tMax : 0.1 * cloud.boundingBoxDiagonal();
+      ts = scaleSeries(lo, std::max(hi, lo), args->scales, ScaleSpacing::Log);
+    }
+    const auto progress = makeProgressBar(args->quiet);
+    std::vector<CurvatureLineSet> sets;
+    nlohmann::json perScale = nlohmann::json::array();
+    for (std::size_t s = 0; s < ts.size(); ++s) {
+      options.scale = ts[s];
+      const auto scaleProgress = [&](double f, std::string_view stage) {
+        return !progress || progress((double(s) + f) / double(ts.size()), stage);
+      };
+      sets.push_back(traceCurvatureLines(cloud, options, scaleProgress));
+      const CurvatureLineSet& set = sets.back();
+      std::size_t vertices = 0, closed = 0;
+      double length = 0;
+      for (const CurvatureLine& line : set.lines) {
+        vertices += line.vertices.size();
+        closed += line.closed;
+        length += line.length();
+      }
+      perScale.push_back({{"scale", set.scale},
+                          {"lines", set.lines.size()},
+                          {"closed_lines", closed},
+                          {"vertices", vertices},
+                          {"total_length", length},
+                          {"seeds", set.seeds},
+                          {"samples", set.samples},
+                          {"fits", set.fits},
+                          {"way_stops", stopCounts(set)},
+                          {"seconds", set.seconds}});
+      if (!args->quiet)
+        std::fprintf(stderr, "lines: t = %.6g: %zu lines, %zu vertices, %zu seeds, %.2f s\n",
+                     set.scale, set.lines.size(), vertices, set.seeds, set.seconds);
+    }
+    const PolylineSet polylines = toPolylines(sets, cloud.origin());
+    writePolylines(polylines, args->output, WriteOptions{args->ascii});
+    const double total = std::chrono::duration<double>(Clock::now() - start).count();
+    const nlohmann::json json = {{"command", "lines"},
+                                 {"version", SCALESPACE_VERSION},
+                                 {"input", args->input.path},
+                                 {"output", args->output},
+                                 {"points", cloud.size()},
+                                 {"parameters",
+                                  {{"beta", options.beta},
+                                   {"gamma", options.gamma},
+                                   {"alpha", options.alpha},
+                                   {"robust", options.fit.robust},
+                                   {"max_steps", options.maxSteps},
+                                   {"threads", args->threads}}},
+                                 {"scales", perScale},
+                                 {"seconds", total}};
+    writeJson(summaryPathFor(args->output), json);
+    if (!args->quiet)
+      std::fprintf(stderr, "lines: %zu lines -> %s\n", polylines.lineCount(),
+                   args->output.c_str());
+    reportDone("lines", start, args->quiet);
+  });
+}
+
+// ---------------------------------------------------------------------------------- features
+/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1).
+double medianEdgeLength(const TriangleMesh& mesh) {
+  std::vector<double> lengths;
+  lengths.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c)
+      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
+                   lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+void addFeaturesCommand(CLI::App& app) {
+  struct Args {
+    InputOptions input;
+    std::string output, linesOutput;
+    FeatureCurveOptions features;
+    std::size_t samplesPerVertex = 100;
+    bool ascii = false, quiet = false;
+    int threads = 0;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "features",
+      "feature curves by multi-scale voting of salient curvature lines (Sec. 3.4.1); a mesh "
+      "input (.off .obj) labels its vertices");
+  cmd->add_option("input", args->input.path, "input point cloud or mesh")->required();
+  cmd->add_flag("--drop-invalid", args->input.dropInvalid,
+                "skip points with NaN/Inf coordinates instead of failing");
+  cmd->add_option("-o,--output", args->output,
+                  "output cloud (input points or mesh vertices + feature_votes, curve_id, "
+                  "convexity); a JSON summary is written beside it")
+      ->required();
+  cmd->add_option("--lines", args->linesOutput, "also write the salient lines (.ply or .obj)");
+  cmd->add_option("--spacing", args->features.spacing,
+                  "unit e of the scales and votes (0: mesh median edge length, or mean distance "
+                  "to the 16th neighbour)")
+      ->capture_default_str();
+  cmd->add_option("--scales", args->features.scaleCount, "number of scales in [e, 3e]")
+      ->capture_default_str();
+  cmd->add_option("--salient", args->features.salientThreshold,
+                  "salient vertices: |k1| > (1 - this) K, K the 90th percentile of |k1|")
+      ->capture_default_str();
+  cmd->add_option("--vote-threshold", args->features.voteThreshold,
+                  "curves hold points with |votes| > this x the largest")
+      ->capture_default_str();
+  cmd->add_option("--min-extent", args->features.minCurveExtent,
+                  "drop curves spanning less than this x e (0 keeps all)")
+      ->capture_default_str();
+  cmd->add_option("--mesh-samples", args->samplesPerVertex,
+                  "mesh inputs: sample this many points per vertex by area (Sec. 3.4.1: 100)")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    ThreadScope threads(args->threads);
+    FeatureCurveOptions options = args->features;
+    validateFeatureCurveOptions(options);  // before the read
+    if (args->samplesPerVertex < 1 || args->samplesPerVertex > 10000)
+      throw OptionError("--mesh-samples must be in [1, 10000]");
+    std::vector<std::string> inputs{args->input.path};
+    checkOutput(args->output, OutputKind::Cloud, inputs);
+    if (!args->linesOutput.empty()) checkOutput(args->linesOutput, OutputKind::Lines, inputs);
+
+    // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
+    // edges; a cloud labels its own points on its k-NN graph.
+    const bool mesh = isMeshPath(args->input.path);
+    PointCloud cloud, targets;
+    FeatureCurveResult result;
+    const auto progress = makeProgressBar(args->quiet);
+    if (mesh) {
+      const TriangleMesh triangles = readTriangleMesh(args->input.path);
+      const std::size_t count = args->samplesPerVertex * triangles.vertices.size();
+      cloud = sampleMesh(triangles, count, 1);
+      targets.setRelativePositions(triangles.vertices, Vec3::Zero());
+      if (options.spacing == 0) options.spacing = medianEdgeLength(triangles);
+      if (!args->quiet)
+        std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu samples, e = %.6g\n",
+                     args->input.path.c_str(), triangles.vertices.size(),
+                     triangles.triangles.size(), cloud.size(), options.spacing);
+      const KnnGraph graph = buildMeshEdgeGraph(triangles.vertices.size(), triangles.triangles);
+      result = detectFeatureCurves(cloud, options, triangles.vertices, graph, progress);
+    } else {
+      cloud = loadCloud(args->input, args->quiet);
+      ensureNormals(cloud, args->quiet);
+      result = detectFeatureCurves(cloud, options, progress);
+    }
+    PointCloud& out = mesh ? targets : cloud;
+    AttributeColumn& votes = out.addAttribute("feature_votes", ScalarType::Float32);
+    votes.values = result.votes;
+    AttributeColumn& ids = out.addAttribute("curve_id", ScalarType::Int32);
+    AttributeColumn& convexity = out.addAttribute("convexity", ScalarType::Int8);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      ids.values[i] = result.curveId[i];
+      convexity.values[i] = result.convexity[i];
+    }
+    writeCloud(out, args->output, WriteOptions{args->ascii});
+    if (!args->linesOutput.empty()) {
+      // The salient part of the lines is what voted; the whole lines are written, with k1 and
+      // the scale to tell them apart.
+      writePolylines(toPolylines(result.lineSets, cloud.origin()), args->linesOutput,
+                     WriteOptions{args->ascii});
+    }
+
+    nlohmann::json scales = nlohmann::json::array();
+    for (const FeatureCurveScale& s : result.scales)
+      scales.push_back({{"scale", s.scale},
+                        {"salient_bound", s.salientBound},
+                        {"lines", s.lines},
+                        {"vertices", s.vertices},
+                        {"salient_vertices", s.salientVertices}});
+    nlohmann::json curves = nlohmann::json::array();
+    std::size_t labelled = 0;
+    for (std::size_t c = 0; c < result.curves.size(); ++c) {
+      const FeatureCurve& curve = result.curves[c];
+      labelled += curve.points.size();
+      nlohmann::json voted = nlohmann::json::array();
+      for (std::size_t s = 0; s < result.scales.size(); ++s)
+        if (curve.scaleMask >> s & 1) voted.push_back(result.scales[s].scale);
+      curves.push_back({{"id", c},
+                        {"points", curve.points.size()},
+                        {"length", curve.length},
+                        {"convexity", curve.convexity > 0 ? "convex" : "concave"},
+                        {"scales", voted}});
+    }
+    const double total = std::chrono::duration<double>(Clock::now() - start).count();
+    const nlohmann::json json = {
+        {"command", "features"},
+        {"version", SCALESPACE_VERSION},
+        {"input", args->input.path},
+        {"output", args->output},
+        {"labelled", mesh ? "mesh vertices" : "points"},
+        {"points", out.size()},
+        {"samples", cloud.size()},
+        {"spacing", result.spacing},
+        {"max_vote", result.maxVote},
+        {"feature_points", labelled},
+        {"parameters",
+         {{"scale_count", options.scaleCount},
+          {"salient_threshold", options.salientThreshold},
+          {"salient_percentile", options.salientPercentile},
+          {"vote_threshold", options.voteThreshold},
+          {"min_curve_extent", options.minCurveExtent},
+          {"threads", args->threads}}},
+        {"scales", scales},
+        {"curves", curves},
+        {"seconds", total}};
+    const std::string summaryPath = summaryPathFor(args->output);
+    writeJson(summaryPath, json);
+    if (!args->quiet)
+      std::fprintf(stderr, "features: %zu curves, %zu of %zu %s labelled -> %s (summary %s)\n",
+                   result.curves.size(), labelled, out.size(), mesh ? "vertices" : "points",
+                   args->output.c_str(), summaryPath.c_str());
+    reportDone("features", start, args->quiet);
+  });
+}
+
+}  // namespace
+
+void addFeatureCommands(CLI::App& app) {
+  addLinesCommand(app);
+  addFeaturesCommand(app);
+}
+
+}  // namespace scalespace::cli
