@@ -14,10 +14,12 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
 #include "scalespace/planes/PlaneExport.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
 #include "scalespace/planes/StackPlanes.hpp"
 #include "scalespace/render/ColorMap.hpp"
+#include "scalespace/render/LineRenderer.hpp"
 #include "scalespace/render/PngWriter.hpp"
 #include "scalespace/render/PointRenderer.hpp"
 
@@ -53,6 +55,7 @@ void addRenderCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
     std::string output, color, labels, view = "iso", up = "z", size = "1024x768";
+    std::string lines, lineColor;
     int radius = -1;
     bool noShading = false, quiet = false;
   };
@@ -74,10 +77,16 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--point-radius", args->radius, "splat radius in pixels (-1 = automatic)")
       ->capture_default_str();
   cmd->add_flag("--no-shading", args->noShading, "flat colours (no shading from normals)");
+  auto* lines = cmd->add_option("--lines", args->lines,
+                                "draw these polylines (.ply with vertex and edge elements) over "
+                                "the points, hidden where the surface is in front of them");
+  cmd->add_option("--line-color-by", args->lineColor,
+                  "colour the lines by a vertex attribute of theirs (default: solid red)")
+      ->needs(lines);
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
     const auto start = std::chrono::steady_clock::now();
-    checkOutput(args->output, OutputKind::Png, {args->input.path});
+    checkOutput(args->output, OutputKind::Png, {args->input.path, args->lines});
     RenderOptions options;
     parseSize(args->size, options.width, options.height);
     options.view = args->view;
@@ -90,8 +99,24 @@ void addRenderCommand(CLI::App& app) {
       std::fprintf(stderr, "warning: --point-radius %d is drawn as %d pixels (the largest)\n",
                    args->radius, kMaxPointRadius);
     options.shading = !args->noShading;
+    // The lines first: they are small, and a bad lines file or colour attribute is then reported
+    // before the (possibly long) read of the cloud.
+    PolylineSet polylines;
+    LineRenderOptions lineOptions;
+    lineOptions.colorAttribute = args->lineColor;
+    if (!args->lines.empty()) {
+      polylines = readPolylines(args->lines);
+      polylineColors(polylines, lineOptions);
+    }
     const PointCloud cloud = loadCloud(args->input, args->quiet);
-    writePng(renderPoints(cloud, options), args->output);
+    Rendering rendering = renderPointsWithDepth(cloud, options);
+    if (!args->lines.empty()) {
+      drawPolylines(rendering, polylines, lineOptions);
+      if (!args->quiet)
+        std::fprintf(stderr, "%zu lines, %zu vertices drawn\n", polylines.lineCount(),
+                     polylines.vertices.size());
+    }
+    writePng(rendering.image, args->output);
     reportDone("render", start, args->quiet);
   });
 }

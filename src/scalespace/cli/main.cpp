@@ -40,6 +40,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"StackWriteOptions::encoding", "--encoding"},
     {"RenderOptions::up", "--up"},
     {"RenderOptions::view", "--view"},
+    {"LineRenderOptions::colorAttribute", "--line-color-by"},
     {"RenderOptions::width and height", "--size width and height"},
     {"SceneOptions::noise", "--noise"},
     {"CurvatureLineOptions::beta", "--beta"},

@@ -3,13 +3,18 @@
 //
 // Reading: the `vertex` element gives the points: x y z -> positions, nx ny nz -> normals, every
 // other scalar property -> an attribute column of that PLY type (char/uchar/.../double and the
-// int8/.../float64 aliases). List properties and other elements (faces, edges, ...) are parsed
-// and skipped; comments and obj_info are ignored.
+// int8/.../float64 aliases). List properties and other elements (faces, ...) are parsed and
+// skipped; so is the `edge` element (scalar vertex1, vertex2: polylines, io/Polylines.hpp) unless
+// the caller asks for it. Comments and obj_info are ignored.
 // Writing: x y z as float32 when that is exact, else float64; nx ny nz float32; then every
-// attribute column with its ScalarType, in column order.
+// attribute column with its ScalarType, in column order; then, when given, the edges as
+// `element edge` with `int vertex1, int vertex2` (the layout CloudCompare, MeshLab and Blender
+// use).
+#include <array>
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/io/ReadOptions.hpp"
@@ -18,10 +23,20 @@ namespace scalespace {
 
 enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
 
-/// Parses a whole PLY file held in `data`; `file` names it in error messages.
-PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options = {},
-                   ReadReport* report = nullptr);
+/// An item of the `edge` element: the 0-based indices of the two vertices it joins.
+using PlyEdge = std::array<Index, 2>;
 
-void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding);
+/// Parses a whole PLY file held in `data`; `file` names it in error messages. With `edges`, also
+/// hands back the `edge` element's items in file order (none when the file has no such element),
+/// each index checked against the vertex count (FileError naming the edge's line or byte); an edge
+/// element without scalar vertex1 and vertex2 properties is a FileError. Reading edges with
+/// ReadOptions::dropNonFinite is an OptionError: skipping a vertex would renumber the others.
+PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options = {},
+                   ReadReport* report = nullptr, std::vector<PlyEdge>* edges = nullptr);
+
+/// Writes the cloud as the vertex element and, when `edges` is given, an edge element after it
+/// (indices below cloud.size(), which must fit an int: Error otherwise).
+void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding,
+              const std::vector<PlyEdge>* edges = nullptr);
 
 }  // namespace scalespace

@@ -1,4 +1,5 @@
 #include <array>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -187,15 +188,16 @@ VertexLayout planVertex(const PlyElement& vertex, const std::string& file, Cloud
   return layout;
 }
 
-/// Stores property `i`'s value into the point being assembled.
+/// Stores property `i`'s value into the point being assembled; `finish` adds the point.
 struct VertexAssembler {
   const VertexLayout& layout;
+  CloudBuilder& builder;
   Vec3 position = Vec3::Zero();
   Vec3 normal = Vec3::Zero();
   std::vector<double> values;
 
-  explicit VertexAssembler(const VertexLayout& l, std::size_t columns)
-      : layout(l), values(columns, 0.0) {}
+  VertexAssembler(const VertexLayout& l, CloudBuilder& b)
+      : layout(l), builder(b), values(b.columnCount(), 0.0) {}
   void set(std::size_t i, double value) {
     for (int k = 0; k < 3; ++k) {
       if (layout.position[k] == int(i)) position[k] = value;
@@ -203,10 +205,104 @@ struct VertexAssembler {
     }
     if (layout.column[i] >= 0) values[std::size_t(layout.column[i])] = value;
   }
+  template <class Where>
+  void finish(Where&& where) {
+    builder.addPoint(position, normal, values.data(), where);
+  }
+};
+
+/// Which properties of the `edge` element hold its two vertex indices.
+struct EdgeLayout {
+  int vertex1 = -1, vertex2 = -1;
+};
+
+EdgeLayout planEdge(const PlyElement& edge, const std::string& file) {
+  EdgeLayout layout;
+  for (std::size_t i = 0; i < edge.properties.size(); ++i) {
+    if (edge.properties[i].isList) continue;
+    if (edge.properties[i].name == "vertex1") layout.vertex1 = int(i);
+    if (edge.properties[i].name == "vertex2") layout.vertex2 = int(i);
+  }
+  if (layout.vertex1 < 0 || layout.vertex2 < 0)
+    throw FileError(file, lineWhere(edge.line),
+                    "the edge element has no scalar properties 'vertex1' and 'vertex2'",
+                    "an edge is declared as 'property int vertex1' and 'property int vertex2'");
+  return layout;
+}
+
+/// Collects the `edge` element's vertex index pairs, each checked against the vertex count as it
+/// is read, so that the error names the place of the bad edge.
+struct EdgeAssembler {
+  const EdgeLayout& layout;
+  std::size_t vertexCount;
+  const std::string& file;
+  std::vector<PlyEdge>& edges;
+  double ends[2] = {0, 0};
+
+  void set(std::size_t i, double value) {
+    if (int(i) == layout.vertex1) ends[0] = value;
+    if (int(i) == layout.vertex2) ends[1] = value;
+  }
+  template <class Where>
+  void finish(Where&& where) {
+    for (int k = 0; k < 2; ++k)
+      if (!(ends[k] >= 0 && ends[k] < double(vertexCount) && ends[k] == std::floor(ends[k])))
+        throw FileError(file, where(),
+                        "edge " + std::to_string(edges.size() + 1) + ": vertex" +
+                            std::to_string(k + 1) + " = " + formatNumber(ends[k]) +
+                            " is not the index of a vertex (the file has " +
+                            std::to_string(vertexCount) + ")",
+                        "vertex indices start at 0 and stay below the vertex count");
+    edges.push_back({Index(ends[0]), Index(ends[1])});
+  }
+};
+
+/// For elements nobody reads: ascii values are still parsed (and so checked).
+struct IgnoredItems {
+  void set(std::size_t, double) {}
+  template <class Where>
+  void finish(Where&&) {}
+};
+
+void skipBinaryList(ByteReader& in, const PlyProperty& p, bool big, const std::string& file) {
+  const double count = in.readScalar(p.countType, big, "a list count");
+  if (count < 0)
+    throw FileError(file, byteWhere(in.offset()), "negative list length in '" + p.name + "'");
+  std::size_t bytes = 0;
+  if (!multiplyChecked(std::size_t(count), scalarTypeSize(p.type), bytes))
+    throw FileError(file, byteWhere(in.offset()), "list too long");
+  in.skip(bytes, "list items");
+}
+
+/// Decodes every item of `element` into `sink` (lists are skipped: no reader keeps one).
+template <class Sink>
+void readBinaryItems(ByteReader& in, const PlyElement& element, bool big, const std::string& file,
+                     Sink& sink) {
+  for (std::size_t n = 0; n < element.count; ++n) {
+    const std::size_t start = in.offset();
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      const PlyProperty& p = element.properties[i];
+      if (p.isList)
+        skipBinaryList(in, p, big, file);
+      else
+        sink.set(i, in.readScalar(p.type, big, "a property value"));
+    }
+    sink.finish([&] { return byteWhere(start); });
+  }
+}
+
+/// The elements a reader wants: the vertices always, the edges when `edges` is given.
+struct ElementPlan {
+  std::size_t vertexIndex = 0;
+  const VertexLayout* vertex = nullptr;
+  std::size_t edgeIndex = std::size_t(-1);  // none
+  const EdgeLayout* edge = nullptr;
+  std::size_t vertexCount = 0;
+  std::vector<PlyEdge>* edges = nullptr;
 };
 
 void readBinary(const PlyHeader& header, std::string_view data, const std::string& file,
-                CloudBuilder& builder, const VertexLayout* layout, std::size_t vertexIndex) {
+                CloudBuilder& builder, const ElementPlan& plan) {
   const bool big = header.encoding == PlyEncoding::BinaryBigEndian;
   ByteReader in(data, file);
   in.seek(header.dataOffset, "the end of the header");
@@ -228,59 +324,83 @@ void readBinary(const PlyHeader& header, std::string_view data, const std::strin
                           " items of at least " + std::to_string(minimum) + " bytes but only " +
                           std::to_string(in.remaining()) + " bytes remain",
                       "the file is truncated or its header count is wrong");
-    if (e != vertexIndex) {
-      if (fixed) {
-        in.skip(needed, element.name.c_str());
-        continue;
-      }
+    if (e == plan.vertexIndex) {
+      builder.reserve(element.count);
+      VertexAssembler vertex(*plan.vertex, builder);
+      readBinaryItems(in, element, big, file, vertex);
+    } else if (e == plan.edgeIndex) {
+      plan.edges->reserve(element.count);
+      EdgeAssembler edge{*plan.edge, plan.vertexCount, file, *plan.edges};
+      readBinaryItems(in, element, big, file, edge);
+    } else if (fixed) {
+      in.skip(needed, element.name.c_str());
+    } else {
       for (std::size_t n = 0; n < element.count; ++n)
         for (const auto& p : element.properties) {
-          if (!p.isList) {
+          if (p.isList)
+            skipBinaryList(in, p, big, file);
+          else
             in.skip(scalarTypeSize(p.type), "a property");
-            continue;
-          }
-          const double count = in.readScalar(p.countType, big, "a list count");
-          if (count < 0)
-            throw FileError(file, byteWhere(in.offset()),
-                            "negative list length in '" + p.name + "'");
-          std::size_t bytes = 0;
-          if (!multiplyChecked(std::size_t(count), scalarTypeSize(p.type), bytes))
-            throw FileError(file, byteWhere(in.offset()), "list too long");
-          in.skip(bytes, "list items");
         }
-      continue;
-    }
-    builder.reserve(element.count);
-    VertexAssembler vertex(*layout, builder.columnCount());
-    for (std::size_t n = 0; n < element.count; ++n) {
-      const std::size_t start = in.offset();
-      for (std::size_t i = 0; i < element.properties.size(); ++i) {
-        const PlyProperty& p = element.properties[i];
-        if (p.isList) {
-          const double count = in.readScalar(p.countType, big, "a list count");
-          if (count < 0)
-            throw FileError(file, byteWhere(in.offset()),
-                            "negative list length in '" + p.name + "'");
-          std::size_t bytes = 0;
-          if (!multiplyChecked(std::size_t(count), scalarTypeSize(p.type), bytes))
-            throw FileError(file, byteWhere(in.offset()), "list too long");
-          in.skip(bytes, "list items");
-        } else {
-          vertex.set(i, in.readScalar(p.type, big, "a vertex property"));
-        }
-      }
-      builder.addPoint(vertex.position, vertex.normal, vertex.values.data(),
-                       [&] { return byteWhere(start); });
     }
   }
 }
 
-void readAscii(const PlyHeader& header, std::string_view data, const std::string& file,
-               CloudBuilder& builder, const VertexLayout* layout, std::size_t vertexIndex) {
-  LineScanner lines(data.substr(header.dataOffset));
-  const std::size_t lineBase = header.dataLine;
+/// Parses the lines of every item of `element` into `sink`.
+template <class Sink>
+void readAsciiItems(LineScanner& lines, std::size_t lineBase, const PlyElement& element,
+                    const std::string& file, Sink& sink) {
   std::vector<std::string_view> tokens;
   std::string_view line;
+  for (std::size_t n = 0; n < element.count; ++n) {
+    do {
+      if (!lines.next(line))
+        throw FileError(file, lineWhere(lineBase + lines.lineNumber() + 1),
+                        "unexpected end of file: element '" + element.name + "' declares " +
+                            std::to_string(element.count) + " items, found " + std::to_string(n),
+                        "the file is truncated or its header count is wrong");
+      splitWhitespace(line, tokens);
+    } while (tokens.empty());
+    const std::size_t lineNumber = lineBase + lines.lineNumber();
+    std::size_t t = 0;
+    auto nextNumber = [&](ScalarType type, const std::string& name) {
+      if (t >= tokens.size())
+        throw FileError(file, lineWhere(lineNumber),
+                        "too few values: property '" + name + "' is missing");
+      const auto value = parseNumber(tokens[t]);
+      if (!value || !fitsScalarType(*value, type))
+        throw FileError(file, lineWhere(lineNumber),
+                        quoted(tokens[t]) + " is not a valid " + scalarTypeName(type) +
+                            " for property '" + name + "'");
+      ++t;
+      return toStoredValue(*value, type);  // a float property holds a float
+    };
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      const PlyProperty& p = element.properties[i];
+      if (p.isList) {
+        const double count = nextNumber(p.countType, p.name);
+        if (count < 0 || count > double(tokens.size() - t))
+          throw FileError(file, lineWhere(lineNumber),
+                          "list '" + p.name + "' declares " + formatNumber(count) +
+                              " items but the line has fewer values");
+        for (std::size_t k = 0; k < std::size_t(count); ++k) nextNumber(p.type, p.name);
+      } else {
+        sink.set(i, nextNumber(p.type, p.name));
+      }
+    }
+    if (t != tokens.size())
+      throw FileError(
+          file, lineWhere(lineNumber),
+          "expected " + std::to_string(t) + " values, found " + std::to_string(tokens.size()),
+          "each " + element.name + " must be on its own line");
+    sink.finish([&] { return lineWhere(lineNumber); });
+  }
+}
+
+void readAscii(const PlyHeader& header, std::string_view data, const std::string& file,
+               CloudBuilder& builder, const ElementPlan& plan) {
+  LineScanner lines(data.substr(header.dataOffset));
+  const std::size_t lineBase = header.dataLine;
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     const PlyElement& element = header.elements[e];
     if (element.properties.empty()) continue;
@@ -291,58 +411,17 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
                           " items but the file has only " + std::to_string(lines.remainingBytes()) +
                           " bytes left",
                       "the file is truncated or its header count is wrong");
-    VertexAssembler* vertex = nullptr;
-    std::optional<VertexAssembler> storage;
-    if (e == vertexIndex) {
+    if (e == plan.vertexIndex) {
       builder.reserve(element.count);
-      storage.emplace(*layout, builder.columnCount());
-      vertex = &*storage;
-    }
-    for (std::size_t n = 0; n < element.count; ++n) {
-      do {
-        if (!lines.next(line))
-          throw FileError(file, lineWhere(lineBase + lines.lineNumber() + 1),
-                          "unexpected end of file: element '" + element.name + "' declares " +
-                              std::to_string(element.count) + " items, found " + std::to_string(n),
-                          "the file is truncated or its header count is wrong");
-        splitWhitespace(line, tokens);
-      } while (tokens.empty());
-      const std::size_t lineNumber = lineBase + lines.lineNumber();
-      std::size_t t = 0;
-      auto nextNumber = [&](ScalarType type, const std::string& name) {
-        if (t >= tokens.size())
-          throw FileError(file, lineWhere(lineNumber),
-                          "too few values: property '" + name + "' is missing");
-        const auto value = parseNumber(tokens[t]);
-        if (!value || !fitsScalarType(*value, type))
-          throw FileError(file, lineWhere(lineNumber),
-                          quoted(tokens[t]) + " is not a valid " + scalarTypeName(type) +
-                              " for property '" + name + "'");
-        ++t;
-        return toStoredValue(*value, type);  // a float property holds a float
-      };
-      for (std::size_t i = 0; i < element.properties.size(); ++i) {
-        const PlyProperty& p = element.properties[i];
-        if (p.isList) {
-          const double count = nextNumber(p.countType, p.name);
-          if (count < 0 || count > double(tokens.size() - t))
-            throw FileError(file, lineWhere(lineNumber),
-                            "list '" + p.name + "' declares " + formatNumber(count) +
-                                " items but the line has fewer values");
-          for (std::size_t k = 0; k < std::size_t(count); ++k) nextNumber(p.type, p.name);
-        } else {
-          const double value = nextNumber(p.type, p.name);
-          if (vertex) vertex->set(i, value);
-        }
-      }
-      if (t != tokens.size())
-        throw FileError(
-            file, lineWhere(lineNumber),
-            "expected " + std::to_string(t) + " values, found " + std::to_string(tokens.size()),
-            "each " + element.name + " must be on its own line");
-      if (vertex)
-        builder.addPoint(vertex->position, vertex->normal, vertex->values.data(),
-                         [&] { return lineWhere(lineNumber); });
+      VertexAssembler vertex(*plan.vertex, builder);
+      readAsciiItems(lines, lineBase, element, file, vertex);
+    } else if (e == plan.edgeIndex) {
+      plan.edges->reserve(element.count);
+      EdgeAssembler edge{*plan.edge, plan.vertexCount, file, *plan.edges};
+      readAsciiItems(lines, lineBase, element, file, edge);
+    } else {
+      IgnoredItems ignored;
+      readAsciiItems(lines, lineBase, element, file, ignored);
     }
   }
 }
@@ -350,20 +429,42 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
 }  // namespace
 
 PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options,
-                   ReadReport* report) {
+                   ReadReport* report, std::vector<PlyEdge>* edges) {
   const PlyHeader header = parseHeader(data, file);
-  std::size_t vertexIndex = header.elements.size();
-  for (std::size_t e = 0; e < header.elements.size(); ++e)
-    if (header.elements[e].name == "vertex") vertexIndex = e;
-  if (vertexIndex == header.elements.size())
+  ElementPlan plan;
+  plan.vertexIndex = header.elements.size();
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    if (header.elements[e].name == "vertex") plan.vertexIndex = e;
+    if (header.elements[e].name == "edge" && edges) plan.edgeIndex = e;
+  }
+  if (plan.vertexIndex == header.elements.size())
     throw FileError(file, lineWhere(header.dataLine), "the header declares no 'vertex' element",
                     "a point cloud PLY needs 'element vertex <count>' with x, y, z properties");
+  if (edges) {
+    // Edges index the vertices as stored: dropping a vertex would shift every later index.
+    if (options.dropNonFinite)
+      throw OptionError(
+          "ReadOptions::dropNonFinite cannot be used when reading edges (it would renumber "
+          "the vertices they join)");
+    edges->clear();
+  }
   CloudBuilder builder(file, options);
-  const VertexLayout layout = planVertex(header.elements[vertexIndex], file, builder);
+  const VertexLayout vertex = planVertex(header.elements[plan.vertexIndex], file, builder);
+  plan.vertex = &vertex;
+  EdgeLayout edge;
+  if (plan.edgeIndex < header.elements.size() &&
+      !header.elements[plan.edgeIndex].properties.empty()) {
+    edge = planEdge(header.elements[plan.edgeIndex], file);
+    plan.edge = &edge;
+    plan.edges = edges;
+    plan.vertexCount = header.elements[plan.vertexIndex].count;
+  } else {
+    plan.edgeIndex = std::size_t(-1);  // no edge stored
+  }
   if (header.encoding == PlyEncoding::Ascii)
-    readAscii(header, data, file, builder, &layout, vertexIndex);
+    readAscii(header, data, file, builder, plan);
   else
-    readBinary(header, data, file, builder, &layout, vertexIndex);
+    readBinary(header, data, file, builder, plan);
   return builder.finish(report, std::string("ply (") + encodingName(header.encoding) + ")");
 }
 

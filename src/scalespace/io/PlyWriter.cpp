@@ -1,5 +1,9 @@
+#include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
+#include "scalespace/core/Error.hpp"
 #include "scalespace/io/ByteReader.hpp"
 #include "scalespace/io/PlyFormat.hpp"
 #include "scalespace/io/TextParsing.hpp"
@@ -64,10 +68,46 @@ std::vector<PlyColumn> plyColumns(const PointCloud& cloud) {
   return out;
 }
 
+/// The edge element's rows, after the vertices: two int32 per edge.
+void writeEdges(const std::vector<PlyEdge>& edges, std::ostream& out, PlyEncoding encoding) {
+  if (encoding == PlyEncoding::Ascii) {
+    std::string line;
+    for (const PlyEdge& e : edges) {
+      line = std::to_string(e[0]);
+      line += ' ';
+      line += std::to_string(e[1]);
+      line += '\n';
+      out << line;
+    }
+    return;
+  }
+  const bool big = encoding == PlyEncoding::BinaryBigEndian;
+  std::vector<char> rows(8 * std::min<std::size_t>(edges.size(), 4096));
+  for (std::size_t first = 0; first < edges.size(); first += 4096) {
+    const std::size_t count = std::min<std::size_t>(edges.size() - first, 4096);
+    for (std::size_t k = 0; k < count; ++k)
+      for (int end = 0; end < 2; ++end)
+        encodeScalar(double(edges[first + k][std::size_t(end)]), ScalarType::Int32, big,
+                     rows.data() + 8 * k + 4 * end);
+    out.write(rows.data(), std::streamsize(8 * count));
+  }
+}
+
 }  // namespace
 
-void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) {
+void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding,
+              const std::vector<PlyEdge>* edges) {
   checkAttributeNames(cloud, "PLY", {"x", "y", "z"}, {"nx", "ny", "nz"});
+  if (edges) {
+    // vertex1 and vertex2 are `int`, the type every viewer reads.
+    if (cloud.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
+      throw Error("cannot write edges to PLY: " + std::to_string(cloud.size()) +
+                  " vertices do not fit the int vertex indices");
+    for (const PlyEdge& e : *edges)
+      if (e[0] >= cloud.size() || e[1] >= cloud.size())
+        throw Error("cannot write an edge to vertex " + std::to_string(std::max(e[0], e[1])) +
+                    ": there are " + std::to_string(cloud.size()) + " vertices");
+  }
   const ScalarType positionType = positionTypeFor(cloud);
   const bool normals = cloud.hasNormals();
   const std::vector<PlyColumn> columns = plyColumns(cloud);
@@ -84,6 +124,8 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
     for (const char* name : {"nx", "ny", "nz"}) out << "property float " << name << '\n';
   for (const PlyColumn& c : columns)
     out << "property " << plyTypeName(c.type) << ' ' << c.column->name << '\n';
+  if (edges)
+    out << "element edge " << edges->size() << "\nproperty int vertex1\nproperty int vertex2\n";
   out << "end_header\n";
 
   if (encoding == PlyEncoding::Ascii) {
@@ -107,6 +149,7 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
       line.back() = '\n';
       out << line;
     }
+    if (edges) writeEdges(*edges, out, encoding);
     return;
   }
 
@@ -127,6 +170,7 @@ void writePly(const PointCloud& cloud, std::ostream& out, PlyEncoding encoding) 
     for (const PlyColumn& c : columns) put(c.column->values[i] * c.factor, c.type);
     out.write(row.data(), std::streamsize(row.size()));
   }
+  if (edges) writeEdges(*edges, out, encoding);
 }
 
 }  // namespace scalespace

@@ -96,20 +96,21 @@ std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& optio
   return std::vector<Rgb>(n, Rgb{200, 200, 200});
 }
 
-Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
+ScreenFrame frameCloud(const PointCloud& cloud, const RenderOptions& options) {
   if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
     throw OptionError("RenderOptions::width and height must be between 1 and 16384");
   if (options.margin < 0 || options.margin >= 0.5)
     throw OptionError("render margin must be in [0, 0.5)");
-  const Vec3 forward = viewDirection(options.view, options.up);
+  ScreenFrame f;
+  f.forward = viewDirection(options.view, options.up);
   const UpFrame frame = upFrame(options.up);
-  const Vec3 upHint = std::abs(forward.dot(frame.up)) > 0.99 ? frame.ahead : frame.up;
-  const Vec3 right = forward.cross(upHint).normalized();
-  const Vec3 up = right.cross(forward);
-
-  Image image(options.width, options.height, options.background);
-  if (cloud.empty()) return image;
-  const std::vector<Rgb> colors = pointColors(cloud, options);
+  const Vec3 upHint = std::abs(f.forward.dot(frame.up)) > 0.99 ? frame.ahead : frame.up;
+  f.right = f.forward.cross(upHint).normalized();
+  f.up = f.right.cross(f.forward);
+  f.origin = cloud.origin();
+  f.width = options.width;
+  f.height = options.height;
+  if (cloud.empty()) return f;
 
   // Framing: the projected corners of the bounding box fill the image minus the margin.
   Vec3 lo, hi;
@@ -118,42 +119,59 @@ Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
   for (int c = 0; c < 8; ++c) {
     const Vec3 corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
                       (c & 4) ? hi.z() : lo.z());
-    minX = std::min(minX, corner.dot(right));
-    maxX = std::max(maxX, corner.dot(right));
-    minY = std::min(minY, corner.dot(up));
-    maxY = std::max(maxY, corner.dot(up));
+    minX = std::min(minX, corner.dot(f.right));
+    maxX = std::max(maxX, corner.dot(f.right));
+    minY = std::min(minY, corner.dot(f.up));
+    maxY = std::max(maxY, corner.dot(f.up));
   }
   const double usable = 1.0 - 2.0 * options.margin;
   const double spanX = maxX - minX, spanY = maxY - minY;
-  double scale = 1.0;  // pixels per unit; a single point (zero span) keeps 1
+  // A single point (zero span) keeps 1 pixel per unit.
   if (spanX > 0 || spanY > 0)
-    scale = std::min(spanX > 0 ? usable * options.width / spanX : 1e300,
-                     spanY > 0 ? usable * options.height / spanY : 1e300);
-  const double centreX = 0.5 * (minX + maxX), centreY = 0.5 * (minY + maxY);
+    f.scale = std::min(spanX > 0 ? usable * options.width / spanX : 1e300,
+                       spanY > 0 ? usable * options.height / spanY : 1e300);
+  f.centreX = 0.5 * (minX + maxX);
+  f.centreY = 0.5 * (minY + maxY);
+  f.boxWidth = spanX * f.scale;
+  f.boxHeight = spanY * f.scale;
+  return f;
+}
+
+Rendering renderPointsWithDepth(const PointCloud& cloud, const RenderOptions& options) {
+  Rendering out;
+  out.frame = frameCloud(cloud, options);
+  const ScreenFrame& frame = out.frame;
+  Image& image = out.image;
+  image = Image(options.width, options.height, options.background);
+  out.depth.assign(image.pixels.size(), std::numeric_limits<float>::infinity());
+  if (cloud.empty()) return out;
+  const std::vector<Rgb> colors = pointColors(cloud, options);
 
   // Each point fills (2r + 1)^2 pixels: beyond kMaxPointRadius a typo would take minutes.
   int radius = std::min(options.pointRadius, kMaxPointRadius);
   if (radius < 0) {
     // Half the mean spacing of the points over the framed area, so a dense surface looks closed.
-    const double area = std::max(1.0, spanX * scale) * std::max(1.0, spanY * scale);
+    const double area = std::max(1.0, frame.boxWidth) * std::max(1.0, frame.boxHeight);
     radius = int(std::clamp(std::lround(0.5 * std::sqrt(area / double(cloud.size()))), 0L, 8L));
   }
+  out.pointRadius = radius;
 
-  std::vector<float> depth(image.pixels.size(), std::numeric_limits<float>::infinity());
+  std::vector<float>& depth = out.depth;
   const auto& positions = cloud.positions();
   const bool shade = options.shading && cloud.hasNormals();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Vec3& p = positions[i];
-    const double sx = 0.5 * options.width + (p.dot(right) - centreX) * scale;
-    const double sy = 0.5 * options.height - (p.dot(up) - centreY) * scale;
-    const float z = float(p.dot(forward));  // smaller = nearer to the camera
+    const Vec3 s = frame.project(p);
+    const double sx = s.x(), sy = s.y();
+    const float z = float(s.z());  // smaller = nearer to the camera
     if (!std::isfinite(sx) || !std::isfinite(sy)) continue;
     const int px = int(std::floor(sx)), py = int(std::floor(sy));
     Rgb c = colors[i];
     if (shade) {
       // Two-sided headlight: normals of unoriented clouds may point either way.
-      const double s = 0.35 + 0.65 * std::min(1.0, std::abs(cloud.normals()[i].dot(forward)));
-      c = {std::uint8_t(c.r * s), std::uint8_t(c.g * s), std::uint8_t(c.b * s)};
+      const double light =
+          0.35 + 0.65 * std::min(1.0, std::abs(cloud.normals()[i].dot(frame.forward)));
+      c = {std::uint8_t(c.r * light), std::uint8_t(c.g * light), std::uint8_t(c.b * light)};
     }
     for (int dy = -radius; dy <= radius; ++dy)
       for (int dx = -radius; dx <= radius; ++dx) {
@@ -167,7 +185,7 @@ Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
         }
       }
   }
-  return image;
+  return out;
 }
 
 }  // namespace scalespace

@@ -48,9 +48,42 @@ UpFrame upFrame(const std::string& up);
 /// OptionError for anything else.
 Vec3 viewDirection(const std::string& view, const std::string& up = "z");
 
+/// The orthographic camera renderPoints frames a cloud with: screen axes `right` and `up`,
+/// `forward` the viewing direction, all in the cloud's frame (positions relative to `origin`).
+struct ScreenFrame {
+  Vec3 right = Vec3::UnitX(), up = Vec3::UnitZ(), forward = Vec3::UnitY();
+  Vec3 origin = Vec3::Zero();  // the framed cloud's origin()
+  double scale = 1.0;          // pixels per unit length
+  double centreX = 0, centreY = 0;
+  int width = 0, height = 0;
+  double boxWidth = 0, boxHeight = 0;  // the framed bounding box on screen, in pixels
+  /// Pixel coordinates (x right, y down; pixel (i, j) covers [i, i + 1) x [j, j + 1)) and depth
+  /// (smaller = nearer) of a position relative to `origin`.
+  Vec3 project(const Vec3& relative) const {
+    return {0.5 * width + (relative.dot(right) - centreX) * scale,
+            0.5 * height - (relative.dot(up) - centreY) * scale, relative.dot(forward)};
+  }
+};
+
+/// The camera for `cloud`: its bounding box, projected, fills the image minus the margin. Throws
+/// OptionError for a bad size, margin or view.
+ScreenFrame frameCloud(const PointCloud& cloud, const RenderOptions& options);
+
+/// An image with its depth buffer and camera, so that more can be drawn over the points (lines:
+/// render/LineRenderer.hpp) with the depth test.
+struct Rendering {
+  Image image;
+  std::vector<float> depth;  // per pixel, +infinity where nothing was drawn
+  ScreenFrame frame;
+  int pointRadius = 0;  // the splat radius drawn, in pixels
+};
+
 /// Renders the cloud framed on its bounding box. Throws OptionError for a bad size, view or
 /// attribute name.
-Image renderPoints(const PointCloud& cloud, const RenderOptions& options);
+Rendering renderPointsWithDepth(const PointCloud& cloud, const RenderOptions& options);
+inline Image renderPoints(const PointCloud& cloud, const RenderOptions& options) {
+  return renderPointsWithDepth(cloud, options).image;
+}
 
 /// The per-point colours renderPoints would use (before shading).
 std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& options);
