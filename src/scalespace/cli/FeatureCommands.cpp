@@ -119,7 +119,8 @@ void addLinesCommand(CLI::App& app) {
 
     std::vector<double> ts{args->scale};
     if (args->scales > 0) {
-      const double lo = args->tMin > 0 ? args->tMin : meanKthNeighborDistance(cloud.positions(), 16);
+      const double lo =
+          args->tMin > 0 ? args->tMin : meanKthNeighborDistance(cloud.positions(), 16);
       const double hi = args->tMax > 0 ? args->tMax : 0.1 * cloud.boundingBoxDiagonal();
       ts = scaleSeries(lo, std::max(hi, lo), args->scales, ScaleSpacing::Log);
     }
@@ -173,8 +174,7 @@ void addLinesCommand(CLI::App& app) {
                                  {"seconds", total}};
     writeJson(summaryPathFor(args->output), json);
     if (!args->quiet)
-      std::fprintf(stderr, "lines: %zu lines -> %s\n", polylines.lineCount(),
-                   args->output.c_str());
+      std::fprintf(stderr, "lines: %zu lines -> %s\n", polylines.lineCount(), args->output.c_str());
     reportDone("lines", start, args->quiet);
   });
 }
@@ -308,27 +308,26 @@ void addFeaturesCommand(CLI::App& app) {
                         {"scales", voted}});
     }
     const double total = std::chrono::duration<double>(Clock::now() - start).count();
-    const nlohmann::json json = {
-        {"command", "features"},
-        {"version", SCALESPACE_VERSION},
-        {"input", args->input.path},
-        {"output", args->output},
-        {"labelled", mesh ? "mesh vertices" : "points"},
-        {"points", out.size()},
-        {"samples", cloud.size()},
-        {"spacing", result.spacing},
-        {"max_vote", result.maxVote},
-        {"feature_points", labelled},
-        {"parameters",
-         {{"scale_count", options.scaleCount},
-          {"salient_threshold", options.salientThreshold},
-          {"salient_percentile", options.salientPercentile},
-          {"vote_threshold", options.voteThreshold},
-          {"min_curve_extent", options.minCurveExtent},
-          {"threads", args->threads}}},
-        {"scales", scales},
-        {"curves", curves},
-        {"seconds", total}};
+    const nlohmann::json json = {{"command", "features"},
+                                 {"version", SCALESPACE_VERSION},
+                                 {"input", args->input.path},
+                                 {"output", args->output},
+                                 {"labelled", mesh ? "mesh vertices" : "points"},
+                                 {"points", out.size()},
+                                 {"samples", cloud.size()},
+                                 {"spacing", result.spacing},
+                                 {"max_vote", result.maxVote},
+                                 {"feature_points", labelled},
+                                 {"parameters",
+                                  {{"scale_count", options.scaleCount},
+                                   {"salient_threshold", options.salientThreshold},
+                                   {"salient_percentile", options.salientPercentile},
+                                   {"vote_threshold", options.voteThreshold},
+                                   {"min_curve_extent", options.minCurveExtent},
+                                   {"threads", args->threads}}},
+                                 {"scales", scales},
+                                 {"curves", curves},
+                                 {"seconds", total}};
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);
     if (!args->quiet)

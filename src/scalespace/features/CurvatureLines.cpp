@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <string>
 #include <unordered_map>
@@ -184,12 +185,14 @@ std::vector<Index> lineSamples(const std::vector<Vec3>& positions, double alpha,
 
 namespace {
 
-/// Traces the lines of one scale. Sequential tracing (Kalogerakis 2009: each line runs until it
-/// meets an earlier one) is what the result reproduces, but lines are traced in batches so that
-/// each step of a batch is one call of the shared fit driver: a batch's lines advance together,
-/// stop on the lines of earlier batches as they go, and are then cut, in line order, where they
-/// meet an earlier line of their own batch. A line's path depends on its own fits only, so this
-/// gives exactly the sequential result, for any thread count.
+/// Traces the lines of one scale: a pool of at most `poolSize` lines advances in rounds, one step
+/// of every active way per round and one call of the shared fit driver per round. When lines end,
+/// the next seeds (in the seeded random order) start lines in their place, unless they lie on a
+/// line already drawn. A way stops on any vertex placed in an earlier round by another line, or
+/// in the same round by a line started before it. Everything is decided per round from the state
+/// of the previous one, so the result depends on the pool size (a function of the seed count), not
+/// on the thread count. A small pool approaches the sequential tracer (each line runs until it
+/// meets an earlier one) that a pool of one would be.
 class LineTracer {
  public:
   LineTracer(const CurvatureLineOptions& options, const SurfaceSamples& samples,
@@ -201,26 +204,38 @@ class LineTracer {
         delta_(options.gamma * options.scale),
         collision_(options.collisionFraction * delta_),
         cosTurn_(std::cos(options.maxTurnDegrees * M_PI / 180)),
-        lines_(std::max(collision_, 1e-9 * t_)) {
+        placed_(std::max(collision_, 1e-9 * options.scale)) {
     fitOptions_.fit = options.fit;
   }
 
-  /// Traces the lines of `seeds` (input points, in tracing order) and appends them to the result.
-  void traceBatch(const std::vector<Index>& seeds, const std::vector<Vec3>& seedPositions) {
-    const std::vector<Start> starts = startLines(seeds, seedPositions);
-    std::vector<Way> ways(2 * starts.size());
-    for (std::size_t l = 0; l < starts.size(); ++l) {
-      ways[2 * l] = Way{l, 0, {}, true, LineStop::MaxSteps};
-      ways[2 * l + 1] = Way{l, 1, {}, true, LineStop::MaxSteps};
+  void trace(const std::vector<Index>& seeds, const std::vector<Vec3>& seedPositions,
+             std::size_t poolSize, const std::function<void(double)>& progress) {
+    std::size_t next = 0;
+    std::vector<std::size_t> active;  // ways, by increasing id
+    while (next < seeds.size() || !active.empty()) {
+      progress(double(next) / double(std::max<std::size_t>(1, seeds.size())));
+      const std::size_t want = poolSize > active.size() / 2 ? poolSize - active.size() / 2 : 0;
+      if (want > 0 && next < seeds.size()) {
+        const std::size_t end = std::min(seeds.size(), next + want);
+        startLines(seeds, seedPositions, next, end, active);
+        next = end;
+      }
+      if (!active.empty()) step(active);
     }
-    advance(starts, ways);
-    keepUntilEarlierLines(starts, ways);
+    // Lines in the order their seeds started them.
+    for (Line& line : lines_) {
+      ++result_.stops[std::size_t(ways_[line.ways[0]].stop)];
+      ++result_.stops[std::size_t(ways_[line.ways[1]].stop)];
+      CurvatureLine out = assemble(line);
+      if (out.vertices.size() >= 2) result_.lines.push_back(std::move(out));
+    }
   }
 
  private:
-  struct Start {
+  struct Line {
     Index seed;
-    CurvatureLineVertex vertex;
+    CurvatureLineVertex start;
+    std::size_t ways[2];  // backward, forward
   };
 
   std::vector<LocalFit> fit(const std::vector<Vec3>& queries) {
@@ -228,13 +243,15 @@ class LineTracer {
     return fitPoints(samples_, FitQueries{queries, scales_}, fitOptions_);
   }
 
-  /// The projected seeds with a minimal direction, away from the lines traced so far.
-  std::vector<Start> startLines(const std::vector<Index>& seeds,
-                                const std::vector<Vec3>& seedPositions) {
-    const std::vector<LocalFit> fits = fit(seedPositions);
-    std::vector<Start> starts;
+  /// Starts a line at each projected seed of [first, end) with a minimal direction, inside the
+  /// data and away from the lines drawn so far (those started just before it included).
+  void startLines(const std::vector<Index>& seeds, const std::vector<Vec3>& seedPositions,
+                  std::size_t first, std::size_t end, std::vector<std::size_t>& active) {
+    const std::vector<Vec3> queries(seedPositions.begin() + std::ptrdiff_t(first),
+                                    seedPositions.begin() + std::ptrdiff_t(end));
+    const std::vector<LocalFit> fits = fit(queries);
     std::vector<Neighbor> found;
-    for (std::size_t s = 0; s < seeds.size(); ++s) {
+    for (std::size_t s = 0; s < fits.size(); ++s) {
       const LocalFit& f = fits[s];
       if (!f.valid) {
         ++result_.stops[std::size_t(LineStop::InvalidFit)];
@@ -250,10 +267,16 @@ class LineTracer {
         ++result_.stops[std::size_t(LineStop::Border)];
         continue;
       }
-      if (nearEarlierLine(f.projection)) continue;
-      starts.push_back({seeds[s], makeVertex(f, m, m.direction)});
+      if (nearAnyLine(f.projection)) continue;
+      const std::size_t id = lines_.size();
+      lines_.push_back(
+          {seeds[first + s], makeVertex(f, m, m.direction), {ways_.size(), ways_.size() + 1}});
+      for (int side = 0; side < 2; ++side) {
+        active.push_back(ways_.size());
+        ways_.push_back(Way{id, side, {}, true, LineStop::MaxSteps});
+      }
+      placed_.insert({id, 0, 0, f.projection});
     }
-    return starts;
   }
 
   /// The border test of CurvatureLineOptions::borderOffset.
@@ -265,86 +288,95 @@ class LineTracer {
     for (const Neighbor& nb : found) centroid += samples_.positions[nb.index];
     Vec3 offset = centroid / double(found.size()) - p;
     offset -= offset.dot(normal) * normal;
-    return offset.norm() > options_.borderOffset * t_;
+    // Inside the data the centroid of n samples spread over a disc of radius t wanders by about
+    // sigma = t / (2 sqrt(n)) per axis: a bound below 4 sigma would stop lines at random (8% of
+    // the steps with 32 samples at 0.2 t; 0.03% at 4 sigma).
+    const double sigma = t_ / (2 * std::sqrt(double(found.size())));
+    return offset.norm() > std::max(options_.borderOffset * t_, 4 * sigma);
   }
 
-  bool nearEarlierLine(const Vec3& p) const {
+  bool nearAnyLine(const Vec3& p) const {
     bool near = false;
-    lines_.forEachNear(p, [&](const VertexTag& tag) {
+    placed_.forEachNear(p, [&](const VertexTag& tag) {
       near = near || (tag.position - p).squaredNorm() < collision_ * collision_;
     });
     return near;
   }
 
-  /// Rounds: every active way takes one step (Eq. 3.2); one fitPoints call per round.
-  void advance(const std::vector<Start>& starts, std::vector<Way>& ways) {
-    auto last = [&](const Way& w) -> const CurvatureLineVertex& {
-      return w.vertices.empty() ? starts[w.line].vertex : w.vertices.back();
-    };
-    auto heading = [&](const Way& w) -> Vec3 {
-      const Vec3 tangent = last(w).tangent;
-      return (w.vertices.empty() && w.side == 0) ? Vec3(-tangent) : tangent;
-    };
-    // The batch's own vertices, for loops (a line meeting itself).
-    VertexGrid own(std::max(collision_, 1e-9 * t_));
-    for (std::size_t l = 0; l < starts.size(); ++l)
-      own.insert({l, 0, 0, starts[l].vertex.position});
+  const CurvatureLineVertex& last(const Way& w) const {
+    return w.vertices.empty() ? lines_[w.line].start : w.vertices.back();
+  }
+  Vec3 heading(const Way& w) const {
+    const Vec3 tangent = last(w).tangent;
+    return (w.vertices.empty() && w.side == 0) ? Vec3(-tangent) : tangent;
+  }
 
-    std::vector<std::size_t> active(ways.size());
-    std::iota(active.begin(), active.end(), std::size_t(0));
-    std::vector<CurvatureLineVertex> candidate(ways.size());
-    std::vector<std::uint8_t> outcome(ways.size());  // 0 continue, else 1 + LineStop
-    std::vector<Vec3> queries;
-    const double d2 = collision_ * collision_;
-    for (int step = 1; !active.empty(); ++step) {
-      queries.resize(active.size());
-      for (std::size_t a = 0; a < active.size(); ++a) {
-        const Way& w = ways[active[a]];
-        queries[a] = last(w).position + delta_ * heading(w);
-      }
-      const std::vector<LocalFit> fits = fit(queries);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active.size(), 64), [&](const auto& r) {
-        std::vector<Neighbor> found;
-        for (std::size_t a = r.begin(); a != r.end(); ++a) {
-          const std::size_t id = active[a];
-          const Way& w = ways[id];
-          const LineStop stop =
-              stepOutcome(fits[a], last(w).position, heading(w), candidate[id], found);
-          outcome[id] = stop == LineStop::MaxSteps ? 0 : std::uint8_t(1 + int(stop));
-          if (outcome[id] || collision_ <= 0) continue;
-          const Vec3& p = candidate[id].position;
-          lines_.forEachNear(p, [&](const VertexTag& tag) {
-            if (!outcome[id] && (tag.position - p).squaredNorm() < d2)
-              outcome[id] = 1 + int(LineStop::Collision);
-          });
-          own.forEachNear(p, [&](const VertexTag& tag) {
-            if (!outcome[id] && tag.line == w.line && (tag.position - p).squaredNorm() < d2 &&
-                stepsApart(w.side, step, tag.side, tag.step) > 3)
-              outcome[id] = 1 + int(LineStop::Loop);
-          });
-        }
-      });
-      // The two ways of a line meeting in the same round close it.
-      for (std::size_t a = 0; a + 1 < active.size(); ++a) {
-        const std::size_t back = active[a], forward = active[a + 1];
-        if (forward != back + 1 || back % 2 || outcome[back] || outcome[forward]) continue;
-        if ((candidate[back].position - candidate[forward].position).squaredNorm() < d2 &&
-            2 * step > 3)
-          outcome[back] = outcome[forward] = 1 + int(LineStop::Loop);
-      }
-      std::vector<std::size_t> next;
-      for (const std::size_t id : active) {
-        Way& w = ways[id];
-        if (outcome[id]) {
-          w.stop = LineStop(outcome[id] - 1);
-          continue;
-        }
-        w.vertices.push_back(candidate[id]);
-        if (collision_ > 0) own.insert({w.line, w.side, step, candidate[id].position});
-        if (step < options_.maxSteps) next.push_back(id);
-      }
-      active.swap(next);
+  /// One round: every active way takes one step (Eq. 3.2).
+  void step(std::vector<std::size_t>& active) {
+    std::vector<Vec3> queries(active.size());
+    for (std::size_t a = 0; a < active.size(); ++a) {
+      const Way& w = ways_[active[a]];
+      queries[a] = last(w).position + delta_ * heading(w);
     }
+    const std::vector<LocalFit> fits = fit(queries);
+    std::vector<CurvatureLineVertex> candidate(active.size());
+    std::vector<std::uint8_t> outcome(active.size());  // 0 go on, else 1 + LineStop
+    const double d2 = collision_ * collision_;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active.size(), 64), [&](const auto& r) {
+      std::vector<Neighbor> found;
+      for (std::size_t a = r.begin(); a != r.end(); ++a) {
+        const Way& w = ways_[active[a]];
+        const int stepIndex = int(w.vertices.size()) + 1;
+        const LineStop stop =
+            stepOutcome(fits[a], last(w).position, heading(w), candidate[a], found);
+        outcome[a] = stop == LineStop::MaxSteps ? 0 : std::uint8_t(1 + int(stop));
+        if (outcome[a] || collision_ <= 0) continue;
+        const Vec3& p = candidate[a].position;
+        placed_.forEachNear(p, [&](const VertexTag& tag) {
+          if (outcome[a] || (tag.position - p).squaredNorm() >= d2) return;
+          if (tag.line != w.line)
+            outcome[a] = 1 + int(LineStop::Collision);
+          else if (stepsApart(w.side, stepIndex, tag.side, tag.step) > 3)
+            outcome[a] = 1 + int(LineStop::Loop);
+        });
+      }
+    });
+    // Vertices of this round, in way order (lines started earlier first): one that comes within
+    // the collision distance of a vertex kept before it in this round stops its way.
+    if (collision_ > 0) {
+      VertexGrid round(collision_);
+      for (std::size_t a = 0; a < active.size(); ++a) {
+        if (outcome[a]) continue;
+        const Way& w = ways_[active[a]];
+        const int stepIndex = int(w.vertices.size()) + 1;
+        const Vec3& p = candidate[a].position;
+        round.forEachNear(p, [&](const VertexTag& tag) {
+          if (outcome[a] || (tag.position - p).squaredNorm() >= d2) return;
+          if (tag.line != w.line)
+            outcome[a] = 1 + int(LineStop::Collision);
+          else if (stepsApart(w.side, stepIndex, tag.side, tag.step) > 3)
+            outcome[a] = 1 + int(LineStop::Loop);
+        });
+        if (!outcome[a]) round.insert({w.line, w.side, stepIndex, p});
+      }
+    }
+    std::vector<std::size_t> next;
+    next.reserve(active.size());
+    for (std::size_t a = 0; a < active.size(); ++a) {
+      Way& w = ways_[active[a]];
+      if (outcome[a]) {
+        w.stop = LineStop(outcome[a] - 1);
+        continue;
+      }
+      w.vertices.push_back(candidate[a]);
+      if (collision_ > 0)
+        placed_.insert({w.line, w.side, int(w.vertices.size()), candidate[a].position});
+      if (int(w.vertices.size()) < options_.maxSteps)
+        next.push_back(active[a]);
+      else
+        w.stop = LineStop::MaxSteps;
+    }
+    active.swap(next);
   }
 
   /// What one step gives: MaxSteps (meaning "go on") and the new vertex, or why the way stops.
@@ -361,50 +393,12 @@ class LineTracer {
     return LineStop::MaxSteps;
   }
 
-  /// Cuts each line of the batch, in line order, at its first vertex (from the seed outwards)
-  /// within the collision distance of an earlier line of the batch (as cut), drops lines whose
-  /// seed is there, and adds the rest to the result and to the lines the next batches stop on.
-  void keepUntilEarlierLines(const std::vector<Start>& starts, std::vector<Way>& ways) {
-    VertexGrid kept(std::max(collision_, 1e-9 * t_));
-    const double d2 = collision_ * collision_;
-    auto blocked = [&](const Vec3& p) {
-      bool near = false;
-      kept.forEachNear(
-          p, [&](const VertexTag& tag) { near = near || (tag.position - p).squaredNorm() < d2; });
-      return near;
-    };
-    for (std::size_t l = 0; l < starts.size(); ++l) {
-      Way &back = ways[2 * l], &forward = ways[2 * l + 1];
-      if (collision_ > 0 && blocked(starts[l].vertex.position)) {
-        ++result_.stops[std::size_t(LineStop::Collision)];
-        continue;
-      }
-      for (Way* w : {&back, &forward}) {
-        if (collision_ <= 0) break;
-        for (std::size_t i = 0; i < w->vertices.size(); ++i)
-          if (blocked(w->vertices[i].position)) {
-            w->vertices.resize(i);
-            w->stop = LineStop::Collision;
-            break;
-          }
-      }
-      ++result_.stops[std::size_t(back.stop)];
-      ++result_.stops[std::size_t(forward.stop)];
-      CurvatureLine line = assemble(starts[l], back, forward);
-      if (line.vertices.size() < 2) continue;
-      for (const CurvatureLineVertex& v : line.vertices) {
-        kept.insert({l, 0, 0, v.position});
-        lines_.insert({result_.lines.size(), 0, 0, v.position});
-      }
-      result_.lines.push_back(std::move(line));
-    }
-  }
-
   /// The backward way reversed (its tangents turned to the line's direction), the seed, the
   /// forward way.
-  static CurvatureLine assemble(const Start& start, const Way& back, const Way& forward) {
+  CurvatureLine assemble(const Line& l) const {
+    const Way &back = ways_[l.ways[0]], &forward = ways_[l.ways[1]];
     CurvatureLine line;
-    line.seed = start.seed;
+    line.seed = l.seed;
     line.stopBackward = back.stop;
     line.stopForward = forward.stop;
     line.closed = back.stop == LineStop::Loop || forward.stop == LineStop::Loop;
@@ -413,7 +407,7 @@ class LineTracer {
       line.vertices.push_back(*it);
       line.vertices.back().tangent = -it->tangent;
     }
-    line.vertices.push_back(start.vertex);
+    line.vertices.push_back(l.start);
     line.vertices.insert(line.vertices.end(), forward.vertices.begin(), forward.vertices.end());
     return line;
   }
@@ -424,7 +418,9 @@ class LineTracer {
   const double t_, delta_, collision_, cosTurn_;
   FitPointsOptions fitOptions_;
   const std::vector<double> scales_{options_.scale};
-  VertexGrid lines_;  // vertices of the lines kept so far
+  std::vector<Line> lines_;
+  std::vector<Way> ways_;
+  VertexGrid placed_;  // every vertex placed so far
 };
 
 }  // namespace
@@ -466,18 +462,15 @@ CurvatureLineSet traceCurvatureLines(const PointCloud& cloud, const CurvatureLin
     const auto ka = sampleOrderKey(options.seed + 2, a), kb = sampleOrderKey(options.seed + 2, b);
     return ka != kb ? ka < kb : a < b;
   });
-  // Batches of a size that depends on the seed count only (never on the threads).
-  const std::size_t batch = std::max<std::size_t>(256, seeds.size() / 32);
+  // The pool's size depends on the seed count only (never on the threads): large enough for
+  // each round's fits to fill the cores, small enough that concurrent lines rarely share a line's
+  // path (they would cut it into pieces).
+  const std::size_t pool = std::max<std::size_t>(32, seeds.size() / 128);
+  std::vector<Vec3> seedPositions(seeds.size());
+  for (std::size_t s = 0; s < seeds.size(); ++s) seedPositions[s] = cloud.positions()[seeds[s]];
   LineTracer tracer(options, samples, result);
-  for (std::size_t first = 0; first < seeds.size(); first += batch) {
-    check(double(first) / double(seeds.size()), "tracing curvature lines");
-    const std::vector<Index> part(
-        seeds.begin() + std::ptrdiff_t(first),
-        seeds.begin() + std::ptrdiff_t(std::min(seeds.size(), first + batch)));
-    std::vector<Vec3> seedPositions(part.size());
-    for (std::size_t s = 0; s < part.size(); ++s) seedPositions[s] = cloud.positions()[part[s]];
-    tracer.traceBatch(part, seedPositions);
-  }
+  tracer.trace(seeds, seedPositions, pool,
+               [&](double fraction) { check(fraction, "tracing curvature lines"); });
   check(1, "tracing curvature lines");
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

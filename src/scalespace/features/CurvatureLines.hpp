@@ -50,8 +50,9 @@ struct CurvatureLineOptions {
   double minCurvatureGap = 0.1;
   /// Stop a way at the border of the data (a scan's edge, a hole): where the centroid of the
   /// samples within t of the vertex is more than borderOffset t from it along the surface (half
-  /// a disc puts it 0.42 t away; a full one near 0). Beyond the border the APSS extrapolates and
-  /// a one-sided neighbourhood biases the curvatures. 0 never stops there.
+  /// a disc puts it 0.42 t away; a full one near 0) and more than 4 sigma, sigma = t / (2 sqrt(n))
+  /// the centroid's random wander over n samples inside the data. Beyond the border the APSS
+  /// extrapolates and a one-sided neighbourhood biases the curvatures. 0 never stops there.
   double borderOffset = 0.2;
   /// Stop a way when one step turns by more than this (the field jumped: crossing an umbilic).
   double maxTurnDegrees = 45;

@@ -90,12 +90,12 @@ bool isMeshPath(const std::string& path) {
 TriangleMesh readTriangleMesh(const std::string& path) {
   if (!isMeshPath(path))
     throw FileError(path, "", "is not a mesh file", "give an .off or .obj file");
-  const std::string data = readWholeFile(path);
-  TriangleMesh mesh = formatFromPath(path) == CloudFormat::Off ? parseOff(data, path)
-                                                               : parseObj(data, path);
+  const std::string data = io_detail::readWholeFile(path);
+  TriangleMesh mesh =
+      formatFromPath(path) == CloudFormat::Off ? parseOff(data, path) : parseObj(data, path);
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
-    if (!isUsablePosition(mesh.vertices[v]))
-      throw FileError(path, lineWhere(mesh.vertexLines[v]),
+    if (!io_detail::isUsablePosition(mesh.vertices[v]))
+      throw FileError(path, io_detail::lineWhere(mesh.vertexLines[v]),
                       "vertex " + std::to_string(v + 1) +
                           " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                       "fix or remove that vertex");
