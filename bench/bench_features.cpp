@@ -1,0 +1,791 @@
+// Feature-curve detection (Sec. 3.4.1) against ground truth from triangle meshes: ours
+// (detectFeatureCurves with the default FeatureCurveOptions), CGAL's VCM sharp edges and a
+// covariance threshold, on clean points and on a noisy copy, in the same run.
+//
+//   bench_features [--points N (100000)] [--data DIR (/tmp/real/cgal/data/meshes)]
+//                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
+//
+// Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
+// fandisk_large: Debian's libcgal-demo data; a missing file is skipped with a line saying so) and
+// three built here: "box" (a box whose four long edges are a chamfer and fillets of radii 1, 2 and
+// 4 e: fillets are smooth on the mesh, so they are not ground truth and count against a method that
+// flags them), "creases" (a prism whose top is a zigzag with convex and concave creases whose face
+// normals turn by 30 to 150 degrees) and "box_on_ground" (a box standing on an open ground square:
+// its footprint is a concave curve; the ground's outer border is not a feature).
+// Ground truth:
+// - sharp edges: mesh edges between two faces whose normals differ by >= --angle degrees, convex
+//   or concave (from the outward orientation; a closed mesh with negative volume is flipped);
+// - points: N points drawn by area (sampleMesh), their normals dropped, then estimated and
+//   oriented as the CLI does for inputs without normals (PCA 10-NN, MST); the noisy copy adds
+//   Gaussian noise of sigma 1e-3 of the bounding-box diagonal to each coordinate and estimates
+//   its own normals;
+// - a point is a feature point when its noise-free position lies within e of a sharp edge, e the
+//   mean distance to the 16th nearest neighbour on the clean points;
+// - curves: sharp edges of the same sign sharing a mesh vertex (union-find), each feature point
+//   on the curve of its nearest sharp edge.
+// Methods: "ours" labels the points with curveId >= 0 (its curves are the detected curves); "vcm
+// R/r" is CGAL::compute_vcm with offset radius R and convolution radius r (multiples of e), points
+// labelled by vcm_is_on_feature_edge at 0.16; "cov X" labels the points whose surface variation
+// lambda0 / (lambda0 + lambda1 + lambda2) over the 16 nearest neighbours (the point included)
+// exceeds X. A peer's curves are the connected components of its labelled points on the 10-NN
+// graph.
+// Metrics: point-wise precision, recall, MCC; Dice 2|A n B| / (|A| + |B|) (Eq. 3.4) and the
+// symmetric Hausdorff distance (Eq. 3.3) between the feature points and the labelled points over
+// the diagonal (distances between noise-free positions); per curve: each ground-truth curve is
+// matched with the detected curve that holds most of its points; cDice and cH/diag are the means
+// over ground-truth curves (cH over the matched ones), cRec the fraction of ground-truth curves
+// whose match covers >= 50 % of their points. Seconds: the method on a cloud with normals (the
+// peers' 10-NN graph included; settings of one peer that share a computation each report it).
+// The whole run (11 models, both noise levels) took about 17 min on 2 shared cores, 13 of them in
+// CGAL's VCM (about 11 s per setting and cloud of 100k points: its offset step, which r does not
+// change); ours about 1 s per cloud; --no-peers runs in under a minute.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/vcm_estimate_edges.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/core/MemoryReuse.hpp"
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/features/FeatureCurves.hpp"
+#include "scalespace/io/MeshFormat.hpp"
+
+using namespace scalespace;
+using Clock = std::chrono::steady_clock;
+using Vec2 = Eigen::Vector2d;
+using Triangle = std::array<Index, 3>;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kSpacingNeighbors = 16;            // e: mean distance to the 16th nearest neighbour
+constexpr std::size_t kPeerGraphNeighbors = 10;  // the peers' curves: components on the 10-NN graph
+constexpr std::size_t kCovarianceNeighbors = 16;
+constexpr double kNoise = 1e-3;           // sigma over the bounding-box diagonal
+constexpr double kCurveCovered = 0.5;     // cRec: the match covers >= 50 % of the curve
+constexpr double kVcmThreshold = 0.16;    // CGAL's example value
+constexpr double kAngleTolerance = 1e-6;  // degrees: creases built at exactly --angle count
+constexpr std::uint64_t kSampleSeed = 1, kNoiseSeed = 2;
+
+const char* const kCadModels[] = {"fandisk", "blade", "anchor",       "rotor",
+                                  "joint",   "part",  "anchor_dense", "fandisk_large"};
+const char* const kOwnModels[] = {"box", "creases", "box_on_ground"};
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shapes of our own. They are built with their spacing in mind: e ~ sqrt(16 A / (pi N)) for N
+// points on an area A, the mean 16-NN distance of a uniform sample, so that fillet radii are a
+// given number of spacings whatever --points.
+
+double expectedSpacing(double area, std::size_t points) {
+  return std::sqrt(kSpacingNeighbors * area / (kPi * double(points)));
+}
+
+// `profile` (counter-clockwise in the xy-plane) extruded over z in [0, length], the caps made of
+// `cap` (counter-clockwise triangles of profile indices); faces oriented outwards.
+TriangleMesh extrude(const std::vector<Vec2>& profile, const std::vector<Triangle>& cap,
+                     double length) {
+  TriangleMesh mesh;
+  const Index n = Index(profile.size());
+  for (double z : {0.0, length})
+    for (const Vec2& p : profile) mesh.vertices.emplace_back(p.x(), p.y(), z);
+  for (const Triangle& t : cap) {
+    mesh.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});  // z = length, facing +z
+    mesh.triangles.push_back({t[0], t[2], t[1]});              // z = 0, facing -z
+  }
+  // Side quad i: (d, 0) x (d, length) = length (d.y, -d.x): the right of a counter-clockwise
+  // profile, outwards.
+  for (Index i = 0; i < n; ++i) {
+    const Index j = (i + 1) % n;
+    mesh.triangles.push_back({i, j, j + n});
+    mesh.triangles.push_back({i, j + n, i + n});
+  }
+  return mesh;
+}
+
+struct Corner {
+  enum Kind { Sharp, Chamfer, Fillet } kind = Sharp;
+  double size = 0;  // chamfer: cut along each side; fillet: radius
+};
+
+// The rectangle [0, w] x [0, h], counter-clockwise from (0, 0), with its corners cut.
+std::vector<Vec2> cutRectangle(double w, double h, const std::array<Corner, 4>& corners) {
+  const std::array<Vec2, 4> p{Vec2(0, 0), Vec2(w, 0), Vec2(w, h), Vec2(0, h)};
+  constexpr int kFilletSegments = 12;  // 7.5 degrees per facet: smooth for any --angle above it
+  std::vector<Vec2> out;
+  for (int k = 0; k < 4; ++k) {
+    const Vec2 in = (p[k] - p[(k + 3) % 4]).normalized(),
+               next = (p[(k + 1) % 4] - p[k]).normalized();
+    const double s = corners[k].size;
+    switch (corners[k].kind) {
+      case Corner::Sharp:
+        out.push_back(p[k]);
+        break;
+      case Corner::Chamfer:
+        out.push_back(p[k] - s * in);
+        out.push_back(p[k] + s * next);
+        break;
+      case Corner::Fillet: {
+        const Vec2 start = p[k] - s * in, centre = start + s * Vec2(-in.y(), in.x());
+        for (int i = 0; i <= kFilletSegments; ++i) {
+          const double a = 0.5 * kPi * i / kFilletSegments;  // counter-clockwise quarter turn
+          const Vec2 r = start - centre;
+          out.push_back(centre + Vec2(std::cos(a) * r.x() - std::sin(a) * r.y(),
+                                      std::sin(a) * r.x() + std::cos(a) * r.y()));
+        }
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<Triangle> convexFan(std::size_t n) {
+  std::vector<Triangle> fan;
+  for (Index i = 1; i + 1 < n; ++i) fan.push_back({0, i, i + 1});
+  return fan;
+}
+
+TriangleMesh makeBox(std::size_t points) {
+  const double w = 1.0, h = 0.6, length = 0.8;
+  const double e = expectedSpacing(2 * (w * h + w * length + h * length), points);
+  const std::array<Corner, 4> corners{Corner{Corner::Chamfer, 2 * e}, Corner{Corner::Fillet, e},
+                                      Corner{Corner::Fillet, 2 * e}, Corner{Corner::Fillet, 4 * e}};
+  const std::vector<Vec2> profile = cutRectangle(w, h, corners);
+  return extrude(profile, convexFan(profile.size()), length);
+}
+
+// A prism over a flat base whose top is a polyline of equal segments at the given slopes
+// (degrees): each change of slope is a crease whose normals turn by that difference, concave when
+// the slope increases. The cap is the strips between the top vertices and their feet.
+TriangleMesh makeCreases() {
+  const std::vector<double> slopes{0,   30, 0,   60,  0,  -45, 45,
+                                   -45, 75, -45, -75, 75, -75, 0};  // |turns|: 30 to 150
+  const double segment = 0.2, base = 0.25, length = 0.8;
+  std::vector<Vec2> top{Vec2(0, base)};
+  for (double s : slopes)
+    top.push_back(top.back() + segment * Vec2(std::cos(s * kPi / 180), std::sin(s * kPi / 180)));
+  const Index m = Index(top.size());
+  std::vector<Vec2> profile;  // feet left to right, then the top right to left
+  for (const Vec2& t : top) profile.emplace_back(t.x(), 0);
+  for (Index i = m; i-- > 0;) profile.push_back(top[i]);
+  std::vector<Triangle> cap;
+  const auto foot = [](Index i) { return i; };
+  const auto head = [m](Index i) { return 2 * m - 1 - i; };
+  for (Index i = 0; i + 1 < m; ++i) {
+    cap.push_back({foot(i), foot(i + 1), head(i + 1)});
+    cap.push_back({foot(i), head(i + 1), head(i)});
+  }
+  return extrude(profile, cap, length);
+}
+
+// A box (no bottom) standing on the ground square [-1, 1]^2 with a hole at its footprint: the
+// footprint edges join ground and walls (a concave curve); the ground's border is open.
+TriangleMesh makeBoxOnGround() {
+  const double hx = 0.3, hy = 0.2, height = 0.4;
+  TriangleMesh mesh;
+  const std::array<Vec2, 4> square{Vec2(-1, -1), Vec2(1, -1), Vec2(1, 1), Vec2(-1, 1)};
+  for (const Vec2& s : square) mesh.vertices.emplace_back(s.x(), s.y(), 0);  // 0-3: ground
+  for (double z : {0.0, height})                                             // 4-7, 8-11
+    for (const Vec2& s : square) mesh.vertices.emplace_back(hx * s.x(), hy * s.y(), z);
+  for (Index i = 0; i < 4; ++i) {
+    const Index j = (i + 1) % 4;
+    mesh.triangles.push_back({i, j, 4 + j});  // ground ring, facing +z
+    mesh.triangles.push_back({i, 4 + j, 4 + i});
+    mesh.triangles.push_back({4 + i, 4 + j, 8 + j});  // wall, facing outwards
+    mesh.triangles.push_back({4 + i, 8 + j, 8 + i});
+  }
+  mesh.triangles.push_back({8, 9, 10});
+  mesh.triangles.push_back({8, 10, 11});
+  return mesh;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ground truth.
+
+struct DisjointSets {
+  std::vector<Index> parent;
+  explicit DisjointSets(std::size_t n) : parent(n) {
+    for (std::size_t i = 0; i < n; ++i) parent[i] = Index(i);
+  }
+  Index find(Index i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void unite(Index a, Index b) { parent[find(a)] = find(b); }
+};
+
+struct SharpEdge {
+  Index a = 0, b = 0;
+  int sign = 0;  // +1 convex, -1 concave
+  int curve = -1;
+};
+
+struct MeshEdges {
+  std::vector<SharpEdge> sharp;
+  int curves = 0;
+  std::size_t convex = 0, concave = 0;
+  std::size_t border = 0, nonManifold = 0,
+              inconsistent = 0;  // edges with 1, > 2 faces; bad winding
+  bool flipped = false;
+};
+
+Vec3 faceNormal(const TriangleMesh& mesh, const Triangle& t) {
+  return (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+      .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+}
+
+// Six times the signed volume: positive for a closed mesh whose faces point outwards.
+double orientedVolume(const TriangleMesh& mesh) {
+  double v = 0;
+  for (const Triangle& t : mesh.triangles)
+    v += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
+  return v;
+}
+
+// +1 when the face runs a -> b, -1 when b -> a.
+int direction(const Triangle& t, Index a, Index b) {
+  for (int k = 0; k < 3; ++k)
+    if (t[k] == a) return t[(k + 1) % 3] == b ? 1 : -1;
+  return 0;
+}
+
+Index opposite(const Triangle& t, Index a, Index b) {
+  for (Index v : t)
+    if (v != a && v != b) return v;
+  return a;
+}
+
+// Sharp edges (normals turning by >= angleDegrees) with their sign, grouped into curves.
+MeshEdges findSharpEdges(const TriangleMesh& mesh, double angleDegrees) {
+  std::unordered_map<std::uint64_t, std::vector<Index>> faces;  // edge (lo, hi) -> faces
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = mesh.triangles[f][k], b = mesh.triangles[f][(k + 1) % 3];
+      faces[(std::uint64_t(std::min(a, b)) << 32) | std::max(a, b)].push_back(Index(f));
+    }
+  MeshEdges out;
+  bool closed = true;
+  for (const auto& [key, list] : faces) closed = closed && list.size() == 2;
+  out.flipped = closed && orientedVolume(mesh) < 0;
+  const double cosLimit = std::cos((angleDegrees - kAngleTolerance) * kPi / 180);
+  for (const auto& [key, list] : faces) {
+    if (list.size() != 2) {
+      ++(list.size() == 1 ? out.border : out.nonManifold);
+      continue;
+    }
+    const Index a = Index(key >> 32), b = Index(key & 0xffffffffu);
+    const Triangle &f1 = mesh.triangles[list[0]], &f2 = mesh.triangles[list[1]];
+    const Vec3 n1 = faceNormal(mesh, f1), n2 = faceNormal(mesh, f2);
+    if (n1.norm() == 0 || n2.norm() == 0) continue;  // degenerate face: no angle
+    if (n1.normalized().dot(n2.normalized()) > cosLimit) continue;
+    if (direction(f1, a, b) == direction(f2, a, b)) ++out.inconsistent;
+    // Convex when the other face bends below the plane of the first (outward normals).
+    const double side = n1.dot(mesh.vertices[opposite(f2, a, b)] - mesh.vertices[a]);
+    SharpEdge edge{a, b, (side < 0) != out.flipped ? 1 : -1, -1};
+    ++(edge.sign > 0 ? out.convex : out.concave);
+    out.sharp.push_back(edge);
+  }
+  // Same-sign edges sharing a vertex form one curve: one union-find per sign.
+  for (int sign : {1, -1}) {
+    DisjointSets sets(mesh.vertices.size());
+    for (const SharpEdge& e : out.sharp)
+      if (e.sign == sign) sets.unite(e.a, e.b);
+    std::map<Index, int> curveOfRoot;
+    for (SharpEdge& e : out.sharp)
+      if (e.sign == sign) {
+        const auto [it, added] = curveOfRoot.emplace(sets.find(e.a), out.curves);
+        out.curves += added;
+        e.curve = it->second;
+      }
+  }
+  return out;
+}
+
+double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+
+// Per point, the curve of its nearest sharp edge when that edge lies within `radius`, else -1.
+// Each edge queries balls along itself (pieces <= 2 radius long) rather than one ball around it:
+// a long edge would otherwise visit most of the cloud.
+std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const SpatialIndex& index,
+                                      const TriangleMesh& mesh, const Vec3& origin,
+                                      const MeshEdges& edges, double radius) {
+  std::vector<int> curve(positions.size(), -1);
+  std::vector<double> best(positions.size(), radius);
+  std::vector<Neighbor> found;
+  for (const SharpEdge& e : edges.sharp) {
+    const Vec3 a = mesh.vertices[e.a] - origin, b = mesh.vertices[e.b] - origin;
+    const double length = (b - a).norm();
+    const int pieces = std::max(1, int(std::ceil(length / (2 * radius))));
+    for (int k = 0; k < pieces; ++k) {
+      const Vec3 centre = a + (b - a) * ((k + 0.5) / pieces);
+      index.radiusSearch(centre, 0.5 * length / pieces + radius, found);
+      for (const Neighbor& n : found) {
+        const double d = segmentDistance(positions[n.index], a, b);
+        if (d <= best[n.index]) best[n.index] = d, curve[n.index] = e.curve;
+      }
+    }
+  }
+  return curve;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Clouds.
+
+// As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
+void estimateOrientedNormals(PointCloud& cloud) {
+  auto index = makeSpatialIndex(cloud.positions());
+  NormalEstimationResult est = estimateNormals(cloud.positions(), *index);
+  orientNormals(cloud.positions(), est.normals, *index, {}, est.valid);
+  cloud.setNormals(std::move(est.normals));
+}
+
+PointCloud noisyCopy(const PointCloud& clean, double sigma) {
+  std::mt19937_64 rng(kNoiseSeed);
+  std::normal_distribution<double> gauss(0.0, sigma);
+  std::vector<Vec3> moved = clean.positions();
+  for (Vec3& p : moved)
+    for (int c = 0; c < 3; ++c) p[c] += gauss(rng);
+  PointCloud noisy;
+  noisy.setRelativePositions(std::move(moved), clean.origin());
+  return noisy;
+}
+
+struct Model {
+  std::string name;
+  TriangleMesh mesh;
+  PointCloud clean;     // with estimated normals
+  std::vector<int> gt;  // per point: ground-truth curve or -1
+  int gtCurves = 0;     // curves with at least one point
+  MeshEdges edges;
+  double spacing = 0, diagonal = 0;
+};
+
+Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, double angle) {
+  Model m;
+  m.name = std::move(name);
+  m.mesh = std::move(mesh);
+  m.clean = sampleMesh(m.mesh, points, kSampleSeed);
+  m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
+  estimateOrientedNormals(m.clean);
+  m.diagonal = m.clean.boundingBoxDiagonal();
+  m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
+  m.edges = findSharpEdges(m.mesh, angle);
+  const auto index = makeSpatialIndex(m.clean.positions());
+  m.gt = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
+                              m.spacing);
+  std::vector<bool> used(std::size_t(m.edges.curves), false);
+  for (int c : m.gt)
+    if (c >= 0) used[std::size_t(c)] = true;
+  m.gtCurves = int(std::count(used.begin(), used.end(), true));
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Metrics.
+
+std::unique_ptr<SpatialIndex> indexOf(const std::vector<Index>& set,
+                                      const std::vector<Vec3>& positions) {
+  std::vector<Vec3> p;
+  p.reserve(set.size());
+  for (Index i : set) p.push_back(positions[i]);
+  return makeSpatialIndex(p);
+}
+
+// max over `from` of the distance to the nearest point of the set indexed by `to`. In parallel:
+// a peer's giant component is matched by every ground-truth curve of a CAD model.
+double directedHausdorff(const std::vector<Index>& from, const SpatialIndex& to,
+                         const std::vector<Vec3>& positions) {
+  const double worst = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, from.size(), 1024), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& r, double w) {
+        std::vector<Neighbor> nearest;
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+          to.knnSearch(positions[from[k]], 1, nearest);
+          w = std::max(w, nearest.front().distSq);
+        }
+        return w;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  return std::sqrt(worst);
+}
+
+double hausdorff(const std::vector<Index>& a, const std::vector<Index>& b,
+                 const std::vector<Vec3>& positions) {
+  if (a.empty() || b.empty()) return NAN;
+  return std::max(directedHausdorff(a, *indexOf(b, positions), positions),
+                  directedHausdorff(b, *indexOf(a, positions), positions));
+}
+
+double dice(std::size_t common, std::size_t a, std::size_t b) {
+  return a + b ? 2.0 * double(common) / double(a + b) : 1.0;
+}
+
+std::vector<std::vector<Index>> groups(const std::vector<int>& label, int count) {
+  std::vector<std::vector<Index>> out(std::size_t(std::max(count, 0)));
+  for (std::size_t i = 0; i < label.size(); ++i)
+    if (label[i] >= 0) out[std::size_t(label[i])].push_back(Index(i));
+  return out;
+}
+
+struct Scores {
+  double labelled = 0, precision = 0, recall = 0, mcc = 0, dice = 0, hausdorff = NAN;
+  std::size_t curves = 0;
+  double curveDice = 0, curveHausdorff = NAN, curveRecall = 0, seconds = 0;
+};
+
+// Per curve: each ground-truth curve against the detected curve holding most of its points.
+void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
+  const std::vector<std::vector<Index>> truth = groups(m.gt, m.edges.curves),
+                                        found = groups(detected, detectedCount);
+  std::map<std::pair<int, int>, std::size_t> overlap;
+  for (std::size_t i = 0; i < m.gt.size(); ++i)
+    if (m.gt[i] >= 0 && detected[i] >= 0) ++overlap[{m.gt[i], detected[i]}];
+  std::vector<int> match(truth.size(), -1);
+  std::vector<std::size_t> common(truth.size(), 0);
+  for (const auto& [pair, k] : overlap)
+    if (k > common[std::size_t(pair.first)])
+      common[std::size_t(pair.first)] = k, match[std::size_t(pair.first)] = pair.second;
+  std::map<int, std::unique_ptr<SpatialIndex>> foundIndex;  // a large component matches many
+  double diceSum = 0, hausdorffSum = 0;
+  std::size_t counted = 0, matched = 0, covered = 0;
+  for (std::size_t g = 0; g < truth.size(); ++g) {
+    if (truth[g].empty()) continue;
+    ++counted;
+    if (match[g] < 0) continue;
+    const std::vector<Index>& d = found[std::size_t(match[g])];
+    diceSum += dice(common[g], truth[g].size(), d.size());
+    covered += double(common[g]) >= kCurveCovered * double(truth[g].size());
+    auto& index = foundIndex[match[g]];
+    if (!index) index = indexOf(d, m.clean.positions());
+    hausdorffSum += std::max(
+        directedHausdorff(truth[g], *index, m.clean.positions()),
+        directedHausdorff(d, *indexOf(truth[g], m.clean.positions()), m.clean.positions()));
+    ++matched;
+  }
+  s.curves = std::size_t(detectedCount);
+  if (counted == 0) return;
+  s.curveDice = diceSum / double(counted);
+  s.curveRecall = double(covered) / double(counted);
+  if (matched) s.curveHausdorff = hausdorffSum / double(matched) / m.diagonal;
+}
+
+// `detected`: per point, its detected curve or -1 (labelled = detected >= 0).
+Scores score(const Model& m, const std::vector<int>& detected, int detectedCount) {
+  double tp = 0, fp = 0, fn = 0, tn = 0;
+  std::vector<Index> truthSet, labelledSet;
+  for (std::size_t i = 0; i < m.gt.size(); ++i) {
+    const bool t = m.gt[i] >= 0, l = detected[i] >= 0;
+    (t ? (l ? tp : fn) : (l ? fp : tn)) += 1;
+    if (t) truthSet.push_back(Index(i));
+    if (l) labelledSet.push_back(Index(i));
+  }
+  Scores s;
+  s.labelled = (tp + fp) / double(m.gt.size());
+  s.precision = tp + fp > 0 ? tp / (tp + fp) : 0;
+  s.recall = tp + fn > 0 ? tp / (tp + fn) : 0;
+  const double denominator = (tp + fp) * (tp + fn) * (tn + fp) * (tn + fn);
+  s.mcc = denominator > 0 ? (tp * tn - fp * fn) / std::sqrt(denominator) : 0;
+  s.dice = dice(std::size_t(tp), truthSet.size(), labelledSet.size());
+  s.hausdorff = hausdorff(truthSet, labelledSet, m.clean.positions()) / m.diagonal;
+  scoreCurves(m, detected, detectedCount, s);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Methods. Each returns per point its curve (or -1) and the number of curves.
+
+struct Detection {
+  std::vector<int> curve;
+  int count = 0;
+};
+
+Detection runOurs(const PointCloud& cloud) {
+  const FeatureCurveResult result = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  Detection d;
+  d.curve = result.curveId;
+  for (int c : d.curve) d.count = std::max(d.count, c + 1);
+  return d;
+}
+
+// The peers' curves: connected components of the labelled points on the (symmetrised) graph.
+Detection components(const std::vector<bool>& labelled, const KnnGraph& graph) {
+  DisjointSets sets(labelled.size());
+  for (std::size_t i = 0; i < graph.size(); ++i)
+    if (labelled[i])
+      for (std::size_t k = graph.offsets[i]; k < graph.offsets[i + 1]; ++k)
+        if (labelled[graph.neighbors[k]]) sets.unite(Index(i), graph.neighbors[k]);
+  Detection d;
+  d.curve.assign(labelled.size(), -1);
+  std::unordered_map<Index, int> idOfRoot;
+  for (std::size_t i = 0; i < labelled.size(); ++i)
+    if (labelled[i]) {
+      const auto [it, added] = idOfRoot.emplace(sets.find(Index(i)), d.count);
+      d.count += added;
+      d.curve[i] = it->second;
+    }
+  return d;
+}
+
+struct VcmSetting {
+  double offset, convolution;  // R and r over e
+};
+const VcmSetting kVcmSettings[] = {{2, 1}, {4, 1}, {4, 2}};
+const double kCovarianceThresholds[] = {0.02, 0.05, 0.1};
+
+std::vector<bool> vcmLabels(const PointCloud& cloud, const VcmSetting& setting, double spacing) {
+  using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::vector<Kernel::Point_3> points;
+  points.reserve(cloud.size());
+  for (const Vec3& p : cloud.positions()) points.emplace_back(p.x(), p.y(), p.z());
+  std::vector<std::array<double, 6>> cov;
+  CGAL::compute_vcm(points, cov, setting.offset * spacing, setting.convolution * spacing);
+  std::vector<bool> labelled(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    labelled[i] = CGAL::vcm_is_on_feature_edge(cov[i], kVcmThreshold);
+  return labelled;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output.
+
+struct Row {
+  std::string method;
+  Scores scores;
+};
+
+void printHeader(double noise) {
+  std::printf("\n# noise %g of the diagonal\n", noise);
+  std::printf("%-14s %-11s %6s %6s %6s %6s %6s %8s %6s %6s %8s %5s %8s\n", "model", "method",
+              "lab%", "P", "R", "MCC", "Dice", "H/diag", "curves", "cDice", "cH/diag", "cRec",
+              "seconds");
+}
+
+// A Hausdorff distance over the diagonal, "-" when one of the sets is empty.
+std::string distanceText(double d) {
+  char buf[16] = "-";
+  if (!std::isnan(d)) std::snprintf(buf, sizeof buf, "%.4f", d);
+  return buf;
+}
+
+void printScores(const char* model, const char* method, const Scores& s) {
+  std::printf("%-14s %-11s %6.2f %6.3f %6.3f %6.3f %6.3f %8s %6zu %6.3f %8s %5.2f %8.2f\n", model,
+              method, 100 * s.labelled, s.precision, s.recall, s.mcc, s.dice,
+              distanceText(s.hausdorff).c_str(), s.curves, s.curveDice,
+              distanceText(s.curveHausdorff).c_str(), s.curveRecall, s.seconds);
+  std::fflush(stdout);
+}
+
+void printModel(const Model& m, std::size_t gtPoints) {
+  std::printf(
+      "# %s: %zu vertices, %zu triangles; sharp edges %zu (convex %zu, concave %zu) in %d curves, "
+      "%d with points; %.2f %% of the points are feature points; e %.4g, diagonal %.4g",
+      m.name.c_str(), m.mesh.vertices.size(), m.mesh.triangles.size(), m.edges.sharp.size(),
+      m.edges.convex, m.edges.concave, m.edges.curves, m.gtCurves,
+      100.0 * double(gtPoints) / double(m.gt.size()), m.spacing, m.diagonal);
+  if (m.edges.border) std::printf("; %zu border edges", m.edges.border);
+  if (m.edges.nonManifold) std::printf("; %zu non-manifold edges", m.edges.nonManifold);
+  if (m.edges.inconsistent)
+    std::printf("; %zu sharp edges wound inconsistently", m.edges.inconsistent);
+  if (m.edges.flipped) std::printf("; faces point inwards: signs flipped");
+  std::printf("\n");
+}
+
+// Means over the models of each method's scores (NaN Hausdorff values left out).
+void printMeans(const std::vector<Row>& rows) {
+  std::vector<std::string> methods;
+  for (const Row& r : rows)
+    if (std::find(methods.begin(), methods.end(), r.method) == methods.end())
+      methods.push_back(r.method);
+  for (const std::string& method : methods) {
+    Scores mean;
+    double n = 0, nH = 0, nCH = 0, curves = 0;
+    mean.hausdorff = mean.curveHausdorff = 0;
+    for (const Row& r : rows) {
+      if (r.method != method) continue;
+      const Scores& s = r.scores;
+      n += 1;
+      mean.labelled += s.labelled, mean.precision += s.precision, mean.recall += s.recall;
+      mean.mcc += s.mcc, mean.dice += s.dice, curves += double(s.curves);
+      mean.curveDice += s.curveDice, mean.curveRecall += s.curveRecall, mean.seconds += s.seconds;
+      if (!std::isnan(s.hausdorff)) mean.hausdorff += s.hausdorff, nH += 1;
+      if (!std::isnan(s.curveHausdorff)) mean.curveHausdorff += s.curveHausdorff, nCH += 1;
+    }
+    for (double* v : {&mean.labelled, &mean.precision, &mean.recall, &mean.mcc, &mean.dice,
+                      &mean.curveDice, &mean.curveRecall, &mean.seconds})
+      *v /= n;
+    mean.hausdorff = nH ? mean.hausdorff / nH : NAN;
+    mean.curveHausdorff = nCH ? mean.curveHausdorff / nCH : NAN;
+    mean.curves = std::size_t(std::lround(curves / n));
+    printScores("mean", method.c_str(), mean);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+bool readMesh(const std::string& dir, const std::string& name, TriangleMesh& mesh) {
+  const std::string path = dir + "/" + name + ".off";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::printf("# %s: %s not found, skipped\n", name.c_str(), path.c_str());
+    return false;
+  }
+  std::stringstream data;
+  data << in.rdbuf();
+  mesh = parseOff(data.str(), path);
+  return true;
+}
+
+bool makeMesh(const std::string& name, const std::string& dir, std::size_t points,
+              TriangleMesh& mesh) {
+  if (name == "box")
+    mesh = makeBox(points);
+  else if (name == "creases")
+    mesh = makeCreases();
+  else if (name == "box_on_ground")
+    mesh = makeBoxOnGround();
+  else
+    return readMesh(dir, name, mesh);
+  return true;
+}
+
+// Every method on one cloud (clean or noisy) of a model.
+void runMethods(const Model& m, const PointCloud& cloud, bool peers, std::vector<Row>& rows) {
+  const auto add = [&](const std::string& method, const Detection& d, double seconds) {
+    Row row{method, score(m, d.curve, d.count)};
+    row.scores.seconds = seconds;
+    printScores(m.name.c_str(), method.c_str(), row.scores);
+    rows.push_back(row);
+  };
+  Clock::time_point start = Clock::now();
+  const Detection ours = runOurs(cloud);
+  add("ours", ours, secondsSince(start));
+  if (!peers) return;
+
+  start = Clock::now();
+  const KnnGraph graph = buildKnnGraph(cloud.positions(), kPeerGraphNeighbors);
+  const double graphSeconds = secondsSince(start);
+  for (const VcmSetting& setting : kVcmSettings) {
+    start = Clock::now();
+    const std::vector<bool> labelled = vcmLabels(cloud, setting, m.spacing);
+    const Detection d = components(labelled, graph);
+    char name[32];
+    std::snprintf(name, sizeof name, "vcm %ge/%ge", setting.offset, setting.convolution);
+    add(name, d, secondsSince(start) + graphSeconds);
+  }
+  start = Clock::now();
+  NormalEstimationOptions covariance;
+  covariance.k = kCovarianceNeighbors;
+  const NormalEstimationResult est = estimateNormals(cloud.positions(), covariance);
+  const double covarianceSeconds = secondsSince(start);
+  for (double threshold : kCovarianceThresholds) {
+    start = Clock::now();
+    std::vector<bool> labelled(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      labelled[i] = est.surfaceVariation[i] > threshold;
+    const Detection d = components(labelled, graph);
+    char name[32];
+    std::snprintf(name, sizeof name, "cov %.2f", threshold);
+    add(name, d, secondsSince(start) + covarianceSeconds + graphSeconds);
+  }
+}
+
+std::vector<std::string> splitList(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
+  std::size_t points = 100000;
+  std::string dir = "/tmp/real/cgal/data/meshes";
+  std::vector<std::string> models(std::begin(kCadModels), std::end(kCadModels));
+  models.insert(models.end(), std::begin(kOwnModels), std::end(kOwnModels));
+  double angle = 30;
+  bool clean = true, noisy = true, peers = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool hasValue = i + 1 < argc;
+    if (a == "--points" && hasValue) {
+      points = std::size_t(std::atoll(argv[++i]));
+    } else if (a == "--data" && hasValue) {
+      dir = argv[++i];
+    } else if (a == "--models" && hasValue) {
+      models = splitList(argv[++i]);
+    } else if (a == "--angle" && hasValue) {
+      angle = std::atof(argv[++i]);
+    } else if (a == "--clean-only") {
+      noisy = false;
+    } else if (a == "--noise-only") {
+      clean = false;
+    } else if (a == "--no-peers") {
+      peers = false;
+    } else {
+      std::fprintf(stderr, "bench_features: unknown argument '%s'\n", argv[i]);
+      return 2;
+    }
+  }
+  std::printf(
+      "# %zu points per model; sharp edges: face normals turning by >= %g degrees; feature "
+      "points within e of one; cRec: share of ground-truth curves whose best-overlapping detected "
+      "curve covers >= %.0f %% of their points; vcm R/r (threshold %.2f), cov: surface variation "
+      "over %zu neighbours > X; peers' curves: components on the %zu-NN graph\n",
+      points, angle, 100 * kCurveCovered, kVcmThreshold, kCovarianceNeighbors, kPeerGraphNeighbors);
+  std::vector<double> noiseLevels;
+  if (clean) noiseLevels.push_back(0);
+  if (noisy) noiseLevels.push_back(kNoise);
+  for (double noise : noiseLevels) {
+    printHeader(noise);
+    std::vector<Row> rows;
+    for (const std::string& name : models) {
+      try {
+        TriangleMesh mesh;
+        if (!makeMesh(name, dir, points, mesh)) continue;
+        const Model m = prepareModel(name, std::move(mesh), points, angle);
+        printModel(
+            m, std::size_t(std::count_if(m.gt.begin(), m.gt.end(), [](int c) { return c >= 0; })));
+        if (noise == 0) {
+          runMethods(m, m.clean, peers, rows);
+        } else {
+          PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
+          estimateOrientedNormals(cloud);
+          runMethods(m, cloud, peers, rows);
+        }
+      } catch (const Error& error) {
+        std::printf("# %s: skipped (%s)\n", name.c_str(), error.what());
+      }
+    }
+    printMeans(rows);
+  }
+  return 0;
+}
