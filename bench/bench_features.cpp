@@ -4,6 +4,9 @@
 //
 //   bench_features [--points N (100000)] [--data DIR (/tmp/real/cgal/data/meshes)]
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
+//                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
+//                  [--vote-radius X]
+//                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
 // fandisk_large: Debian's libcgal-demo data; a missing file is skipped with a line saying so) and
@@ -525,8 +528,12 @@ struct Detection {
   int count = 0;
 };
 
+// Ours with the library's defaults unless --salient / --vote-threshold / --min-curvature /
+// --vote-radius say otherwise (to measure a setting against the same ground truth).
+FeatureCurveOptions ourOptions;
+
 Detection runOurs(const PointCloud& cloud) {
-  const FeatureCurveResult result = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  const FeatureCurveResult result = detectFeatureCurves(cloud, ourOptions);
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
@@ -748,6 +755,16 @@ int main(int argc, char** argv) {
       noisy = false;
     } else if (a == "--noise-only") {
       clean = false;
+    } else if (a == "--salient" && hasValue) {
+      ourOptions.salientThreshold = std::atof(argv[++i]);
+    } else if (a == "--vote-threshold" && hasValue) {
+      ourOptions.voteThreshold = std::atof(argv[++i]);
+    } else if (a == "--min-curvature" && hasValue) {
+      ourOptions.minSalientCurvature = std::atof(argv[++i]);
+    } else if (a == "--min-scales" && hasValue) {
+      ourOptions.minVotingScales = std::atoi(argv[++i]);
+    } else if (a == "--vote-radius" && hasValue) {
+      ourOptions.voteRadiusFactor = std::atof(argv[++i]);
     } else if (a == "--no-peers") {
       peers = false;
     } else {

@@ -226,6 +226,12 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--vote-threshold", args->features.voteThreshold,
                   "curves hold points with |votes| > this x the largest")
       ->capture_default_str();
+  cmd->add_option("--min-curvature", args->features.minSalientCurvature,
+                  "salient vertices also have |k1| t >= this (0 = the thesis' rule alone)")
+      ->capture_default_str();
+  cmd->add_option("--min-scales", args->features.minVotingScales,
+                  "points join curves only when this many scales voted for them (1 = the thesis)")
+      ->capture_default_str();
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e (0 keeps all)")
       ->capture_default_str();
@@ -323,6 +329,8 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"salient_threshold", options.salientThreshold},
                                    {"salient_percentile", options.salientPercentile},
                                    {"vote_threshold", options.voteThreshold},
+                                   {"min_salient_curvature", options.minSalientCurvature},
+                                   {"min_voting_scales", options.minVotingScales},
                                    {"min_curve_extent", options.minCurveExtent},
                                    {"threads", args->threads}}},
                                  {"scales", scales},

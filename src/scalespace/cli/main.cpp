@@ -52,6 +52,8 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::salientThreshold", "--salient"},
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
+    {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
+    {"FeatureCurveOptions::minVotingScales", "--min-scales"},
     {"the thread count (threads option)", "--threads"},
     {"findSimilar: no component", "--similar: no component"},
 };

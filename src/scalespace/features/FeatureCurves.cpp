@@ -84,12 +84,16 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
   require(
       std::isfinite(o.salientPercentile) && o.salientPercentile >= 0 && o.salientPercentile <= 1,
       "FeatureCurveOptions::salientPercentile must be in [0, 1]");
-  require(std::isfinite(o.salientThreshold) && o.salientThreshold >= 0,
-          "FeatureCurveOptions::salientThreshold must be finite and >= 0");
+  require(std::isfinite(o.salientThreshold) && o.salientThreshold >= 0 && o.salientThreshold <= 1,
+          "FeatureCurveOptions::salientThreshold must be in [0, 1]");
+  require(std::isfinite(o.minSalientCurvature) && o.minSalientCurvature >= 0,
+          "FeatureCurveOptions::minSalientCurvature must be finite and >= 0");
   require(std::isfinite(o.voteRadiusFactor) && o.voteRadiusFactor > 0,
           "FeatureCurveOptions::voteRadiusFactor must be finite and > 0");
   require(std::isfinite(o.voteThreshold) && o.voteThreshold >= 0 && o.voteThreshold < 1,
           "FeatureCurveOptions::voteThreshold must be in [0, 1)");
+  require(o.minVotingScales >= 1 && o.minVotingScales <= o.scaleCount,
+          "FeatureCurveOptions::minVotingScales must be in [1, scaleCount]");
   require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
           "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
   require(o.graphNeighbors >= 1 && std::size_t(o.graphNeighbors) <= kMaxNeighborCount,
@@ -192,7 +196,8 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     summary.scale = lineOptions.scale;
     summary.salientBound = quantile(lines.seedKappa1, options.salientPercentile);
     summary.lines = lines.lines.size();
-    const double bound = (1 - options.salientThreshold) * summary.salientBound;
+    const double bound = std::max((1 - options.salientThreshold) * summary.salientBound,
+                                  options.minSalientCurvature / lineOptions.scale);
     for (const CurvatureLine& line : lines.lines)
       for (const CurvatureLineVertex& v : line.vertices) {
         ++summary.vertices;
@@ -240,7 +245,8 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
   std::vector<std::uint8_t> eligible(n, 0);
   result.convexity.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i)
-    if (result.maxVote > 0 && std::abs(result.votes[i]) > threshold) {
+    if (result.maxVote > 0 && std::abs(result.votes[i]) > threshold &&
+        __builtin_popcount(voters[i]) >= options.minVotingScales) {
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
