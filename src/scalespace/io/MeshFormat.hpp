@@ -50,6 +50,10 @@ std::vector<Vec3> areaWeightedVertexNormals(const TriangleMesh& mesh);
 /// (one std::mt19937_64 stream: triangle by cumulative area + binary search, then the
 /// square-root barycentric trick). Normals as described above. Throws OptionError when the mesh
 /// has no triangle of positive area or count exceeds the Index range.
-PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t seed);
+/// With creaseAngleDegrees < 180, a triangle with a vertex normal more than that angle away from
+/// its own normal (a vertex on a sharp edge, whose normal averages faces on both sides) gives its
+/// samples the face normal: on a CAD mesh the interpolation would tilt every normal near an edge.
+PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t seed,
+                      double creaseAngleDegrees = 180);
 
 }  // namespace scalespace

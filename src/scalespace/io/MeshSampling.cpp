@@ -33,7 +33,9 @@ std::vector<Vec3> areaWeightedVertexNormals(const TriangleMesh& mesh) {
   return normals;
 }
 
-PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t seed) {
+PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t seed,
+                      double creaseAngleDegrees) {
+  const double cosCrease = std::cos(std::clamp(creaseAngleDegrees, 0.0, 180.0) * M_PI / 180);
   if (count > std::numeric_limits<Index>::max())
     throw OptionError("mesh sampling: " + std::to_string(count) + " samples exceed the limit of " +
                       std::to_string(std::numeric_limits<Index>::max()) + " points");
@@ -69,7 +71,16 @@ PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t
     const double r2 = uniform01(rng);
     const double wa = 1.0 - s, wb = s * (1.0 - r2), wc = s * r2;
     points[i] = wa * mesh.vertices[t[0]] + wb * mesh.vertices[t[1]] + wc * mesh.vertices[t[2]];
-    Vec3 n = wa * vertexNormals[t[0]] + wb * vertexNormals[t[1]] + wc * vertexNormals[t[2]];
+    const Vec3 face = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                          .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                          .normalized();
+    const bool crease = creaseAngleDegrees < 180 && (vertexNormals[t[0]].dot(face) < cosCrease ||
+                                                     vertexNormals[t[1]].dot(face) < cosCrease ||
+                                                     vertexNormals[t[2]].dot(face) < cosCrease);
+    Vec3 n =
+        crease
+            ? face
+            : Vec3(wa * vertexNormals[t[0]] + wb * vertexNormals[t[1]] + wc * vertexNormals[t[2]]);
     double length = n.norm();
     if (!(length > 1e-12) || !std::isfinite(length)) {
       // Opposite vertex normals cancelled out (or the file gave zero normals): use the face's.

@@ -1,0 +1,145 @@
+// `scalespace lines` and `scalespace features`: outputs other tools open, mesh vertices labelled,
+// clear errors on bad options and inputs.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli/CliTestSupport.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+using test::Cli;
+using test::run;
+
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+/// A unit cube as an OFF mesh whose faces are n x n grids of squares (two triangles each),
+/// outward: the mesh protocol of Sec. 3.4.1 needs vertices spread along the edges.
+void writeCube(const std::string& path, int n) {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  auto index = [&](const Vec3& p) {
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+      if ((vertices[v] - p).norm() < 1e-9) return int(v);
+    vertices.push_back(p);
+    return int(vertices.size() - 1);
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      Vec3 u = Vec3::Zero(), v = Vec3::Zero(), o = Vec3::Zero();
+      u[(axis + 1) % 3] = 1.0 / n;
+      v[(axis + 2) % 3] = 1.0 / n;
+      o[axis] = side;
+      if (side == 0) std::swap(u, v);  // outward on both sides
+      if (side == 0) o = Vec3::Zero();
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const Vec3 p = o + i * u + j * v;
+          const int a = index(p), b = index(p + u), c = index(p + u + v), d = index(p + v);
+          triangles.push_back({a, b, c});
+          triangles.push_back({a, c, d});
+        }
+    }
+  std::ofstream out(path);
+  out << "OFF\n" << vertices.size() << " " << triangles.size() << " 0\n";
+  for (const Vec3& p : vertices) out << p.x() << " " << p.y() << " " << p.z() << "\n";
+  for (const auto& t : triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+}
+
+}  // namespace
+
+TEST_F(Cli, LinesWritePlyWithEdgesAndObj) {
+  ASSERT_EQ(run("generate cylinder -n 20000 -q -o " + path("c.ply")).code, 0);
+  auto r = run("lines " + path("c.ply") + " --scale 0.1 -q -o " + path("l.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PolylineSet lines = readPolylines(path("l.ply"));
+  ASSERT_GT(lines.lineCount(), 5u);
+  for (const char* column : {"line_id", "scale", "k1", "k2", "k_gap", "nu", "tx", "ty", "tz"})
+    EXPECT_NE(lines.vertices.findAttribute(column), nullptr) << column;
+  const nlohmann::json summary = readJson(path("l.json"));
+  EXPECT_EQ(summary["scales"][0]["lines"].get<std::size_t>(), lines.lineCount());
+  // Several scales into one OBJ: `l` records.
+  r = run("lines " + path("c.ply") + " --scales 2 --tmin 0.08 --tmax 0.2 -q -o " + path("l.obj"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream obj(path("l.obj"));
+  std::string text((std::istreambuf_iterator<char>(obj)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\nl "), std::string::npos);
+  EXPECT_EQ(readJson(path("l.json"))["scales"].size(), 2u);
+}
+
+TEST_F(Cli, FeaturesLabelPointsAndMeshVertices) {
+  ASSERT_EQ(run("generate box -n 40000 -q -o " + path("b.ply")).code, 0);
+  auto r = run("features " + path("b.ply") + " -q -o " + path("f.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PointCloud labelled = readCloud(path("f.ply"));
+  for (const char* column : {"feature_votes", "curve_id", "convexity"})
+    ASSERT_NE(labelled.findAttribute(column), nullptr) << column;
+  const nlohmann::json summary = readJson(path("f.json"));
+  ASSERT_GE(summary["curves"].size(), 1u);
+  EXPECT_EQ(summary["curves"][0]["convexity"], "convex");
+  EXPECT_EQ(summary["scales"].size(), 5u);
+
+  // A mesh: the vertices on its edges are labelled convex, those of the faces' middles none.
+  writeCube(path("cube.off"), 10);
+  r = run("features " + path("cube.off") + " -q -o " + path("m.ply") + " --lines " +
+          path("m_lines.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PointCloud vertices = readCloud(path("m.ply"));
+  ASSERT_EQ(vertices.size(), 602u);
+  const AttributeColumn* convexity = vertices.findAttribute("convexity");
+  ASSERT_NE(convexity, nullptr);
+  std::size_t edgeVertices = 0, edgeConvex = 0, middleLabelled = 0;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const Vec3 p = vertices.absolutePosition(i);
+    int onBorder = 0;  // coordinates at 0 or 1: 2 on an edge, 1 inside a face
+    for (int c = 0; c < 3; ++c) onBorder += std::abs(p[c]) < 1e-6 || std::abs(p[c] - 1) < 1e-6;
+    double inside = 1;
+    for (int c = 0; c < 3; ++c) inside = std::min({inside, std::abs(p[c]), std::abs(1 - p[c])});
+    if (onBorder >= 2) {
+      ++edgeVertices;
+      edgeConvex += convexity->values[i] == 1;
+    }
+    if (onBorder == 1 && inside >= 0.35) middleLabelled += convexity->values[i] != 0;
+  }
+  EXPECT_GE(edgeConvex, std::size_t(0.9 * double(edgeVertices))) << edgeVertices;
+  EXPECT_EQ(middleLabelled, 0u);
+  EXPECT_EQ(readJson(path("m.json"))["labelled"], "mesh vertices");
+  EXPECT_GT(readPolylines(path("m_lines.ply")).lineCount(), 0u);
+}
+
+TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
+  ASSERT_EQ(run("generate cylinder -n 3000 -q -o " + path("c.ply")).code, 0);
+  auto refused = [&](const std::string& args, const std::string& says, int code = 2) {
+    const auto r = run(args);
+    EXPECT_EQ(r.code, code) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+    EXPECT_FALSE(std::filesystem::exists(path("out.ply"))) << args;
+  };
+  const std::string c = path("c.ply");
+  refused("lines " + c + " -o " + path("out.ply"), "--scale");
+  refused("lines " + c + " --scale 0.1 -o " + path("out.xyz"), ".ply or .obj");
+  refused("lines " + c + " --scale -1 -o " + path("out.ply"), "scale");
+  refused("lines " + c + " --scale 0.1 --gamma 0 -o " + path("out.ply"), "--gamma");
+  refused("lines " + c + " --scale 0.1 --alpha 0.9 -o " + path("out.ply"), "--alpha");
+  refused("lines " + c + " --scale 0.1 -o " + c, "never overwritten");
+  refused("features " + c + " --salient 2 -o " + path("out.ply"), "--salient");
+  refused("features " + c + " --scales 0 -o " + path("out.ply"), "--scales");
+  refused("features " + c + " --min-scales 9 -o " + path("out.ply"), "--min-scales");
+  refused("features " + c + " -o " + path("out.off"), "OFF and OBJ");
+  refused("features " + c + " --mesh-samples 0 -o " + path("out.ply"), "--mesh-samples");
+  std::ofstream(path("bad.off")) << "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n";
+  refused("features " + path("bad.off") + " -o " + path("out.ply"), "vertex 2", 1);
+  std::ofstream(path("flat.off")) << "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n";
+  refused("features " + path("flat.off") + " -o " + path("out.ply"), "no faces", 1);
+}
