@@ -321,7 +321,6 @@ class LineTracer {
     const std::vector<LocalFit> fits = fit(queries);
     std::vector<CurvatureLineVertex> candidate(active.size());
     std::vector<std::uint8_t> outcome(active.size());  // 0 go on, else 1 + LineStop
-    const double d2 = collision_ * collision_;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active.size(), 64), [&](const auto& r) {
       std::vector<Neighbor> found;
       for (std::size_t a = r.begin(); a != r.end(); ++a) {
@@ -332,13 +331,7 @@ class LineTracer {
         outcome[a] = stop == LineStop::MaxSteps ? 0 : std::uint8_t(1 + int(stop));
         if (outcome[a] || collision_ <= 0) continue;
         const Vec3& p = candidate[a].position;
-        placed_.forEachNear(p, [&](const VertexTag& tag) {
-          if (outcome[a] || (tag.position - p).squaredNorm() >= d2) return;
-          if (tag.line != w.line)
-            outcome[a] = 1 + int(LineStop::Collision);
-          else if (stepsApart(w.side, stepIndex, tag.side, tag.step) > 3)
-            outcome[a] = 1 + int(LineStop::Loop);
-        });
+        outcome[a] = meeting(placed_, w, stepIndex, p);
       }
     });
     // Vertices of this round, in way order (lines started earlier first): one that comes within
@@ -350,13 +343,7 @@ class LineTracer {
         const Way& w = ways_[active[a]];
         const int stepIndex = int(w.vertices.size()) + 1;
         const Vec3& p = candidate[a].position;
-        round.forEachNear(p, [&](const VertexTag& tag) {
-          if (outcome[a] || (tag.position - p).squaredNorm() >= d2) return;
-          if (tag.line != w.line)
-            outcome[a] = 1 + int(LineStop::Collision);
-          else if (stepsApart(w.side, stepIndex, tag.side, tag.step) > 3)
-            outcome[a] = 1 + int(LineStop::Loop);
-        });
+        outcome[a] = meeting(round, w, stepIndex, p);
         if (!outcome[a]) round.insert({w.line, w.side, stepIndex, p});
       }
     }
@@ -377,6 +364,21 @@ class LineTracer {
         w.stop = LineStop::MaxSteps;
     }
     active.swap(next);
+  }
+
+  /// 0 when the vertex `p` of way `w` at step `stepIndex` meets no vertex of `grid` within the
+  /// collision distance, else 1 + Collision (another line's) or 1 + Loop (its own line's, more
+  /// than 3 steps away along it: nearer ones are its neighbours).
+  std::uint8_t meeting(const VertexGrid& grid, const Way& w, int stepIndex, const Vec3& p) const {
+    std::uint8_t out = 0;
+    grid.forEachNear(p, [&](const VertexTag& tag) {
+      if (out || (tag.position - p).squaredNorm() >= collision_ * collision_) return;
+      if (tag.line != w.line)
+        out = 1 + int(LineStop::Collision);
+      else if (stepsApart(w.side, stepIndex, tag.side, tag.step) > 3)
+        out = 1 + int(LineStop::Loop);
+    });
+    return out;
   }
 
   /// What one step gives: MaxSteps (meaning "go on") and the new vertex, or why the way stops.
