@@ -216,7 +216,9 @@ void addFeaturesCommand(CLI::App& app) {
                   "output cloud (input points or mesh vertices + feature_votes, curve_id, "
                   "convexity); a JSON summary is written beside it")
       ->required();
-  cmd->add_option("--lines", args->linesOutput, "also write the salient lines (.ply or .obj)");
+  cmd->add_option("--lines", args->linesOutput,
+                  "also write the curvature lines of every scale (.ply or .obj; their k1 and "
+                  "scale tell the salient ones)");
   cmd->add_option("--spacing", args->features.spacing,
                   "unit e of the scales and votes (0: mesh median edge length, or mean distance "
                   "to the 16th neighbour)")
@@ -235,6 +237,9 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--min-scales", args->features.minVotingScales,
                   "points join curves only when this many scales voted for them (1 = the thesis)")
       ->capture_default_str();
+  cmd->add_flag("--all-salient{false}", args->features.ridgeOnly,
+                "vote with every salient vertex, not only the most curved across nearby lines "
+                "(the thesis)");
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e (0 keeps all)")
       ->capture_default_str();
@@ -348,6 +353,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"vote_threshold", options.voteThreshold},
                                    {"min_salient_curvature", options.minSalientCurvature},
                                    {"min_voting_scales", options.minVotingScales},
+                                   {"ridge_only", options.ridgeOnly},
                                    {"min_curve_extent", options.minCurveExtent},
                                    {"threads", args->threads}}},
                                  {"scales", scales},

@@ -67,6 +67,38 @@ double bandLength(const std::vector<Vec3>& positions, const std::vector<Index>& 
   return total;
 }
 
+/// Of the salient vertices of one scale, those with the largest |kappa1| across the lines near
+/// them: no vertex of the same sign within t, displaced across the first one's line (its offset
+/// along that line's tangent under half its length), is more curved. Parallel lines flank a
+/// crease over a band as wide as t; only the one on the crease is kept (non-maximum suppression,
+/// as an edge detector thins its gradient).
+std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLineVertex*>& vertices,
+                                           double t) {
+  std::vector<Vec3> positions(vertices.size());
+  for (std::size_t i = 0; i < vertices.size(); ++i) positions[i] = vertices[i]->position;
+  std::vector<std::uint8_t> keep(vertices.size(), 1);
+  if (vertices.empty()) return keep;
+  const auto index = makeSpatialIndex(positions);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256), [&](const auto& r) {
+    std::vector<Neighbor> found;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const CurvatureLineVertex& v = *vertices[i];
+      index->radiusSearch(v.position, t, found);
+      for (const Neighbor& nb : found) {
+        const CurvatureLineVertex& u = *vertices[nb.index];
+        if ((u.kappa1 > 0) != (v.kappa1 > 0) || !(std::abs(u.kappa1) > std::abs(v.kappa1)))
+          continue;
+        const Vec3 d = u.position - v.position;
+        if (std::abs(d.dot(v.tangent)) < 0.5 * d.norm()) {
+          keep[i] = 0;
+          break;
+        }
+      }
+    }
+  });
+  return keep;
+}
+
 }  // namespace
 
 void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
@@ -198,15 +230,22 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     summary.lines = lines.lines.size();
     const double bound = std::max((1 - options.salientThreshold) * summary.salientBound,
                                   options.minSalientCurvature / lineOptions.scale);
+    std::vector<const CurvatureLineVertex*> candidates;
     for (const CurvatureLine& line : lines.lines)
       for (const CurvatureLineVertex& v : line.vertices) {
         ++summary.vertices;
-        if (!(std::abs(v.kappa1) > bound)) continue;
-        ++summary.salientVertices;
-        salient.push_back(v.position);
-        salientSign.push_back(v.kappa1 > 0 ? 1 : -1);
-        salientScale.push_back(std::uint8_t(s));
+        if (std::abs(v.kappa1) > bound) candidates.push_back(&v);
       }
+    const std::vector<std::uint8_t> keep = options.ridgeOnly
+                                               ? acrossLineMaxima(candidates, lineOptions.scale)
+                                               : std::vector<std::uint8_t>(candidates.size(), 1);
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      if (!keep[c]) continue;
+      ++summary.salientVertices;
+      salient.push_back(candidates[c]->position);
+      salientSign.push_back(candidates[c]->kappa1 > 0 ? 1 : -1);
+      salientScale.push_back(std::uint8_t(s));
+    }
     result.scales.push_back(summary);
     result.lineSets.push_back(std::move(lines));
   }
