@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/CliTestSupport.hpp"
+#include "features/CubeMesh.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/io/Polylines.hpp"
 
@@ -28,29 +29,8 @@ nlohmann::json readJson(const std::string& path) {
 /// outward: the mesh protocol of Sec. 3.4.1 needs vertices spread along the edges.
 void writeCube(const std::string& path, int n) {
   std::vector<Vec3> vertices;
-  std::vector<std::array<int, 3>> triangles;
-  auto index = [&](const Vec3& p) {
-    for (std::size_t v = 0; v < vertices.size(); ++v)
-      if ((vertices[v] - p).norm() < 1e-9) return int(v);
-    vertices.push_back(p);
-    return int(vertices.size() - 1);
-  };
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      Vec3 u = Vec3::Zero(), v = Vec3::Zero(), o = Vec3::Zero();
-      u[(axis + 1) % 3] = 1.0 / n;
-      v[(axis + 2) % 3] = 1.0 / n;
-      o[axis] = side;
-      if (side == 0) std::swap(u, v);  // outward on both sides
-      if (side == 0) o = Vec3::Zero();
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          const Vec3 p = o + i * u + j * v;
-          const int a = index(p), b = index(p + u), c = index(p + u + v), d = index(p + v);
-          triangles.push_back({a, b, c});
-          triangles.push_back({a, c, d});
-        }
-    }
+  std::vector<std::array<Index, 3>> triangles;
+  test::cubeMesh(n, vertices, triangles);
   std::ofstream out(path);
   out << "OFF\n" << vertices.size() << " " << triangles.size() << " 0\n";
   for (const Vec3& p : vertices) out << p.x() << " " << p.y() << " " << p.z() << "\n";

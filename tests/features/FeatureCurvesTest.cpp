@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "features/CubeMesh.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/features/FeatureCurves.hpp"
 
@@ -174,37 +175,13 @@ TEST(FeatureCurves, SameResultForAnyThreadCount) {
   EXPECT_EQ(one.curveId, many.curveId);
 }
 
-/// The unit cube as a mesh whose faces are n x n grids of squares (two triangles each).
-void cubeMesh(int n, std::vector<Vec3>& vertices, std::vector<std::array<Index, 3>>& triangles) {
-  auto index = [&](const Vec3& p) {
-    for (std::size_t v = 0; v < vertices.size(); ++v)
-      if ((vertices[v] - p).norm() < 1e-9) return Index(v);
-    vertices.push_back(p);
-    return Index(vertices.size() - 1);
-  };
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      Vec3 u = Vec3::Zero(), v = Vec3::Zero(), o = Vec3::Zero();
-      u[(axis + 1) % 3] = 1.0 / n;
-      v[(axis + 2) % 3] = 1.0 / n;
-      o[axis] = side;
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          const Vec3 p = o + i * u + j * v;
-          const Index a = index(p), b = index(p + u), c = index(p + u + v), d = index(p + v);
-          triangles.push_back({a, b, c});
-          triangles.push_back({a, c, d});
-        }
-    }
-}
-
 TEST(FeatureCurves, MeshVerticesAreLabelledOnTheMeshEdges) {
   RectangleSampler s;
   addBox(s, 8000, true);
   const PointCloud cloud = s.cloud();
   std::vector<Vec3> vertices;
   std::vector<std::array<Index, 3>> triangles;
-  cubeMesh(4, vertices, triangles);
+  test::cubeMesh(4, vertices, triangles);
   ASSERT_EQ(vertices.size(), 98u);
   const KnnGraph graph = buildMeshEdgeGraph(vertices.size(), triangles);
   EXPECT_EQ(graph.neighbors.size(), 2 * (3 * triangles.size() / 2));  // each edge in 2 triangles

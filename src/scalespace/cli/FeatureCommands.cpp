@@ -274,14 +274,9 @@ void addFeaturesCommand(CLI::App& app) {
       targets.setRelativePositions(triangles.vertices, Vec3::Zero());
       if (options.spacing == 0) {
         options.spacing = medianEdgeLength(triangles);
-        Vec3 lo = cloud.positions().front(), hi = lo;
-        for (const Vec3& p : cloud.positions()) {
-          lo = lo.cwiseMin(p);
-          hi = hi.cwiseMax(p);
-        }
         // The protocol of Sec. 3.4.1 is made for dense meshes (5k-215k vertices): on a coarse
         // one the scales [e, 3e] are as large as its faces.
-        if (options.spacing > 0.05 * (hi - lo).norm())
+        if (options.spacing > 0.05 * cloud.boundingBoxDiagonal())
           printWarnings({"the mesh is coarse (median edge " + std::to_string(options.spacing) +
                          ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
                          "faces; give a finer --spacing, or remesh it"});

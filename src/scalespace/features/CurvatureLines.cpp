@@ -93,7 +93,6 @@ struct Way {
   std::size_t line = 0;
   int side = 0;  // 0 backward, 1 forward
   std::vector<CurvatureLineVertex> vertices;
-  bool active = true;
   LineStop stop = LineStop::MaxSteps;
 };
 
@@ -178,9 +177,7 @@ std::vector<Index> lineSamples(const std::vector<Vec3>& positions, double alpha,
                                std::uint64_t seed) {
   std::vector<Index> all(positions.size());
   std::iota(all.begin(), all.end(), Index(0));
-  if (alpha <= 0) return all;
-  return poissonDiskSample(positions, all, poissonDiskSeparation(alpha, t),
-                           pyramidLevelSeed(seed, 0));
+  return samplePyramidLevel(positions, all, alpha, t, seed, 0);  // alpha = 0 keeps every point
 }
 
 namespace {
@@ -273,7 +270,7 @@ class LineTracer {
           {seeds[first + s], makeVertex(f, m, m.direction), {ways_.size(), ways_.size() + 1}});
       for (int side = 0; side < 2; ++side) {
         active.push_back(ways_.size());
-        ways_.push_back(Way{id, side, {}, true, LineStop::MaxSteps});
+        ways_.push_back(Way{id, side, {}, LineStop::MaxSteps});
       }
       placed_.insert({id, 0, 0, f.projection});
     }

@@ -13,6 +13,7 @@
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
 
 namespace scalespace {
 
@@ -139,19 +140,11 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
 double meanKthNeighborDistance(const std::vector<Vec3>& positions, int k) {
   require(k >= 1, "meanKthNeighborDistance: k must be >= 1");
   if (positions.size() < 2) return 0;
-  const std::size_t kk = std::min<std::size_t>(std::size_t(k), positions.size() - 1);
   const auto index = makeSpatialIndex(positions);
-  std::vector<double> distance(positions.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024), [&](const auto& r) {
-    std::vector<Neighbor> found;
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      index->knnSearch(positions[i], kk + 1, found);
-      distance[i] = std::sqrt(found.back().distSq);
-    }
-  });
+  const int kk = int(std::min<std::size_t>(std::size_t(k), positions.size() - 1));
   double sum = 0;  // in index order: the same for any thread count
-  for (const double d : distance) sum += d;
-  return sum / double(distance.size());
+  for (const double d : knnRadii(positions, *index, kk)) sum += d;
+  return sum / double(positions.size());
 }
 
 KnnGraph buildMeshEdgeGraph(std::size_t vertexCount,
