@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "scalespace/cli/CylinderCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
@@ -106,7 +107,8 @@ void checkOutput(const std::string& output, OutputKind kind,
                         ": choose another output (inputs are never overwritten)");
   }
   const std::string ext = lowerExtension(output);
-  const bool isFolder = kind == OutputKind::Stack || kind == OutputKind::PlanesResult;
+  const bool isFolder = kind == OutputKind::Stack || kind == OutputKind::PlanesResult ||
+                        kind == OutputKind::CylindersResult;
   switch (kind) {
     case OutputKind::Cloud: {
       const char* const writable = "write .ply, .xyz, .txt, .csv, .pts, .las or .pcd";
@@ -138,6 +140,9 @@ void checkOutput(const std::string& output, OutputKind kind,
       break;
     case OutputKind::PlanesResult:
       checkPlaneResultDestination(output);
+      break;
+    case OutputKind::CylindersResult:
+      checkCylinderResultDestination(output);
       break;
   }
   if (!isFolder && fs::is_directory(output, ec))

@@ -29,12 +29,13 @@ void ensureNormals(PointCloud& cloud, bool quiet);
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {
-  Cloud,         // a point cloud in a writable format (.ply .xyz .txt .csv .pts .las .pcd)
-  Png,           // an image (.png)
-  Csv,           // a table (.csv)
-  Stack,         // a scale stack folder: replaces only an earlier stack
-  PlanesResult,  // the planes' folder: new, empty, or an earlier result
-  Lines          // polylines (.ply with edges, .obj)
+  Cloud,           // a point cloud in a writable format (.ply .xyz .txt .csv .pts .las .pcd)
+  Png,             // an image (.png)
+  Csv,             // a table (.csv)
+  Stack,           // a scale stack folder: replaces only an earlier stack
+  PlanesResult,    // the planes' folder: new, empty, or an earlier result
+  Lines,           // polylines (.ply with edges, .obj)
+  CylindersResult  // the cylinders' folder: new, empty, or an earlier result
 };
 
 /// Checks an output before any work, so that a long run never fails at its end: the output is

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/CylinderCommands.hpp"
 #include "scalespace/cli/FeatureCommands.hpp"
 #include "scalespace/cli/PlanesCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
@@ -15,6 +16,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/PipeScene.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/fit/FitDiagnosis.hpp"
@@ -86,6 +88,7 @@ void addGenerateCommand(CLI::App& app) {
     GenerateOptions options;
     double normalNoise = 0;
     bool absoluteNoise = false;
+    bool oneSided = false;
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -93,10 +96,11 @@ void addGenerateCommand(CLI::App& app) {
       "generate",
       "sample an analytic surface (exact normals and curvatures as columns) or a "
       "piecewise-planar scene (Table 2.1's, or house / yard in metres; face labels as gt_face, "
-      "house / yard also group labels as gt_group)");
+      "house / yard also group labels as gt_group), or the pipe rack of the cylinders (pipe labels "
+      "as gt_pipe, elbow parts and cable strands as gt_part)");
   cmd->add_option("shape", args->shape,
                   "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | "
-                  "house | yard")
+                  "house | yard | pipes")
       ->required();
   cmd->add_option("-n,--points", args->options.pointCount, "number of points")
       ->capture_default_str();
@@ -106,6 +110,8 @@ void addGenerateCommand(CLI::App& app) {
   cmd->add_option("--normal-noise", args->normalNoise,
                   "analytic shapes: normal rotation noise sigma in degrees (Sec. 1.4.3)");
   cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
+  cmd->add_flag("--one-sided", args->oneSided,
+                "pipes: keep what a scanner above the rack sees (each pipe a half-pipe)");
   cmd->add_option("-o,--output", args->output, "output cloud (.ply .xyz .pcd .las)")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
@@ -113,8 +119,17 @@ void addGenerateCommand(CLI::App& app) {
     if (args->options.pointCount == 0) throw OptionError("--points must be >= 1");
     if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
     checkOutput(args->output, OutputKind::Cloud, {});
+    if (args->oneSided && args->shape != "pipes")
+      throw OptionError("--one-sided applies to the pipes scene only");
     PointCloud cloud;
-    if (!generateScene(args->shape, args->options, cloud)) {
+    if (args->shape == "pipes") {
+      PipeSceneOptions o;
+      o.pointCount = args->options.pointCount;
+      o.noise = args->options.noise;
+      o.seed = args->options.seed;
+      o.oneSided = args->oneSided;
+      cloud = generatePipeScene(o);
+    } else if (!generateScene(args->shape, args->options, cloud)) {
       SurfaceSampleOptions o;
       o.shape = parseSurfaceShape(args->shape);  // OptionError names the accepted shapes
       o.count = args->options.pointCount;
@@ -332,6 +347,7 @@ void addCloudCommands(CLI::App& app) {
   addScalesCommands(app);
   addPlanesCommands(app);
   addFeatureCommands(app);
+  addCylinderCommands(app);
 }
 
 }  // namespace scalespace::cli

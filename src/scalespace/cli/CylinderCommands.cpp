@@ -1,0 +1,263 @@
+#include "scalespace/cli/CylinderCommands.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/ProgressBar.hpp"
+#include "scalespace/core/Error.hpp"
+#include "scalespace/features/CylinderDetection.hpp"
+#include "scalespace/io/AtomicFile.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
+
+namespace scalespace::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+// The marker that tells our folder from a user's: components.json names the result.
+constexpr const char* kResultTag = "\"result\":\"cylinders\"";
+
+bool isCylinderResult(const std::string& directory) {
+  std::ifstream in(fs::path(directory) / "components.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  return in && text.str().find(kResultTag) != std::string::npos;
+}
+
+nlohmann::json point(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+
+// The axes of the components (their representative tubes) as polylines with the radius profile.
+PolylineSet axesOf(const CylinderDetection& detection, const Vec3& origin) {
+  PolylineSet out;
+  std::vector<Vec3> positions;
+  std::vector<double> ids, radii;
+  for (const CylinderComponent& c : detection.components) {
+    if (c.tube.axis.size() < 2) continue;
+    for (std::size_t k = 0; k < c.tube.axis.size(); ++k) {
+      positions.push_back(c.tube.axis[k]);
+      ids.push_back(c.id);
+      radii.push_back(c.tube.radii[k]);
+    }
+    out.offsets.push_back(positions.size());
+  }
+  out.vertices.setRelativePositions(std::move(positions), origin);
+  out.vertices.addAttribute("component", ScalarType::Int32).values = std::move(ids);
+  out.vertices.addAttribute("radius", ScalarType::Float32).values = std::move(radii);
+  return out;
+}
+
+void writeComponentsCsv(const CylinderDetection& detection, const Vec3& origin,
+                        const std::string& path) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "id,birth_level,birth_scale,death_level,death_scale,persistence,representative_scale,"
+           "point_count,straight,radius,radius_start,radius_end,rms,length,arc_degrees,dx,dy,dz,"
+           "cx,cy,cz\n";
+    out.precision(9);
+    for (const CylinderComponent& c : detection.components) {
+      const TubeFit& t = c.tube;
+      const Vec3 centre = t.centre + origin;
+      out << c.id << ',' << c.birthLevel << ',' << c.birthScale << ',' << c.deathLevel << ','
+          << c.deathScale << ',' << c.persistence << ','
+          << detection.levels[std::size_t(c.representativeLevel)].scale << ',' << t.pointCount
+          << ',' << (t.straight ? 1 : 0) << ',' << t.radius << ',' << t.radii.front() << ','
+          << t.radii.back() << ',' << t.rms << ',' << t.length << ',' << t.arcDegrees << ','
+          << t.direction.x() << ',' << t.direction.y() << ',' << t.direction.z() << ','
+          << centre.x() << ',' << centre.y() << ',' << centre.z() << '\n';
+    }
+  });
+}
+
+nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& origin) {
+  nlohmann::json components = nlohmann::json::array();
+  for (const CylinderComponent& c : detection.components) {
+    const TubeFit& t = c.tube;
+    nlohmann::json axis = nlohmann::json::array();
+    for (const Vec3& p : t.axis) axis.push_back(point(p + origin));
+    components.push_back({{"id", c.id},
+                          {"birth_level", c.birthLevel},
+                          {"birth_scale", c.birthScale},
+                          {"death_level", c.deathLevel},
+                          {"death_scale", c.deathScale},
+                          {"persistence", c.persistence},
+                          {"representative_level", c.representativeLevel},
+                          {"point_count", t.pointCount},
+                          {"straight", t.straight},
+                          {"radius", t.radius},
+                          {"rms", t.rms},
+                          {"length", t.length},
+                          {"arc_degrees", t.arcDegrees},
+                          {"direction", point(t.direction)},
+                          {"centre", point(t.centre + origin)},
+                          {"axis", axis},
+                          {"radii", t.radii}});
+  }
+  return components;
+}
+
+void addCylindersCommand(CLI::App& app) {
+  struct Args {
+    InputOptions input;
+    std::string output;
+    CylinderOptions cylinders;
+    double scale = 0;
+    int minPersistence = 0;
+    bool ascii = false, quiet = false;
+    int threads = 0;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "cylinders",
+      "cylinders across scales (Sec. 3.5): regular minimal-curvature lines, their anisotropy, "
+      "region growing, a tube per region (curved axis, radius profile), linked across scales "
+      "into persistent components");
+  cmd->add_option("input", args->input.path, "input point cloud (oriented normals, or estimated)")
+      ->required();
+  cmd->add_flag("--drop-invalid", args->input.dropInvalid,
+                "skip points with NaN/Inf coordinates instead of failing");
+  cmd->add_option("-o,--output", args->output,
+                  "output folder: cloud.ply (cylinder_id, anisotropy), components.json / .csv, "
+                  "axes.ply")
+      ->required();
+  cmd->add_option("--scales", args->cylinders.scaleCount, "number of log-spaced scales")
+      ->capture_default_str();
+  cmd->add_option("--tmin", args->cylinders.tMin,
+                  "smallest scale (0: twice the median distance to the 10th neighbour)")
+      ->capture_default_str();
+  cmd->add_option("--tmax", args->cylinders.tMax, "largest scale (0: a tenth of the diagonal)")
+      ->capture_default_str();
+  cmd->add_option("--scale", args->scale,
+                  "label the points with the components at the scale nearest to this (default: "
+                  "the most persistent component holding each point)");
+  cmd->add_option("--min-persistence", args->minPersistence,
+                  "label only components living at least this many scale steps")
+      ->capture_default_str();
+  cmd->add_option("--epsilon", args->cylinders.epsilon,
+                  "region growing tolerance of Eq. 3.10 on anisotropy, directions and normals")
+      ->capture_default_str();
+  cmd->add_option("--min-anisotropy", args->cylinders.minAnisotropy,
+                  "points join regions only with at least this line anisotropy")
+      ->capture_default_str();
+  cmd->add_option("--min-arc", args->cylinders.tube.minArcDegrees,
+                  "a tube's points' normals must turn at least this much around its axis")
+      ->capture_default_str();
+  cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
+                  "a tube's RMS distance to its surface is at most this x its radius")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
+  cmd->callback([args] {
+    const auto start = Clock::now();
+    ThreadScope threads(args->threads);
+    validateCylinderOptions(args->cylinders);
+    if (args->scale != 0 && !(args->scale > 0 && std::isfinite(args->scale)))
+      throw OptionError("--scale must be finite and > 0");
+    if (args->minPersistence < 0) throw OptionError("--min-persistence must be >= 0");
+    checkOutput(args->output, OutputKind::CylindersResult, {args->input.path});
+    PointCloud cloud = loadCloud(args->input, args->quiet);
+    ensureNormals(cloud, args->quiet);
+    const CylinderDetection detection =
+        detectCylinders(cloud, args->cylinders, makeProgressBar(args->quiet));
+
+    int level = -1;
+    std::vector<int> labels;
+    if (args->scale > 0) {
+      level = nearestCylinderLevel(detection, args->scale);
+      labels = cylinderLabelsAtLevel(detection, level, args->minPersistence);
+    } else {
+      labels = cylinderLabelsByPersistence(detection, args->minPersistence);
+    }
+    // Anisotropy at the chosen scale, or the largest over the scales; -1 where no line passed.
+    std::vector<double> anisotropy(cloud.size(), -1.0);
+    for (int j = 0; j < detection.scaleCount(); ++j) {
+      if (level >= 0 && j != level) continue;
+      const std::vector<float>& sigma = detection.levels[std::size_t(j)].anisotropy;
+      for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (std::isfinite(sigma[i])) anisotropy[i] = std::max(anisotropy[i], double(sigma[i]));
+    }
+    std::size_t labelled = 0;
+    AttributeColumn& ids = cloud.addAttribute("cylinder_id", ScalarType::Int32);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      ids.values[i] = labels[i];
+      labelled += labels[i] >= 0;
+    }
+    cloud.addAttribute("anisotropy", ScalarType::Float32).values = std::move(anisotropy);
+
+    std::error_code ec;
+    fs::create_directories(args->output, ec);
+    if (ec) throw FileError(args->output, "", "cannot create the folder: " + ec.message());
+    const fs::path dir(args->output);
+    writeCloud(cloud, (dir / "cloud.ply").string(), WriteOptions{args->ascii});
+    writePolylines(axesOf(detection, cloud.origin()), (dir / "axes.ply").string(),
+                   WriteOptions{args->ascii});
+    writeComponentsCsv(detection, cloud.origin(), (dir / "components.csv").string());
+    nlohmann::json levels = nlohmann::json::array();
+    for (const CylinderLevel& l : detection.levels)
+      levels.push_back({{"scale", l.scale},
+                        {"lines", l.lines},
+                        {"regular_lines", l.regularLines},
+                        {"regions", l.regions},
+                        {"tubes", l.tubes.size()},
+                        {"seconds", l.seconds}});
+    const CylinderOptions& o = args->cylinders;
+    const nlohmann::json json = {
+        {"result", "cylinders"},
+        {"version", SCALESPACE_VERSION},
+        {"input", args->input.path},
+        {"point_count", cloud.size()},
+        {"labels",
+         {{"scale", level >= 0 ? nlohmann::json(detection.levels[std::size_t(level)].scale)
+                               : nlohmann::json("most persistent")},
+          {"min_persistence", args->minPersistence},
+          {"labelled_points", labelled}}},
+        {"parameters",
+         {{"epsilon", o.epsilon},
+          {"min_anisotropy", o.minAnisotropy},
+          {"min_length_factor", o.filter.minLengthFactor},
+          {"max_curvature_factor", o.filter.maxCurvatureFactor},
+          {"max_mean_variation", o.filter.maxMeanVariation},
+          {"min_arc_degrees", o.tube.minArcDegrees},
+          {"max_relative_rms", o.tube.maxRelativeRms},
+          {"threads", args->threads}}},
+        {"levels", levels},
+        {"components", componentsJson(detection, cloud.origin())},
+        {"seconds", detection.seconds}};
+    // Compact: the tag is then found as written (isCylinderResult).
+    const std::string text = json.dump();
+    writeFileAtomically((dir / "components.json").string(),
+                        [&](std::ostream& out) { out << text << '\n'; });
+    if (!args->quiet)
+      std::fprintf(stderr,
+                   "cylinders: %zu components over %d scales, %zu of %zu points labelled -> %s\n",
+                   detection.components.size(), detection.scaleCount(), labelled, cloud.size(),
+                   args->output.c_str());
+    reportDone("cylinders", start, args->quiet);
+  });
+}
+
+}  // namespace
+
+void checkCylinderResultDestination(const std::string& directory) {
+  std::error_code ec;
+  if (!fs::exists(directory, ec)) return;
+  if (!fs::is_directory(directory, ec))
+    throw FileError(directory, "", "exists and is not a folder",
+                    "choose another output folder for the cylinders");
+  if (!fs::is_empty(directory, ec) && !isCylinderResult(directory))
+    throw FileError(directory, "",
+                    "is a folder that holds other files and no cylinders result: refusing to "
+                    "write into it",
+                    "choose a new or empty output folder");
+}
+
+void addCylinderCommands(CLI::App& app) { addCylindersCommand(app); }
+
+}  // namespace scalespace::cli

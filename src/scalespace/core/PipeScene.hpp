@@ -1,0 +1,51 @@
+#pragma once
+// A pipe-rack scene in metres with ground truth, for the cylinders of Sec. 3.5: tubes of radii
+// 0.03 to 0.35 m (ratio > 10), a bent pipe (straight, a 90-degree elbow of torus, straight), a
+// tapering pipe (cone), a cable of three strands twisted around a common axis (three thin tubes
+// at a small scale, one thick tube at a large one), and what must not become a cylinder: a floor,
+// a wall and a box standing on the floor. Sampled uniformly by area with exact outward normals.
+//
+// Columns: "gt_pipe" (int32: PipeTruth::id, -1 on the floor, wall and box) and "gt_part" (int32:
+// for the bent pipe 0 / 1 / 2 = first straight / elbow / second straight, for the cable the strand
+// 0..2, else -1).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scalespace/core/PointCloud.hpp"
+
+namespace scalespace {
+
+struct PipeSceneOptions {
+  std::size_t pointCount = 200000;
+  /// Standard deviation of the isotropic Gaussian positional noise as a fraction of the
+  /// bounding-box diagonal (about 6.7 m).
+  double noise = 0.0;
+  std::uint64_t seed = 1;
+  /// Keep only what a scanner above and in front of the rack sees (normals facing
+  /// oneSidedView): every pipe is seen from one side, a half-pipe (no occlusion is modelled).
+  bool oneSided = false;
+  Vec3 oneSidedView{0.3, -0.5, 1.0};
+};
+
+enum class PipeKind { Straight, Bent, Tapering, Cable };
+
+/// A pipe of the scene, for scoring.
+struct PipeTruth {
+  int id = 0;
+  std::string name;
+  PipeKind kind = PipeKind::Straight;
+  double radius = 0;        // Straight, Bent, Cable (envelope: strand radius + helix radius)
+  double radiusEnd = 0;     // Tapering: radius at the far end (radius at axisPoint)
+  double strandRadius = 0;  // Cable
+  Vec3 axisPoint = Vec3::Zero(), axisDirection = Vec3::UnitX();  // Straight, Tapering, Cable
+  double length = 0;                                             // along the axis
+};
+
+/// The pipes of the scene, by id.
+std::vector<PipeTruth> pipeSceneTruth();
+
+/// Throws OptionError for a zero point count or negative noise.
+PointCloud generatePipeScene(const PipeSceneOptions& options = {});
+
+}  // namespace scalespace

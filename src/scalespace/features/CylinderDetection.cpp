@@ -1,0 +1,253 @@
+#include "scalespace/features/CylinderDetection.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <string>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/core/RegionGrower.hpp"
+#include "scalespace/features/LineAnisotropy.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
+
+namespace scalespace {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Eq. 3.10 as the region grower's criterion: a neighbour joins when its anisotropy, line
+/// direction (unsigned) and normal are all within epsilon of the point it is reached from.
+struct AlignedLines {
+  struct Payload {
+    float normal[3], direction[3], sigma;
+  };
+  const LineAnisotropyField& field;
+  float epsilon;
+  Payload payload(Index i) const {
+    const Vec3& n = field.normal[i];
+    const Vec3& v = field.direction[i];
+    return {{float(n.x()), float(n.y()), float(n.z())},
+            {float(v.x()), float(v.y()), float(v.z())},
+            field.sigma[i]};
+  }
+  bool accept(const Payload&, const Payload& from, const Payload& to) const {
+    const float vv = from.direction[0] * to.direction[0] + from.direction[1] * to.direction[1] +
+                     from.direction[2] * to.direction[2];
+    const float nn = from.normal[0] * to.normal[0] + from.normal[1] * to.normal[1] +
+                     from.normal[2] * to.normal[2];
+    return std::abs(from.sigma - to.sigma) < epsilon && std::abs(vv) > 1 - epsilon &&
+           nn > 1 - epsilon;
+  }
+};
+
+std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
+                                  const CylinderOptions& options) {
+  if (!options.scales.empty()) return options.scales;
+  double tMin = options.tMin, tMax = options.tMax;
+  if (tMin == 0) {
+    if (graph.kthDistance.empty())
+      throw OptionError(
+          "the cloud has too few points (<= CylinderOptions::graphNeighbors) for the automatic "
+          "CylinderOptions::tMin");
+    tMin = 2 * lowerMedian(graph.kthDistance);
+  }
+  if (tMax == 0) tMax = cloud.boundingBoxDiagonal() / 10;
+  if (!(tMax > tMin))
+    throw OptionError("CylinderOptions::tMax (" + std::to_string(tMax) +
+                      ") must be > CylinderOptions::tMin (" + std::to_string(tMin) + ")");
+  return scaleSeries(tMin, tMax, options.scaleCount, ScaleSpacing::Log);
+}
+
+}  // namespace
+
+void validateCylinderOptions(const CylinderOptions& options) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw OptionError(message);
+  };
+  for (std::size_t k = 0; k < options.scales.size(); ++k) {
+    require(std::isfinite(options.scales[k]) && options.scales[k] > 0,
+            "CylinderOptions::scales must be finite and > 0");
+    require(k == 0 || options.scales[k] > options.scales[k - 1],
+            "CylinderOptions::scales must be increasing");
+  }
+  require(options.scaleCount >= 1 && options.scaleCount <= 1000,
+          "CylinderOptions::scaleCount must be in [1, 1000]");
+  require(std::isfinite(options.tMin) && options.tMin >= 0,
+          "CylinderOptions::tMin must be finite and >= 0");
+  require(std::isfinite(options.tMax) && options.tMax >= 0,
+          "CylinderOptions::tMax must be finite and >= 0");
+  require(options.epsilon > 0 && options.epsilon < 1, "CylinderOptions::epsilon must be in (0, 1)");
+  require(options.minAnisotropy >= 0 && options.minAnisotropy <= 1,
+          "CylinderOptions::minAnisotropy must be in [0, 1]");
+  require(options.graphNeighbors >= 1 && options.graphNeighbors <= 100,
+          "CylinderOptions::graphNeighbors must be in [1, 100]");
+  require(options.minJaccard >= 0.5 && options.minJaccard < 1,
+          "CylinderOptions::minJaccard must be in [0.5, 1)");
+  validateLineFilterOptions(options.filter);
+  validateTubeFitOptions(options.tube);
+  CurvatureLineOptions lines = options.lines;
+  lines.scale = 1;  // set per level
+  validateCurvatureLineOptions(lines);
+}
+
+CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions& options,
+                                  const ProgressCallback& progress) {
+  validateCylinderOptions(options);
+  if (!cloud.hasNormals())
+    throw OptionError("cylinders need oriented normals (estimate them first)");
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Vec3>& positions = cloud.positions();
+  const std::size_t n = positions.size();
+  if (progress && !progress(0, "k-NN graph")) throw Cancelled();
+  const KnnGraph graph = buildKnnGraph(positions, std::size_t(options.graphNeighbors));
+  const std::vector<double> scales = resolveScales(cloud, graph, options);
+  const int count = int(scales.size());
+
+  CylinderDetection result;
+  std::vector<RegionLevel> regionLevels;
+  for (int s = 0; s < count; ++s) {
+    const auto levelStart = std::chrono::steady_clock::now();
+    const double t = scales[std::size_t(s)];
+    const std::string stage = "cylinders t=" + std::to_string(t);
+    auto sub = [&](double from, double to) -> ProgressCallback {
+      if (!progress) return {};
+      return [&progress, &stage, s, count, from, to](double f, std::string_view) {
+        return progress((s + from + (to - from) * std::min(f, 1.0)) / count, stage);
+      };
+    };
+    CurvatureLineOptions lineOptions = options.lines;
+    lineOptions.scale = t;
+    const CurvatureLineSet lines = traceCurvatureLines(cloud, lineOptions, sub(0, 0.7));
+    std::vector<const CurvatureLine*> regular;
+    for (const CurvatureLine& line : lines.lines)
+      if (isRegularLine(line, t, options.filter)) regular.push_back(&line);
+    const LineAnisotropyField field = lineAnisotropy(positions, regular, t, sub(0.7, 0.9));
+
+    std::vector<std::uint8_t> eligible(n, 0);
+    for (std::size_t i = 0; i < n; ++i) eligible[i] = field.sigma[i] >= options.minAnisotropy;
+    std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
+      return eligible[i] ? -double(field.sigma[i]) : std::numeric_limits<double>::quiet_NaN();
+    });
+    Segmentation seg = growRegionsFromSeeds(graph, std::move(seeds), eligible,
+                                            AlignedLines{field, float(options.epsilon)});
+    std::vector<TubeFit> tubes(seg.regions.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seg.regions.size(), 1),
+                      [&](const auto& range) {
+                        for (std::size_t r = range.begin(); r != range.end(); ++r)
+                          tubes[r] = fitTube(positions, cloud.normals(), field.normal, field.kappa1,
+                                             seg.regions[r], t, options.tube);
+                      });
+    CylinderLevel level;
+    level.scale = t;
+    level.lines = lines.lines.size();
+    level.regularLines = regular.size();
+    level.regions = seg.regions.size();
+    RegionLevel regionLevel;
+    regionLevel.t = t;
+    for (std::size_t r = 0; r < tubes.size(); ++r) {
+      if (std::getenv("SS_DEBUG") && tubes[r].pointCount >= 500) {
+        Vec3 c = Vec3::Zero();
+        for (Index i : seg.regions[r]) c += positions[i];
+        c /= double(seg.regions[r].size());
+        std::fprintf(
+            stderr,
+            "t=%.3f region %zu n=%zu %s straight=%d r=%.4f rms=%.4f arc=%.0f c=(%.2f %.2f %.2f)\n",
+            t, r, tubes[r].pointCount, tubeRejectionName(tubes[r].rejection),
+            int(tubes[r].straight), tubes[r].radius, tubes[r].rms, tubes[r].arcDegrees, c.x(),
+            c.y(), c.z());
+      }
+    }
+    for (std::size_t r = 0; r < tubes.size(); ++r)
+      if (tubes[r].isTube()) {
+        regionLevel.regions.push_back(std::move(seg.regions[r]));
+        level.tubes.push_back(std::move(tubes[r]));
+      }
+    level.anisotropy = field.sigma;
+    level.seconds = secondsSince(levelStart);
+    result.levels.push_back(std::move(level));
+    regionLevels.push_back(std::move(regionLevel));
+    if (progress && !progress(double(s + 1) / count, stage)) throw Cancelled();
+  }
+
+  result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard);
+  for (std::size_t c = 0; c < result.graph.components.size(); ++c) {
+    const GraphComponent& g = result.graph.components[c];
+    CylinderComponent component;
+    component.id = int(c);
+    component.birthLevel = g.birthLevel;
+    component.deathLevel = g.deathLevel;
+    component.birthScale = g.birthScale;
+    component.deathScale = g.deathScale;
+    component.persistence = g.persistence();
+    std::size_t most = 0;
+    for (std::size_t k = 0; k < g.regionAt.size(); ++k) {
+      const int level = g.birthLevel + int(k);
+      const std::size_t size =
+          result.graph.levels[std::size_t(level)].regions[std::size_t(g.regionAt[k])].size();
+      if (size > most) {
+        most = size;
+        component.representativeLevel = level;
+        component.tube = result.levels[std::size_t(level)].tubes[std::size_t(g.regionAt[k])];
+      }
+    }
+    result.components.push_back(std::move(component));
+  }
+  result.seconds = secondsSince(start);
+  return result;
+}
+
+int nearestCylinderLevel(const CylinderDetection& detection, double t) {
+  if (detection.levels.empty()) throw OptionError("the detection has no scales");
+  if (!(t > 0) || !std::isfinite(t)) throw OptionError("the scale must be finite and > 0");
+  int best = 0;
+  for (int j = 1; j < detection.scaleCount(); ++j)
+    if (std::abs(std::log(detection.levels[std::size_t(j)].scale / t)) <
+        std::abs(std::log(detection.levels[std::size_t(best)].scale / t)))
+      best = j;
+  return best;
+}
+
+std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int level,
+                                       int minPersistence) {
+  if (level < 0 || level >= detection.scaleCount())
+    throw OptionError("level " + std::to_string(level) + " is outside [0, " +
+                      std::to_string(detection.scaleCount()) + ")");
+  std::vector<int> labels = detection.graph.componentLabels(level);
+  for (int& label : labels)
+    if (label >= 0 && detection.components[std::size_t(label)].persistence < minPersistence)
+      label = -1;
+  return labels;
+}
+
+std::vector<int> cylinderLabelsByPersistence(const CylinderDetection& detection,
+                                             int minPersistence) {
+  std::vector<int> labels(detection.graph.pointCount, -1);
+  const auto& components = detection.components;
+  auto better = [&](int a, int b) {  // a beats the current b
+    if (b < 0) return true;
+    const int pa = components[std::size_t(a)].persistence,
+              pb = components[std::size_t(b)].persistence;
+    return pa > pb || (pa == pb && a < b);
+  };
+  for (int level = 0; level < detection.scaleCount(); ++level) {
+    const auto& regions = detection.graph.levels[std::size_t(level)].regions;
+    for (std::size_t r = 0; r < regions.size(); ++r) {
+      const int c = detection.graph.componentOf[std::size_t(level)][r];
+      if (components[std::size_t(c)].persistence < minPersistence) continue;
+      for (const Index i : regions[r])
+        if (better(c, labels[i])) labels[i] = c;
+    }
+  }
+  return labels;
+}
+
+}  // namespace scalespace

@@ -1,0 +1,89 @@
+#pragma once
+// Cylinders across scales (Sec. 3.5, and its future work of Sec. 3.6). At each scale t:
+//   1. minimal-curvature lines (features/CurvatureLines), kept when regular (features/
+//      LineRegularity, Eq. 3.5-3.7);
+//   2. per point the linear anisotropy sigma of the nearby line tangents (features/LineAnisotropy,
+//      Eq. 3.8-3.9);
+//   3. regions grown on the k-NN graph (core/RegionGrower) between neighbours with
+//      |sigma_i - sigma_j| < eps, |v_i . v_j| > 1 - eps and n_i . n_j > 1 - eps (Eq. 3.10), from
+//      every point with sigma >= minAnisotropy (not in the thesis, which grows from every point:
+//      without it the isotropic rest of the cloud forms regions too), most anisotropic first;
+//   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped.
+// Then, as the planes of Ch. 2, the tubes of consecutive scales with Jaccard index > 0.5 are
+// linked into components with a birth and a death scale (core/RegionGraph).
+#include <vector>
+
+#include "scalespace/core/PointCloud.hpp"
+#include "scalespace/core/Progress.hpp"
+#include "scalespace/core/RegionGraph.hpp"
+#include "scalespace/features/CurvatureLines.hpp"
+#include "scalespace/features/LineRegularity.hpp"
+#include "scalespace/features/TubeFit.hpp"
+
+namespace scalespace {
+
+struct CylinderOptions {
+  /// The scales, increasing. Empty: scaleCount log-spaced scales in [tMin, tMax].
+  std::vector<double> scales;
+  int scaleCount = 8;
+  /// 0: twice the median distance to the 10th nearest neighbour (the finest scale whose fits hold
+  /// ~40 points) and a tenth of the bounding-box diagonal.
+  double tMin = 0, tMax = 0;
+  CurvatureLineOptions lines;  // scale set per level
+  LineFilterOptions filter;
+  double epsilon = 0.1;        // Eq. 3.10
+  double minAnisotropy = 0.5;  // sigma of a region's points
+  int graphNeighbors = 10;     // k of the k-NN graph (Sec. 2.3.1's 10)
+  TubeFitOptions tube;
+  double minJaccard = 0.5;  // Sec. 2.3.2
+};
+
+/// OptionError naming the field unless the options can run.
+void validateCylinderOptions(const CylinderOptions& options);
+
+struct CylinderLevel {
+  double scale = 0;
+  std::size_t lines = 0, regularLines = 0, regions = 0;
+  /// The tubes of this level, same order as the graph's regions at this level.
+  std::vector<TubeFit> tubes;
+  std::vector<float> anisotropy;  // per point, NaN where no regular line passes within t
+  double seconds = 0;
+};
+
+struct CylinderComponent {
+  int id = 0;
+  int birthLevel = 0, deathLevel = 0;
+  double birthScale = 0, deathScale = 0;
+  int persistence = 0;
+  /// The level where the component holds the most points (lowest on ties): its tube is reported.
+  int representativeLevel = 0;
+  TubeFit tube;
+};
+
+struct CylinderDetection {
+  std::vector<CylinderLevel> levels;
+  RegionGraph graph;                          // regions = the tubes' points, per level
+  std::vector<CylinderComponent> components;  // same ids as graph.components
+  double seconds = 0;
+  int scaleCount() const { return int(levels.size()); }
+};
+
+/// Runs the pipeline on a cloud with oriented normals. Throws OptionError on bad options or a
+/// cloud without normals, Cancelled on request. Parallel; the result does not depend on the thread
+/// count.
+CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions& options,
+                                  const ProgressCallback& progress = {});
+
+/// The level whose scale is nearest to t on a log scale.
+int nearestCylinderLevel(const CylinderDetection& detection, double t);
+
+/// Per point, the component holding it at `level` if its persistence is >= minPersistence, else -1.
+std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int level,
+                                       int minPersistence = 0);
+
+/// Per point, the most persistent component (lower id on ties) with persistence >= minPersistence
+/// holding it at any level, or -1 (Sec. 2.4.1's query for planes).
+std::vector<int> cylinderLabelsByPersistence(const CylinderDetection& detection,
+                                             int minPersistence = 0);
+
+}  // namespace scalespace

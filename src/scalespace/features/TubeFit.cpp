@@ -1,0 +1,362 @@
+#include "scalespace/features/TubeFit.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "scalespace/core/Error.hpp"
+
+namespace scalespace {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Vec3 anyPerpendicular(const Vec3& d) {
+  return (std::abs(d.x()) < 0.9 ? d.cross(Vec3::UnitX()) : d.cross(Vec3::UnitY())).normalized();
+}
+
+// The straight axis: direction, centre and radius. False when the normals do not turn around
+// any axis (all parallel: a plane).
+bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& scaleNormals,
+                     const std::vector<Index>& points, TubeFit& fit) {
+  const double n = double(points.size());
+  Mat3 spread = Mat3::Zero();
+  Vec3 centroid = Vec3::Zero();
+  for (const Index i : points) {
+    spread += scaleNormals[i] * scaleNormals[i].transpose();
+    centroid += positions[i];
+  }
+  centroid /= n;
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(spread);
+  const Vec3 a = eig.eigenvectors().col(0).normalized();
+  // The centre nearest to every normal line x_i + s n_i, in the plane normal to a: with u_i the
+  // in-plane direction across the normal, minimise sum ((c - x_i) . u_i)^2, the component of c
+  // along a pinned to the centroid's.
+  Mat3 lhs = n * a * a.transpose();
+  Vec3 rhs = n * a * a.dot(centroid);
+  for (const Index i : points) {
+    const Vec3 m = scaleNormals[i] - scaleNormals[i].dot(a) * a;
+    if (m.squaredNorm() < 1e-12) continue;
+    const Vec3 u = a.cross(m).normalized();
+    lhs += u * u.transpose();
+    rhs += u * u.dot(positions[i]);
+  }
+  // Parallel normals leave the in-plane part of lhs with rank <= 1.
+  const Eigen::SelfAdjointEigenSolver<Mat3> check(lhs - n * a * a.transpose());
+  if (!(check.eigenvalues()[1] > 1e-3 * n)) return false;
+  Vec3 c = lhs.ldlt().solve(rhs);
+  // Geometric circle fit in the plane normal to a (Gauss-Newton on |p - c| - r), from there.
+  const Vec3 e1 = anyPerpendicular(a), e2 = a.cross(e1);
+  Eigen::Vector2d centre(e1.dot(c), e2.dot(c));
+  std::vector<Eigen::Vector2d> flat;
+  flat.reserve(points.size());
+  for (const Index i : points) flat.emplace_back(e1.dot(positions[i]), e2.dot(positions[i]));
+  double r = 0;
+  for (const auto& p : flat) r += (p - centre).norm();
+  r /= n;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (const auto& p : flat) {
+      const Eigen::Vector2d d = p - centre;
+      const double len = d.norm();
+      if (len == 0) continue;
+      const Eigen::Vector3d j(-d.x() / len, -d.y() / len, -1);
+      jtj += j * j.transpose();
+      jtr += j * (len - r);
+    }
+    const Eigen::Vector3d step = jtj.ldlt().solve(-jtr);
+    if (!step.allFinite()) break;
+    centre += step.head<2>();
+    r += step.z();
+    if (step.norm() < 1e-9 * (1 + r)) break;
+  }
+  fit.direction = a;
+  fit.centre = centre.x() * e1 + centre.y() * e2 + a.dot(centroid) * a;
+  fit.straightRadius = std::abs(r);
+  return std::isfinite(fit.straightRadius);
+}
+
+// The curved axis: axis points x - n / kappa1 averaged in cells of size h, chained along the
+// longest path of their minimum spanning tree.
+std::vector<Vec3> curvedAxis(const std::vector<Vec3>& positions,
+                             const std::vector<Vec3>& scaleNormals,
+                             const std::vector<float>& kappa1, const std::vector<Index>& points,
+                             double h) {
+  std::vector<Vec3> proposals;
+  proposals.reserve(points.size());
+  for (const Index i : points)
+    if (kappa1[i] != 0) proposals.push_back(positions[i] - scaleNormals[i] / double(kappa1[i]));
+  std::vector<Vec3> nodes;
+  for (;; h *= 2) {
+    std::vector<std::pair<std::int64_t, std::size_t>> keyed;
+    keyed.reserve(proposals.size());
+    for (std::size_t k = 0; k < proposals.size(); ++k) {
+      const Vec3& p = proposals[k];
+      const auto cell = [&](double v) { return std::int64_t(std::floor(v / h)) & 0x1fffff; };
+      keyed.emplace_back((cell(p.x()) << 42) | (cell(p.y()) << 21) | cell(p.z()), k);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    nodes.clear();
+    for (std::size_t b = 0; b < keyed.size();) {
+      std::size_t e = b;
+      Vec3 sum = Vec3::Zero();
+      while (e < keyed.size() && keyed[e].first == keyed[b].first)
+        sum += proposals[keyed[e++].second];
+      if (e - b >= 2) nodes.push_back(sum / double(e - b));
+      b = e;
+    }
+    if (nodes.size() <= 1500) break;
+  }
+  const std::size_t m = nodes.size();
+  if (m < 2) return nodes;
+  // Prim on the complete graph, then the tree's longest path (two farthest-node searches).
+  std::vector<double> best(m, std::numeric_limits<double>::infinity());
+  std::vector<std::size_t> parent(m, 0);
+  std::vector<std::uint8_t> inTree(m, 0);
+  std::vector<std::vector<std::size_t>> tree(m);
+  std::size_t current = 0;
+  inTree[0] = 1;
+  for (std::size_t added = 1; added < m; ++added) {
+    std::size_t next = m;
+    for (std::size_t j = 0; j < m; ++j) {
+      if (inTree[j]) continue;
+      const double d = (nodes[j] - nodes[current]).squaredNorm();
+      if (d < best[j]) {
+        best[j] = d;
+        parent[j] = current;
+      }
+      if (next == m || best[j] < best[next]) next = j;
+    }
+    inTree[next] = 1;
+    tree[next].push_back(parent[next]);
+    tree[parent[next]].push_back(next);
+    current = next;
+  }
+  auto farthest = [&](std::size_t from, std::vector<std::size_t>& via) {
+    std::vector<double> dist(m, -1);
+    via.assign(m, m);
+    std::vector<std::size_t> stack{from};
+    dist[from] = 0;
+    std::size_t far = from;
+    while (!stack.empty()) {
+      const std::size_t v = stack.back();
+      stack.pop_back();
+      if (dist[v] > dist[far]) far = v;
+      for (const std::size_t w : tree[v])
+        if (dist[w] < 0) {
+          dist[w] = dist[v] + (nodes[w] - nodes[v]).norm();
+          via[w] = v;
+          stack.push_back(w);
+        }
+    }
+    return far;
+  };
+  std::vector<std::size_t> via;
+  const std::size_t a = farthest(0, via);
+  const std::size_t b = farthest(a, via);
+  std::vector<Vec3> path;
+  for (std::size_t v = b; v != m; v = via[v]) path.push_back(nodes[v]);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<Vec3> smooth = path;
+    for (std::size_t k = 1; k + 1 < path.size(); ++k)
+      smooth[k] = 0.25 * (path[k - 1] + 2 * path[k] + path[k + 1]);
+    path.swap(smooth);
+  }
+  return path;
+}
+
+struct Projection {
+  std::size_t segment = 0;
+  double along = 0;  // in [0, 1] on the segment
+  double distance = 0;
+};
+
+Projection project(const std::vector<Vec3>& axis, const Vec3& p) {
+  Projection best;
+  best.distance = std::numeric_limits<double>::infinity();
+  for (std::size_t s = 0; s + 1 < axis.size(); ++s) {
+    const Vec3 d = axis[s + 1] - axis[s];
+    const double len2 = d.squaredNorm();
+    const double u = len2 > 0 ? std::clamp((p - axis[s]).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double dist = (p - (axis[s] + u * d)).norm();
+    if (dist < best.distance) best = {s, u, dist};
+  }
+  return best;
+}
+
+// An axis polyline judged against the points: radius profile (each point's distance to the axis
+// shared between the two ends of its segment), RMS about that profile, and the arcs covered
+// around the axis by the input normals and by the points themselves, in a frame carried along
+// the axis without twist. Both arcs are needed: a box edge, rounded by the fits into a tube of
+// radius ~t, has points around a quarter circle but normals in two directions only; an axis
+// proposed far from a thin pipe (a fit much larger than the pipe) sees normals all around but
+// the points under a narrow angle.
+struct AxisEvaluation {
+  std::vector<Vec3> axis;
+  std::vector<double> radii;
+  double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
+};
+
+void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                  const std::vector<Index>& points, AxisEvaluation& e) {
+  const std::size_t m = e.axis.size();
+  std::vector<Projection> proj(points.size());
+  std::vector<double> sum(m, 0), weight(m, 0);
+  e.meanDistance = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    proj[k] = project(e.axis, positions[points[k]]);
+    sum[proj[k].segment] += (1 - proj[k].along) * proj[k].distance;
+    weight[proj[k].segment] += 1 - proj[k].along;
+    sum[proj[k].segment + 1] += proj[k].along * proj[k].distance;
+    weight[proj[k].segment + 1] += proj[k].along;
+    e.meanDistance += proj[k].distance;
+  }
+  e.meanDistance /= double(points.size());
+  e.radii.resize(m);
+  for (std::size_t k = 0; k < m; ++k) e.radii[k] = weight[k] > 1e-9 ? sum[k] / weight[k] : -1;
+  for (std::size_t k = 0; k < m; ++k)  // vertices no point projects to take their neighbour's
+    if (e.radii[k] < 0) e.radii[k] = k > 0 ? e.radii[k - 1] : e.meanDistance;
+  double squares = 0;
+  for (const Projection& p : proj) {
+    const double r = (1 - p.along) * e.radii[p.segment] + p.along * e.radii[p.segment + 1];
+    squares += (p.distance - r) * (p.distance - r);
+  }
+  e.rms = std::sqrt(squares / double(points.size()));
+
+  constexpr int kBins = 24;
+  std::vector<Vec3> tangent(m - 1), across(m - 1);
+  for (std::size_t s = 0; s + 1 < m; ++s) {
+    tangent[s] = (e.axis[s + 1] - e.axis[s]).normalized();
+    Vec3 a = s == 0 ? anyPerpendicular(tangent[0]) : across[s - 1];
+    a -= a.dot(tangent[s]) * tangent[s];
+    across[s] = a.squaredNorm() > 1e-12 ? a.normalized() : anyPerpendicular(tangent[s]);
+  }
+  auto arc = [&](auto&& directionOf) {
+    std::vector<std::size_t> bins(kBins, 0);
+    std::size_t counted = 0;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const std::size_t s = proj[k].segment;
+      const Vec3 d = directionOf(k, s);
+      const Vec3 radial = d - d.dot(tangent[s]) * tangent[s];
+      if (radial.norm() < 0.5 * d.norm()) continue;  // along the axis: an end cap, not the side
+      const double angle =
+          std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
+      ++bins[std::min(kBins - 1, int((angle + kPi) / (2 * kPi) * kBins))];
+      ++counted;
+    }
+    int filled = 0;
+    for (const std::size_t b : bins) filled += double(b) >= std::max(2.0, 0.25 * counted / kBins);
+    return 360.0 * filled / kBins;
+  };
+  e.normalArc = arc([&](std::size_t k, std::size_t) { return normals[points[k]]; });
+  e.positionArc = arc([&](std::size_t k, std::size_t s) {
+    const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
+    return Vec3(positions[points[k]] - foot);
+  });
+}
+
+}  // namespace
+
+const char* tubeRejectionName(TubeRejection rejection) {
+  switch (rejection) {
+    case TubeRejection::None:
+      return "none";
+    case TubeRejection::TooSmall:
+      return "too_small";
+    case TubeRejection::Flat:
+      return "flat";
+    case TubeRejection::NarrowArc:
+      return "narrow_arc";
+    case TubeRejection::Thin:
+      return "thin";
+    case TubeRejection::Rough:
+      return "rough";
+  }
+  return "?";
+}
+
+void validateTubeFitOptions(const TubeFitOptions& options) {
+  auto check = [](bool ok, const char* message) {
+    if (!ok) throw OptionError(message);
+  };
+  check(std::isfinite(options.minCurvatureFactor) && options.minCurvatureFactor >= 0,
+        "TubeFitOptions::minCurvatureFactor must be finite and >= 0");
+  check(options.minArcDegrees >= 0 && options.minArcDegrees <= 360,
+        "TubeFitOptions::minArcDegrees must be in [0, 360]");
+  check(std::isfinite(options.minRadiusFactor) && options.minRadiusFactor >= 0,
+        "TubeFitOptions::minRadiusFactor must be finite and >= 0");
+  check(std::isfinite(options.maxRelativeRms) && options.maxRelativeRms > 0,
+        "TubeFitOptions::maxRelativeRms must be finite and > 0");
+  check(std::isfinite(options.straightRmsRatio) && options.straightRmsRatio >= 1,
+        "TubeFitOptions::straightRmsRatio must be finite and >= 1");
+}
+
+TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                const std::vector<Vec3>& scaleNormals, const std::vector<float>& kappa1,
+                const std::vector<Index>& points, double t, const TubeFitOptions& options) {
+  TubeFit fit;
+  fit.pointCount = points.size();
+  if (points.size() < std::max<std::size_t>(options.minPoints, 3)) return fit;
+  double meanKappa = 0;
+  std::vector<double> radii;
+  for (const Index i : points) {
+    meanKappa += kappa1[i];
+    if (std::abs(kappa1[i]) * t >= options.minCurvatureFactor)
+      radii.push_back(1 / std::abs(kappa1[i]));
+  }
+  meanKappa /= double(points.size());
+  fit.rejection = TubeRejection::Flat;
+  if (std::abs(meanKappa) * t < options.minCurvatureFactor || radii.size() < 3) return fit;
+  if (!fitStraightAxis(positions, scaleNormals, points, fit)) return fit;
+
+  std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(radii.size() / 2), radii.end());
+  const double cell = std::max(t, radii[radii.size() / 2]);
+  AxisEvaluation straight;
+  {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Index i : points) {
+      const double s = (positions[i] - fit.centre).dot(fit.direction);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    const int pieces = std::max(1, int(std::lround((hi - lo) / cell)));
+    for (int k = 0; k <= pieces; ++k)
+      straight.axis.push_back(fit.centre + (lo + (hi - lo) * k / pieces) * fit.direction);
+  }
+  evaluateAxis(positions, normals, points, straight);
+  AxisEvaluation curved;
+  curved.axis = curvedAxis(positions, scaleNormals, kappa1, points, cell);
+  // The straight axis unless the curved one describes the points clearly better (a bent pipe).
+  fit.straight = true;
+  if (curved.axis.size() >= 2) {
+    evaluateAxis(positions, normals, points, curved);
+    fit.straight = straight.rms <= std::max(options.straightRmsRatio * curved.rms,
+                                            curved.rms + 0.02 * curved.meanDistance);
+  }
+  AxisEvaluation& chosen = fit.straight ? straight : curved;
+  fit.axis = std::move(chosen.axis);
+  fit.radii = std::move(chosen.radii);
+  fit.rms = chosen.rms;
+  fit.radius = fit.straight ? fit.straightRadius : chosen.meanDistance;
+  fit.arcDegrees = std::min(chosen.normalArc, chosen.positionArc);
+  for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
+    fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
+
+  if (fit.arcDegrees < options.minArcDegrees)
+    fit.rejection = TubeRejection::NarrowArc;
+  else if (!(fit.radius >= options.minRadiusFactor * t))
+    fit.rejection = TubeRejection::Thin;
+  else if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t)))
+    fit.rejection = TubeRejection::Rough;
+  else
+    fit.rejection = TubeRejection::None;
+  return fit;
+}
+
+}  // namespace scalespace

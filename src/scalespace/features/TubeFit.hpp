@@ -1,0 +1,72 @@
+#pragma once
+// A tube fitted to a region of cylinder points (Sec. 3.5 leaves the regions unmodelled; users need
+// the axis and the radius): its axis as a polyline (curved for a bent pipe), the radius along it
+// (a tapering pipe), the RMS distance of the points to that tube, whether the axis is straight,
+// and the tests that tell a tube from what only looks anisotropic at one scale.
+//
+// How: each point x with the scale's normal n and curvature kappa1 (features/LineAnisotropy)
+// proposes the axis point x - n / kappa1. These are averaged in cells of the tube's size and
+// chained by the longest path of their minimum spanning tree: the curved axis. The straight axis
+// (direction: least-spread direction of the normals; centre: the point nearest to every normal
+// line, refined by a geometric circle fit) is kept unless the curved one fits the points clearly
+// better. The radius profile is the mean distance to the axis per axis vertex.
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+struct TubeFitOptions {
+  std::size_t minPoints = 30;
+  /// The scale's curvature must be that of a tube, not of noise on a plane: |mean kappa1| t >=
+  /// minCurvatureFactor (the line tracer's own flatness bound,
+  /// CurvatureLineOptions::minAnisotropy).
+  double minCurvatureFactor = 0.02;
+  /// The points and their own normals must both turn around the axis by at least this: a
+  /// half-pipe scan covers 180 degrees, a full pipe 360, while the two faces of a box edge,
+  /// rounded by the fit into a tube of radius ~t at every scale, give two normal directions only.
+  double minArcDegrees = 120;
+  /// A tube much thinner than the scale is not one the fits saw: its whole section lies in one
+  /// support. Radius >= minRadiusFactor * t.
+  double minRadiusFactor = 0.25;
+  /// RMS distance to the tube (radius profile) <= maxRelativeRms * max(radius, t): relief smaller
+  /// than the scale (the strands of a cable seen as one tube) is smoothed by the fits, so it is
+  /// not held against the tube.
+  double maxRelativeRms = 0.25;
+  /// The axis is straight unless the curved axis fits the points better: straight when the RMS
+  /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
+  /// the radius of it).
+  double straightRmsRatio = 1.5;
+};
+
+enum class TubeRejection : std::uint8_t { None, TooSmall, Flat, NarrowArc, Thin, Rough };
+const char* tubeRejectionName(TubeRejection rejection);
+
+struct TubeFit {
+  TubeRejection rejection = TubeRejection::TooSmall;
+  bool isTube() const { return rejection == TubeRejection::None; }
+  std::vector<Vec3> axis;     // polyline, >= 2 vertices (when the fit got that far)
+  std::vector<double> radii;  // radius at each axis vertex
+  double radius = 0;          // mean distance of the points to the axis
+  double rms = 0;             // RMS of (distance to the axis - radius profile there)
+  bool straight = false;
+  Vec3 direction = Vec3::UnitX();  // the straight axis: unit direction, and a point on it
+  Vec3 centre = Vec3::Zero();
+  double straightRadius = 0;  // radius of the straight fit
+  double arcDegrees = 0;  // the arc around the axis covered by both the points and their normals
+  double length = 0;      // of the axis polyline
+  std::size_t pointCount = 0;
+};
+
+/// Fits the tube of `points` (indices into positions / normals / the scale fields). `normals` are
+/// the input's oriented normals; `scaleNormals` and `kappa1` those of scale t
+/// (LineAnisotropyField).
+TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                const std::vector<Vec3>& scaleNormals, const std::vector<float>& kappa1,
+                const std::vector<Index>& points, double t, const TubeFitOptions& options = {});
+
+/// OptionError naming the field unless every option is finite and in range.
+void validateTubeFitOptions(const TubeFitOptions& options);
+
+}  // namespace scalespace
