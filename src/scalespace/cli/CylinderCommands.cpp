@@ -68,9 +68,12 @@ void writeComponentsCsv(const CylinderDetection& detection, const Vec3& origin,
           << c.deathScale << ',' << c.persistence << ','
           << detection.levels[std::size_t(c.representativeLevel)].scale << ',' << t.pointCount
           << ',' << (t.straight ? 1 : 0) << ',' << t.radius << ',' << t.radii.front() << ','
-          << t.radii.back() << ',' << t.rms << ',' << t.length << ',' << t.arcDegrees << ','
-          << t.direction.x() << ',' << t.direction.y() << ',' << t.direction.z() << ','
-          << centre.x() << ',' << centre.y() << ',' << centre.z() << '\n';
+          << t.radii.back() << ',' << t.rms << ',' << t.length << ',' << t.arcDegrees;
+      if (t.straight)
+        out << ',' << t.direction.x() << ',' << t.direction.y() << ',' << t.direction.z() << ','
+            << centre.x() << ',' << centre.y() << ',' << centre.z() << '\n';
+      else
+        out << ",,,,,,\n";  // a bent tube has no straight axis
     }
   });
 }
@@ -81,7 +84,7 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
     const TubeFit& t = c.tube;
     nlohmann::json axis = nlohmann::json::array();
     for (const Vec3& p : t.axis) axis.push_back(point(p + origin));
-    components.push_back({{"id", c.id},
+    nlohmann::json item = {{"id", c.id},
                           {"birth_level", c.birthLevel},
                           {"birth_scale", c.birthScale},
                           {"death_level", c.deathLevel},
@@ -94,10 +97,13 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
                           {"rms", t.rms},
                           {"length", t.length},
                           {"arc_degrees", t.arcDegrees},
-                          {"direction", point(t.direction)},
-                          {"centre", point(t.centre + origin)},
                           {"axis", axis},
-                          {"radii", t.radii}});
+                          {"radii", t.radii}};
+    if (t.straight) {  // the straight axis means nothing for a bent tube
+      item["direction"] = point(t.direction);
+      item["centre"] = point(t.centre + origin);
+    }
+    components.push_back(std::move(item));
   }
   return components;
 }

@@ -17,7 +17,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kThinRadius = 0.03, kMediumRadius = 0.1, kThickRadius = 0.35;
 constexpr double kBentRadius = 0.12, kElbowRadius = 0.4;  // tube radius, bend radius of the axis
 constexpr double kTaperStart = 0.15, kTaperEnd = 0.05;
-constexpr double kStrandRadius = 0.03, kHelixRadius = 0.036, kHelixPitch = 0.5;
+constexpr double kStrandRadius = 0.05, kHelixRadius = 0.06, kHelixPitch = 0.8;
 const Vec3 kBentStart{-2.0, 0.8, 0.4};
 constexpr double kBentFirstLength = 1.7, kBentSecondLength = 1.0;
 const Vec3 kBoxLo{1.2, 1.1, 0.0}, kBoxHi{2.0, 1.7, 0.5};

@@ -1,6 +1,6 @@
 #pragma once
-// A pipe-rack scene in metres with ground truth, for the cylinders of Sec. 3.5: tubes of radii
-// 0.03 to 0.35 m (ratio > 10), a bent pipe (straight, a 90-degree elbow of torus, straight), a
+// A pipe-rack scene in metres with ground truth, for the cylinders of Sec. 3.5: straight tubes of
+// radii 0.03, 0.1 and 0.35 m (ratio > 10), a bent pipe (radius 0.12 m) (straight, a 90-degree elbow of torus, straight), a
 // tapering pipe (cone), a cable of three strands twisted around a common axis (three thin tubes
 // at a small scale, one thick tube at a large one), and what must not become a cylinder: a floor,
 // a wall and a box standing on the floor. Sampled uniformly by area with exact outward normals.

@@ -130,7 +130,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     std::vector<const CurvatureLine*> regular;
     for (const CurvatureLine& line : lines.lines)
       if (isRegularLine(line, t, options.filter)) regular.push_back(&line);
-    const LineAnisotropyField field = lineAnisotropy(positions, regular, t, sub(0.7, 0.9));
+    const LineAnisotropyField field = lineAnisotropy(positions, cloud.normals(), regular, t, sub(0.7, 0.9));
 
     std::vector<std::uint8_t> eligible(n, 0);
     for (std::size_t i = 0; i < n; ++i) eligible[i] = field.sigma[i] >= options.minAnisotropy;

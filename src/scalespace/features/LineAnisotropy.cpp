@@ -13,6 +13,7 @@
 namespace scalespace {
 
 LineAnisotropyField lineAnisotropy(const std::vector<Vec3>& positions,
+                                   const std::vector<Vec3>& normals,
                                    const std::vector<const CurvatureLine*>& lines, double t,
                                    const ProgressCallback& progress) {
   struct Vertex {
@@ -50,6 +51,7 @@ LineAnisotropyField lineAnisotropy(const std::vector<Vec3>& positions,
       double weightSum = 0, kappa = 0;
       for (const Neighbor& nb : near) {
         const Vertex& v = vertices[nb.index];
+        if (v.normal.dot(normals[i]) <= 0) continue;  // the other side of the surface
         const double x = 1 - nb.distSq * invT2;  // Eq. 1.6: (r^2/t^2 - 1)^2
         const double w = v.weight * x * x;
         if (!(w > 0)) continue;

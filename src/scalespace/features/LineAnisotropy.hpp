@@ -7,6 +7,12 @@
 // eigenvector), normal and signed kappa1 at this scale: the region growing of Eq. 3.10 compares
 // directions and normals of the scale, not the raw normals (two strands of a cable must join at a
 // coarse scale), and the tubes read their radius from kappa1.
+//
+// (Not in the thesis.) A point only counts the vertices on its own side of the surface, those
+// whose normal makes an angle below 90 degrees with the point's own normal: where two strands of
+// a cable touch, or on the two sides of a thin wall, the vertices of the other side lie within t
+// but belong to another sheet. Without this, the strands of a cable share their normals along the
+// groove between them and grow into one region at every scale.
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
@@ -24,9 +30,11 @@ struct LineAnisotropyField {
   std::vector<float> kappa1;    // weighted mean of the vertices' signed kappa1; 0 where NaN
 };
 
-/// Eq. 3.8-3.9 at the points `positions` from the vertices of `lines` (scale t = lines.scale).
-/// Parallel; the result does not depend on the thread count. Throws Cancelled on request.
+/// Eq. 3.8-3.9 at the points `positions` (oriented `normals`, one per point) from the vertices of
+/// `lines` at scale t. Parallel; the result does not depend on the thread count. Throws Cancelled
+/// on request.
 LineAnisotropyField lineAnisotropy(const std::vector<Vec3>& positions,
+                                   const std::vector<Vec3>& normals,
                                    const std::vector<const CurvatureLine*>& lines, double t,
                                    const ProgressCallback& progress = {});
 

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -237,9 +238,12 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     a -= a.dot(tangent[s]) * tangent[s];
     across[s] = a.squaredNorm() > 1e-12 ? a.normalized() : anyPerpendicular(tangent[s]);
   }
+  // Arcs are counted per axis segment, each in its own frame, and the median over the segments
+  // holding enough points is kept: along a polyline that wanders (the axis of a box's rounded
+  // footprint turning at its corners) one frame would smear two face normals over many angles.
   auto arc = [&](auto&& directionOf) {
-    std::vector<std::size_t> bins(kBins, 0);
-    std::size_t counted = 0;
+    std::vector<std::array<std::uint32_t, kBins>> bins(m - 1);
+    for (auto& b : bins) b.fill(0);
     for (std::size_t k = 0; k < points.size(); ++k) {
       const std::size_t s = proj[k].segment;
       const Vec3 d = directionOf(k, s);
@@ -247,12 +251,30 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
       if (radial.norm() < 0.5 * d.norm()) continue;  // along the axis: an end cap, not the side
       const double angle =
           std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
-      ++bins[std::min(kBins - 1, int((angle + kPi) / (2 * kPi) * kBins))];
-      ++counted;
+      ++bins[s][std::size_t(std::min(kBins - 1, int((angle + kPi) / (2 * kPi) * kBins)))];
     }
-    int filled = 0;
-    for (const std::size_t b : bins) filled += double(b) >= std::max(2.0, 0.25 * counted / kBins);
-    return 360.0 * filled / kBins;
+    std::vector<double> arcs;
+    std::array<std::uint32_t, kBins> all{};
+    for (const auto& b : bins) {
+      std::uint32_t counted = 0;
+      for (int k = 0; k < kBins; ++k) {
+        counted += b[std::size_t(k)];
+        all[std::size_t(k)] += b[std::size_t(k)];
+      }
+      if (counted < 2 * kBins) continue;
+      int filled = 0;
+      for (const std::uint32_t c : b) filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
+      arcs.push_back(360.0 * filled / kBins);
+    }
+    if (arcs.empty()) {  // a short or sparse region: one count over the whole axis
+      std::uint32_t counted = 0;
+      for (const std::uint32_t c : all) counted += c;
+      int filled = 0;
+      for (const std::uint32_t c : all) filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
+      return 360.0 * filled / kBins;
+    }
+    std::nth_element(arcs.begin(), arcs.begin() + std::ptrdiff_t(arcs.size() / 2), arcs.end());
+    return arcs[arcs.size() / 2];
   };
   e.normalArc = arc([&](std::size_t k, std::size_t) { return normals[points[k]]; });
   e.positionArc = arc([&](std::size_t k, std::size_t s) {
@@ -348,7 +370,9 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 
-  if (fit.arcDegrees < options.minArcDegrees)
+  if (fit.length < fit.radius)  // a ring shorter than its radius: too little to call a tube
+    fit.rejection = TubeRejection::TooSmall;
+  else if (fit.arcDegrees < options.minArcDegrees)
     fit.rejection = TubeRejection::NarrowArc;
   else if (!(fit.radius >= options.minRadiusFactor * t))
     fit.rejection = TubeRejection::Thin;

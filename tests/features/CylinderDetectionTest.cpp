@@ -1,0 +1,249 @@
+// Cylinders across scales (Sec. 3.5) on shapes whose tubes are known: straight cylinders of
+// several radii, clean, noisy and seen from one side; a bent tube (torus section); a plane and a
+// box, which hold none; the same result for any thread count; options checked.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/SceneGenerator.hpp"
+#include "scalespace/features/CylinderDetection.hpp"
+#include "scalespace/features/LineRegularity.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Tube {
+  double radius = 1, length = 6;
+  Vec3 axis = Vec3(1, 0.3, 0.2).normalized();
+  double arc = 2 * kPi;  // visible part of the section (a half-pipe scan: pi)
+  double noise = 0;      // Gaussian, absolute
+};
+
+PointCloud sampleTube(const Tube& tube, std::size_t count, std::uint64_t seed = 1) {
+  const Vec3 e1 = tube.axis.cross(Vec3::UnitZ()).normalized(), e2 = tube.axis.cross(e1);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<Vec3> p(count), n(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double s = u(rng) * tube.length, theta = u(rng) * tube.arc;
+    n[i] = std::cos(theta) * e1 + std::sin(theta) * e2;
+    p[i] = s * tube.axis + tube.radius * n[i] + tube.noise * Vec3(g(rng), g(rng), g(rng));
+  }
+  PointCloud cloud;
+  cloud.setAbsolutePositions(p);
+  cloud.setNormals(std::move(n));
+  return cloud;
+}
+
+// A third of a torus: axis circle of radius R in the xy plane, tube radius r (R > 2r, so the
+// tube's curvature 1/r is the larger one everywhere).
+PointCloud sampleTorusSection(double R, double r, std::size_t count) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> p, n;
+  while (p.size() < count) {
+    const double phi = u(rng) * 2 * kPi / 3, theta = u(rng) * 2 * kPi;
+    if (u(rng) * (R + r) > R + r * std::cos(theta)) continue;  // uniform by area
+    const Vec3 out(std::cos(phi), std::sin(phi), 0);
+    const Vec3 normal = std::cos(theta) * out + std::sin(theta) * Vec3::UnitZ();
+    p.push_back(R * out + r * normal);
+    n.push_back(normal);
+  }
+  PointCloud cloud;
+  cloud.setAbsolutePositions(p);
+  cloud.setNormals(std::move(n));
+  return cloud;
+}
+
+CylinderOptions atScales(std::vector<double> scales) {
+  CylinderOptions options;
+  options.scales = std::move(scales);
+  return options;
+}
+
+const CylinderComponent* mostPersistent(const CylinderDetection& d) {
+  const CylinderComponent* best = nullptr;
+  for (const auto& c : d.components)
+    if (!best || c.persistence > best->persistence ||
+        (c.persistence == best->persistence && c.tube.pointCount > best->tube.pointCount))
+      best = &c;
+  return best;
+}
+
+double angleDegrees(const Vec3& a, const Vec3& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180 / kPi;
+}
+
+}  // namespace
+
+TEST(LineRegularity, LengthTurnsAndVariationOfAPolyline) {
+  CurvatureLine line;
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0)}) {
+    CurvatureLineVertex v;
+    v.position = p;
+    v.geometricVariation = 0.5;
+    line.vertices.push_back(v);
+  }
+  const LineRegularity r = lineRegularity(line);
+  EXPECT_DOUBLE_EQ(r.length, 2);
+  EXPECT_NEAR(r.totalCurvature, kPi / 2, 1e-12);
+  EXPECT_NEAR(r.totalVariation, 3 * std::tanh(0.5), 1e-12);
+  LineFilterOptions filter;
+  EXPECT_TRUE(isRegularLine(line, 1, filter));   // L = 2 >= 2t, K = pi/2 <= L/t = 2
+  EXPECT_FALSE(isRegularLine(line, 2, filter));  // L = 2 < 2t
+  filter.maxMeanVariation = 0.4;                 // tanh(0.5) = 0.46 per vertex
+  EXPECT_FALSE(isRegularLine(line, 1, filter));
+}
+
+TEST(Cylinders, StraightCylindersOfSeveralRadiiAndNoise) {
+  for (const double radius : {0.05, 0.3, 2.0})
+    for (const double noise : {0.0, 0.01}) {
+      SCOPED_TRACE("radius " + std::to_string(radius) + " noise " + std::to_string(noise));
+      Tube tube;
+      tube.radius = radius;
+      tube.length = 6 * radius;
+      tube.noise = noise * radius;
+      const PointCloud cloud = sampleTube(tube, 12000);
+      const CylinderDetection d =
+          detectCylinders(cloud, atScales({0.25 * radius, 0.4 * radius, 0.6 * radius}));
+      const CylinderComponent* c = mostPersistent(d);
+      ASSERT_NE(c, nullptr);
+      EXPECT_EQ(c->persistence, 2);  // the same tube at every scale
+      EXPECT_TRUE(c->tube.straight);
+      EXPECT_NEAR(c->tube.radius, radius, (noise > 0 ? 0.02 : 0.01) * radius);
+      EXPECT_LT(angleDegrees(c->tube.direction, tube.axis), noise > 0 ? 2.0 : 1.0);
+      EXPECT_GT(double(c->tube.pointCount), 0.8 * double(cloud.size()));
+      EXPECT_NEAR(c->tube.length, tube.length, 0.05 * tube.length);
+    }
+}
+
+TEST(Cylinders, AHalfPipeScanIsATube) {
+  Tube tube;
+  tube.arc = kPi;
+  const PointCloud cloud = sampleTube(tube, 8000);
+  const CylinderDetection d = detectCylinders(cloud, atScales({0.25, 0.4, 0.6}));
+  const CylinderComponent* c = mostPersistent(d);
+  ASSERT_NE(c, nullptr);
+  EXPECT_NEAR(c->tube.radius, 1.0, 0.01);
+  EXPECT_LT(angleDegrees(c->tube.direction, tube.axis), 1.0);
+  EXPECT_NEAR(c->tube.arcDegrees, 180, 30);
+}
+
+TEST(Cylinders, ATorusSectionIsOneBentTube) {
+  const PointCloud cloud = sampleTorusSection(1.0, 0.25, 20000);
+  const CylinderDetection d = detectCylinders(cloud, atScales({0.08, 0.12, 0.18}));
+  const CylinderComponent* c = mostPersistent(d);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->persistence, 2);
+  EXPECT_FALSE(c->tube.straight);
+  EXPECT_NEAR(c->tube.radius, 0.25, 0.25 * 0.03);
+  EXPECT_GT(double(c->tube.pointCount), 0.8 * double(cloud.size()));
+  // The axis follows the circle of radius 1 over its third (length 2 pi / 3).
+  for (const Vec3& a : c->tube.axis) EXPECT_NEAR(std::hypot(a.x(), a.y()), 1.0, 0.05);
+  EXPECT_NEAR(c->tube.length, 2 * kPi / 3, 0.15);
+  for (const double r : c->tube.radii) EXPECT_NEAR(r, 0.25, 0.25 * 0.1);
+}
+
+TEST(Cylinders, PlanesAndBoxesAreNoCylinders) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::normal_distribution<double> g(0, 0.002);
+  std::vector<Vec3> p(20000);
+  for (Vec3& q : p) q = Vec3(u(rng), u(rng), g(rng));
+  PointCloud plane;
+  plane.setAbsolutePositions(p);
+  plane.setNormals(std::vector<Vec3>(p.size(), Vec3::UnitZ()));
+  EXPECT_TRUE(detectCylinders(plane, atScales({0.05, 0.1, 0.2})).components.empty());
+
+  SceneOptions scene;
+  scene.pointCount = 30000;
+  const PointCloud box = generateScene(SceneKind::Box, scene);
+  const CylinderDetection d = detectCylinders(box, atScales({0.03, 0.06, 0.12}));
+  EXPECT_TRUE(d.components.empty()) << d.components.size() << " components on a box";
+}
+
+TEST(Cylinders, SameResultForAnyThreadCount) {
+  Tube tube;
+  tube.noise = 0.01;
+  const PointCloud cloud = sampleTube(tube, 8000);
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    return detectCylinders(cloud, atScales({0.25, 0.4}));
+  };
+  const CylinderDetection one = run(1), two = run(2);
+  ASSERT_EQ(one.components.size(), two.components.size());
+  for (std::size_t c = 0; c < one.components.size(); ++c) {
+    EXPECT_EQ(one.components[c].tube.radius, two.components[c].tube.radius);
+    EXPECT_EQ(one.components[c].tube.axis, two.components[c].tube.axis);
+  }
+  for (int level = 0; level < 2; ++level) {
+    EXPECT_EQ(cylinderLabelsAtLevel(one, level), cylinderLabelsAtLevel(two, level));
+    const auto& a = one.levels[std::size_t(level)].anisotropy;
+    const auto& b = two.levels[std::size_t(level)].anisotropy;
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(a[i] == b[i] || (std::isnan(a[i]) && std::isnan(b[i])));
+  }
+}
+
+TEST(Cylinders, LabelQueries) {
+  Tube tube;
+  const PointCloud cloud = sampleTube(tube, 8000);
+  const CylinderDetection d = detectCylinders(cloud, atScales({0.25, 0.4, 0.6}));
+  ASSERT_FALSE(d.components.empty());
+  EXPECT_EQ(nearestCylinderLevel(d, 0.41), 1);
+  EXPECT_EQ(nearestCylinderLevel(d, 100), 2);
+  const std::vector<int> byPersistence = cylinderLabelsByPersistence(d);
+  const std::vector<int> atLevel = cylinderLabelsAtLevel(d, 1);
+  ASSERT_EQ(byPersistence.size(), cloud.size());
+  std::size_t labelled = 0;
+  for (const int l : byPersistence) labelled += l >= 0;
+  EXPECT_GT(double(labelled), 0.8 * double(cloud.size()));
+  // No component lives 3 scale steps over 3 scales.
+  for (const int l : cylinderLabelsByPersistence(d, 3)) EXPECT_EQ(l, -1);
+  for (const int l : cylinderLabelsAtLevel(d, 1, 3)) EXPECT_EQ(l, -1);
+  EXPECT_THROW(cylinderLabelsAtLevel(d, 3), OptionError);
+  EXPECT_THROW(nearestCylinderLevel(d, -1), OptionError);
+  (void)atLevel;
+}
+
+TEST(Cylinders, OptionsAreChecked) {
+  const PointCloud cloud = sampleTube(Tube{}, 500);
+  auto rejects = [&](auto&& change, const char* field) {
+    CylinderOptions options = atScales({0.3});
+    change(options);
+    try {
+      detectCylinders(cloud, options);
+      ADD_FAILURE() << "accepted bad " << field;
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  rejects([](CylinderOptions& o) { o.scales = {0.3, 0.2}; }, "CylinderOptions::scales");
+  rejects([](CylinderOptions& o) { o.scales = {-1}; }, "CylinderOptions::scales");
+  rejects([](CylinderOptions& o) { o.epsilon = 1; }, "CylinderOptions::epsilon");
+  rejects([](CylinderOptions& o) { o.minAnisotropy = 2; }, "CylinderOptions::minAnisotropy");
+  rejects([](CylinderOptions& o) { o.graphNeighbors = 0; }, "CylinderOptions::graphNeighbors");
+  rejects([](CylinderOptions& o) { o.filter.minLengthFactor = -1; },
+          "LineFilterOptions::minLengthFactor");
+  rejects([](CylinderOptions& o) { o.tube.minArcDegrees = 400; }, "TubeFitOptions::minArcDegrees");
+  rejects([](CylinderOptions& o) { o.tube.maxRelativeRms = NAN; },
+          "TubeFitOptions::maxRelativeRms");
+  rejects([](CylinderOptions& o) { o.lines.beta = 0; }, "CurvatureLineOptions::beta");
+  PointCloud bare;
+  bare.setAbsolutePositions(cloud.positions());
+  EXPECT_THROW(detectCylinders(bare, atScales({0.3})), OptionError);
+  CylinderOptions automatic;
+  automatic.tMin = 1;
+  automatic.tMax = 0.5;
+  EXPECT_THROW(detectCylinders(cloud, automatic), OptionError);
+}
