@@ -4,10 +4,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
-
-#include <Eigen/Geometry>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SceneGenerator.hpp"

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -49,6 +50,46 @@ struct AlignedLines {
   }
 };
 
+/// Each tube takes, breadth-first through the k-NN graph from its points, the points of no tube
+/// that lie on its surface (|residual| <= max(3 rms, 5% of the radius)) with their own normal
+/// along its radial direction: the points the anisotropy missed, next to the border of the lines
+/// (the groove between the strands of a cable, the ends of a pipe). Tubes claim in region order.
+void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
+                 const std::vector<Vec3>& normals, std::vector<TubeFit>& tubes,
+                 std::vector<std::vector<Index>>& regions, const TubeCoverageOptions& coverage) {
+  if (!coverage.enabled) return;
+  std::vector<int> owner(positions.size(), -1);
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    if (tubes[r].isTube())
+      for (const Index i : regions[r]) owner[i] = int(r);
+  const double minCos = std::cos(coverage.maxAngleDegrees * 3.14159265358979323846 / 180);
+  std::vector<Index> frontier;
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    TubeFit& tube = tubes[r];
+    if (!tube.isTube()) continue;
+    const double tolerance =
+        std::max(coverage.rmsFactor * tube.rms, coverage.radiusFraction * tube.radius);
+    frontier = regions[r];
+    while (!frontier.empty()) {
+      const Index p = frontier.back();
+      frontier.pop_back();
+      for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
+        const Index q = graph.neighbors[e];
+        if (owner[q] >= 0) continue;
+        Vec3 radial;
+        if (std::abs(tubeResidual(tube, positions[q], &radial)) > tolerance ||
+            std::abs(radial.dot(normals[q])) < minCos)
+          continue;
+        owner[q] = int(r);
+        regions[r].push_back(q);
+        frontier.push_back(q);
+      }
+    }
+    std::sort(regions[r].begin(), regions[r].end());
+    tube.pointCount = regions[r].size();
+  }
+}
+
 std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
                                   const CylinderOptions& options) {
   if (!options.scales.empty()) return options.scales;
@@ -94,6 +135,12 @@ void validateCylinderOptions(const CylinderOptions& options) {
           "CylinderOptions::minJaccard must be in [0.5, 1)");
   validateLineFilterOptions(options.filter);
   validateTubeFitOptions(options.tube);
+  require(std::isfinite(options.coverage.rmsFactor) && options.coverage.rmsFactor >= 0,
+          "TubeCoverageOptions::rmsFactor must be finite and >= 0");
+  require(std::isfinite(options.coverage.radiusFraction) && options.coverage.radiusFraction >= 0,
+          "TubeCoverageOptions::radiusFraction must be finite and >= 0");
+  require(options.coverage.maxAngleDegrees >= 0 && options.coverage.maxAngleDegrees <= 90,
+          "TubeCoverageOptions::maxAngleDegrees must be in [0, 90]");
   CurvatureLineOptions lines = options.lines;
   lines.scale = 1;  // set per level
   validateCurvatureLineOptions(lines);
@@ -130,7 +177,8 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     std::vector<const CurvatureLine*> regular;
     for (const CurvatureLine& line : lines.lines)
       if (isRegularLine(line, t, options.filter)) regular.push_back(&line);
-    const LineAnisotropyField field = lineAnisotropy(positions, cloud.normals(), regular, t, sub(0.7, 0.9));
+    const LineAnisotropyField field =
+        lineAnisotropy(positions, cloud.normals(), regular, t, sub(0.7, 0.9));
 
     std::vector<std::uint8_t> eligible(n, 0);
     for (std::size_t i = 0; i < n; ++i) eligible[i] = field.sigma[i] >= options.minAnisotropy;
@@ -146,6 +194,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
                           tubes[r] = fitTube(positions, cloud.normals(), field.normal, field.kappa1,
                                              seg.regions[r], t, options.tube);
                       });
+    extendTubes(graph, positions, cloud.normals(), tubes, seg.regions, options.coverage);
     CylinderLevel level;
     level.scale = t;
     level.lines = lines.lines.size();

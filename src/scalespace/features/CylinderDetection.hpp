@@ -8,7 +8,9 @@
 //      |sigma_i - sigma_j| < eps, |v_i . v_j| > 1 - eps and n_i . n_j > 1 - eps (Eq. 3.10), from
 //      every point with sigma >= minAnisotropy (not in the thesis, which grows from every point:
 //      without it the isotropic rest of the cloud forms regions too), most anisotropic first;
-//   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped.
+//   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped;
+//   5. (not in the thesis) each tube takes the free points lying on it next to it
+//      (TubeCoverageOptions).
 // Then, as the planes of Ch. 2, the tubes of consecutive scales with Jaccard index > 0.5 are
 // linked into components with a birth and a death scale (core/RegionGraph).
 #include <vector>
@@ -21,6 +23,14 @@
 #include "scalespace/features/TubeFit.hpp"
 
 namespace scalespace {
+
+/// (Not in the thesis.) After the region growing each tube takes the points of no tube next to it
+/// that lie on its surface: within max(rmsFactor x its RMS, radiusFraction x its radius) of it,
+/// their own normal within maxAngleDegrees of its radial direction.
+struct TubeCoverageOptions {
+  bool enabled = true;
+  double rmsFactor = 3, radiusFraction = 0.05, maxAngleDegrees = 30;
+};
 
 struct CylinderOptions {
   /// The scales, increasing. Empty: scaleCount log-spaced scales in [tMin, tMax].
@@ -35,6 +45,7 @@ struct CylinderOptions {
   double minAnisotropy = 0.5;  // sigma of a region's points
   int graphNeighbors = 10;     // k of the k-NN graph (Sec. 2.3.1's 10)
   TubeFitOptions tube;
+  TubeCoverageOptions coverage;
   double minJaccard = 0.5;  // Sec. 2.3.2
 };
 

@@ -52,7 +52,7 @@ LineAnisotropyField lineAnisotropy(const std::vector<Vec3>& positions,
       for (const Neighbor& nb : near) {
         const Vertex& v = vertices[nb.index];
         if (v.normal.dot(normals[i]) <= 0) continue;  // the other side of the surface
-        const double x = 1 - nb.distSq * invT2;  // Eq. 1.6: (r^2/t^2 - 1)^2
+        const double x = 1 - nb.distSq * invT2;       // Eq. 1.6: (r^2/t^2 - 1)^2
         const double w = v.weight * x * x;
         if (!(w > 0)) continue;
         sigma += w * v.tangent * v.tangent.transpose();

@@ -270,7 +270,8 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
       std::uint32_t counted = 0;
       for (const std::uint32_t c : all) counted += c;
       int filled = 0;
-      for (const std::uint32_t c : all) filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
+      for (const std::uint32_t c : all)
+        filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
       return 360.0 * filled / kBins;
     }
     std::nth_element(arcs.begin(), arcs.begin() + std::ptrdiff_t(arcs.size() / 2), arcs.end());
@@ -284,6 +285,16 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
 }
 
 }  // namespace
+
+double tubeResidual(const TubeFit& tube, const Vec3& p, Vec3* radial) {
+  const Projection q = project(tube.axis, p);
+  const std::size_t s = q.segment;
+  if (radial) {
+    const Vec3 foot = tube.axis[s] + q.along * (tube.axis[s + 1] - tube.axis[s]);
+    *radial = q.distance > 0 ? Vec3((p - foot) / q.distance) : Vec3::Zero();
+  }
+  return q.distance - ((1 - q.along) * tube.radii[s] + q.along * tube.radii[s + 1]);
+}
 
 const char* tubeRejectionName(TubeRejection rejection) {
   switch (rejection) {

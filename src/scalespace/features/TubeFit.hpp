@@ -66,6 +66,11 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
                 const std::vector<Vec3>& scaleNormals, const std::vector<float>& kappa1,
                 const std::vector<Index>& points, double t, const TubeFitOptions& options = {});
 
+/// Distance from p to the tube's surface (distance to the axis minus the radius profile at the
+/// nearest axis point; negative inside) and, in `radial`, the unit direction from that axis point
+/// to p. The tube must have an axis of >= 2 vertices.
+double tubeResidual(const TubeFit& tube, const Vec3& p, Vec3* radial = nullptr);
+
 /// OptionError naming the field unless every option is finite and in range.
 void validateTubeFitOptions(const TubeFitOptions& options);
 
