@@ -1,0 +1,1 @@
+from ._scalespace import *  # noqa: F401,F403
