@@ -13,8 +13,8 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
-#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Parallel.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/io/CloudBuilder.hpp"
 
 namespace scalespace::python {
@@ -81,8 +81,7 @@ std::string dtypeName(const py::dtype& dtype) { return py::cast<std::string>(dty
 
 std::string shapeText(const py::array& a) {
   std::string s = "(";
-  for (py::ssize_t d = 0; d < a.ndim(); ++d)
-    s += (d ? ", " : "") + std::to_string(a.shape(d));
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) s += (d ? ", " : "") + std::to_string(a.shape(d));
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
@@ -164,8 +163,8 @@ Points asPoints(const py::handle& object, const char* name) {
 Points asVectors(const py::handle& object, std::size_t rows, const char* name) {
   Points p = asRows(object, name);
   if (p.size != rows)
-    throwValue(std::string(name) + ": expected " + std::to_string(rows) + " rows (one per point), got " +
-               std::to_string(p.size));
+    throwValue(std::string(name) + ": expected " + std::to_string(rows) +
+               " rows (one per point), got " + std::to_string(p.size));
   return p;
 }
 
@@ -186,7 +185,8 @@ std::vector<std::uint32_t> asIndices(const py::handle& object, const char* name,
   if (kind != 'i' && kind != 'u')
     throwType(std::string(name) + ": expected integer point indices, got dtype " +
               dtypeName(any.dtype()));
-  const auto values = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(any);
+  const auto values =
+      py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(any);
   if (values.ndim() != 1)
     throwValue(std::string(name) + ": expected a 1-D array of point indices, got shape " +
                shapeText(values));
@@ -219,14 +219,22 @@ py::array typed(const std::vector<double>& values) {
 py::array columnToArray(AttributeColumn&& column, bool nativeType) {
   if (!nativeType || column.type == ScalarType::Float64) return toArray(std::move(column.values));
   switch (column.type) {
-    case ScalarType::Int8: return typed<std::int8_t>(column.values);
-    case ScalarType::UInt8: return typed<std::uint8_t>(column.values);
-    case ScalarType::Int16: return typed<std::int16_t>(column.values);
-    case ScalarType::UInt16: return typed<std::uint16_t>(column.values);
-    case ScalarType::Int32: return typed<std::int32_t>(column.values);
-    case ScalarType::UInt32: return typed<std::uint32_t>(column.values);
-    case ScalarType::Float32: return typed<float>(column.values);
-    case ScalarType::Float64: break;
+    case ScalarType::Int8:
+      return typed<std::int8_t>(column.values);
+    case ScalarType::UInt8:
+      return typed<std::uint8_t>(column.values);
+    case ScalarType::Int16:
+      return typed<std::int16_t>(column.values);
+    case ScalarType::UInt16:
+      return typed<std::uint16_t>(column.values);
+    case ScalarType::Int32:
+      return typed<std::int32_t>(column.values);
+    case ScalarType::UInt32:
+      return typed<std::uint32_t>(column.values);
+    case ScalarType::Float32:
+      return typed<float>(column.values);
+    case ScalarType::Float64:
+      break;
   }
   return toArray(std::move(column.values));
 }
@@ -243,13 +251,15 @@ ScalarType scalarTypeOf(const py::dtype& dtype, const std::string& name) {
   if (kind == 'u' && size == 1) return ScalarType::UInt8;
   if (kind == 'u' && size == 2) return ScalarType::UInt16;
   if (kind == 'u' && size == 4) return ScalarType::UInt32;
-  throwType("attribute '" + name + "': files hold int8..int32, uint8..uint32, float32, float64 or "
-            "bool columns, got dtype " + dtypeName(dtype) +
-            " (convert it, e.g. .astype(np.int32))");
+  throwType("attribute '" + name +
+            "': files hold int8..int32, uint8..uint32, float32, float64 or "
+            "bool columns, got dtype " +
+            dtypeName(dtype) + " (convert it, e.g. .astype(np.int32))");
 }
 
 std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
-                                            const std::string& orient, const py::handle& viewpoint,
+                                            const std::string& orient,
+                                            const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
@@ -259,14 +269,12 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   NormalOrientationOptions o;
   o.k = k;
   if (orient == "mst") {
-    if (!viewpoint.is_none()) throw OptionError("viewpoint goes with orient='viewpoint'");
+    if (viewpoint) throw OptionError("viewpoint goes with orient='viewpoint'");
     o.method = OrientationMethod::MinimumSpanningTree;
   } else if (orient == "viewpoint") {
-    if (viewpoint.is_none()) throw OptionError("orient='viewpoint' needs viewpoint=(x, y, z)");
-    const DoubleArray v = asDoubles(viewpoint, "viewpoint", "three numbers");
-    if (v.size() != 3) throw OptionError("viewpoint expects three numbers (x, y, z)");
+    if (!viewpoint) throw OptionError("orient='viewpoint' needs viewpoint=(x, y, z)");
     o.method = OrientationMethod::Viewpoint;
-    o.viewpoint = Vec3(v.data()[0], v.data()[1], v.data()[2]) - cloud.origin();
+    o.viewpoint = *viewpoint - cloud.origin();  // the cloud works in recentred coordinates
   } else {
     throw OptionError("orient takes 'mst' or 'viewpoint', got '" + orient + "'");
   }
@@ -278,6 +286,13 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
       orientNormals(cloud.positions(), est.normals, *index, o, est.valid, progress);
   cloud.setNormals(std::move(est.normals));
   return std::move(ori.reliable);
+}
+
+std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name) {
+  if (object.is_none()) return std::nullopt;
+  const DoubleArray v = asDoubles(object, name, "three numbers");
+  if (v.size() != 3) throwValue(std::string(name) + ": expected three numbers (x, y, z)");
+  return Vec3(v.data()[0], v.data()[1], v.data()[2]);
 }
 
 void warn(const std::vector<std::string>& warnings) {

@@ -58,8 +58,7 @@ PointCloud makeCloud(const Points& points, const py::handle& normals);
 
 /// A 1-D integer array (point indices, labels) as `T`, with range checks against `limit` when
 /// given (index >= limit -> ValueError naming `name`).
-std::vector<std::uint32_t> asIndices(const py::handle& object, const char* name,
-                                     std::size_t limit);
+std::vector<std::uint32_t> asIndices(const py::handle& object, const char* name, std::size_t limit);
 
 /// Moves `values` into a NumPy array of `shape` (the product must be values.size()).
 template <class T>
@@ -126,10 +125,14 @@ class Call {
 
 /// Estimates (PCA over k neighbours) and orients normals in place, as `scalespace normals` and
 /// the commands that need normals do: orient "mst" or "viewpoint" (then `viewpoint`, absolute
-/// coordinates, is required). Returns the per-point reliability of the orientation.
-std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
-                                            const std::string& orient, const py::handle& viewpoint,
-                                            const ProgressCallback& progress);
+/// coordinates, is required). Returns the per-point reliability of the orientation. Needs no GIL.
+std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k = 10,
+                                            const std::string& orient = "mst",
+                                            const std::optional<Vec3>& viewpoint = std::nullopt,
+                                            const ProgressCallback& progress = {});
+
+/// Three numbers (x, y, z) or None.
+std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);
 
 /// Issues the library's result warnings (mostly invalid fits) as Python RuntimeWarnings, as the
 /// CLI prints them on stderr.

@@ -79,10 +79,10 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
                     const py::handle& viewpoint, std::optional<int> threads, py::object progress) {
   PointCloud cloud = makeCloud(asPoints(points), py::none());
+  const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   Call call(std::move(progress), threads);
-  std::vector<std::uint8_t> reliable = call([&] {
-    return estimateAndOrient(cloud, k, orient, viewpoint, call.progress());
-  });
+  std::vector<std::uint8_t> reliable =
+      call([&] { return estimateAndOrient(cloud, k, orient, view, call.progress()); });
   py::array_t<bool> reliableArray(py::ssize_t(reliable.size()));
   for (std::size_t i = 0; i < reliable.size(); ++i) reliableArray.mutable_data()[i] = reliable[i];
   return py::make_tuple(vectorsToArray(cloud.normals()), reliableArray);
@@ -106,7 +106,7 @@ py::dict curvaturePy(const py::handle& points, const py::handle& normals,
                       std::to_string(cloud.size()) + ")");
   Call call(std::move(progress), threads);
   const CurvatureSummary summary = call([&] {
-    if (!cloud.hasNormals()) estimateAndOrient(cloud, k, "mst", py::none(), call.progress());
+    if (!cloud.hasNormals()) estimateAndOrient(cloud, k, "mst", std::nullopt, call.progress());
     return computeCurvatureColumns(cloud, options, call.progress());
   });
   warn(summary.warnings);
@@ -141,8 +141,7 @@ py::array_t<std::uint8_t> renderPy(const py::handle& points, const py::handle& n
   auto column = [&](const py::handle& object, const char* name) {
     const DoubleArray a = DoubleArray::ensure(py::module_::import("numpy").attr("asarray")(object));
     if (!a || a.ndim() != 1 || std::size_t(a.size()) != n)
-      throwValue(std::string(name) + ": expected " + std::to_string(n) +
-                 " values (one per point)");
+      throwValue(std::string(name) + ": expected " + std::to_string(n) + " values (one per point)");
     AttributeColumn& c = cloud.addAttribute(name, ScalarType::Float64);
     c.values.assign(a.data(), a.data() + n);
   };
@@ -204,9 +203,8 @@ curv_mean curv_max curv_min dir_max_x .. dir_min_z gls_tau gls_kappa gls_fitness
 (float64), neighbors (int32), fit_valid (uint8; 0: invalid fit, zeros elsewhere).
 Most fits invalid: a RuntimeWarning says why.)doc");
   m.def("render", &renderPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
-        "colors"_a = py::none(), "labels"_a = py::none(), "values"_a = py::none(),
-        "view"_a = "iso", "up"_a = "z", "width"_a = 1024, "height"_a = 768,
-        "point_radius"_a = -1, "shading"_a = true,
+        "colors"_a = py::none(), "labels"_a = py::none(), "values"_a = py::none(), "view"_a = "iso",
+        "up"_a = "z", "width"_a = 1024, "height"_a = 768, "point_radius"_a = -1, "shading"_a = true,
         R"doc(Renders the points (software, orthographic) to an (height, width, 3) uint8 image.
 
 Colour by colors (N, 3) uint8, or labels (N,) integers (distinct hues, -1 grey), or values (N,)
