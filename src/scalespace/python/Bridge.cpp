@@ -77,7 +77,9 @@ PyObject* newException(py::module_& m, const char* name, PyObject* bases, const 
   return type;
 }
 
-std::string dtypeName(const py::dtype& dtype) { return py::cast<std::string>(dtype.attr("name")); }
+std::string dtypeName(const py::dtype& dtype) {
+  return py::str(py::handle(dtype)).cast<std::string>();
+}
 
 std::string shapeText(const py::array& a) {
   std::string s = "(";
