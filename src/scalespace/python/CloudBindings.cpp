@@ -2,6 +2,8 @@
 // mirrors its command's defaults (cli/CloudCommands.cpp, cli/PlanesCommands.cpp `render`).
 #include <pybind11/stl.h>
 
+#include <chrono>
+
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/io/CloudIO.hpp"
@@ -88,10 +90,10 @@ py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& 
   return py::make_tuple(vectorsToArray(cloud.normals()), reliableArray);
 }
 
-py::dict curvaturePy(const py::handle& points, const py::handle& normals,
-                     std::optional<double> scale, std::optional<int> scaleK,
-                     const std::string& estimator, bool mls, bool robust, std::size_t k,
-                     std::optional<int> threads, py::object progress) {
+py::object curvaturePy(const py::handle& points, const py::handle& normals,
+                       std::optional<double> scale, std::optional<int> scaleK,
+                       const std::string& estimator, bool mls, bool robust, std::size_t k,
+                       bool withSummary, std::optional<int> threads, py::object progress) {
   CurvatureOptions options;
   options.fit.estimator = parseEstimator(estimator);
   options.fit.mls = mls;
@@ -105,9 +107,15 @@ py::dict curvaturePy(const py::handle& points, const py::handle& normals,
                       " must be smaller than the number of points (" +
                       std::to_string(cloud.size()) + ")");
   Call call(std::move(progress), threads);
+  const bool estimated = !cloud.hasNormals();
+  double librarySeconds = 0;
   const CurvatureSummary summary = call([&] {
-    if (!cloud.hasNormals()) estimateAndOrient(cloud, k, "mst", std::nullopt, call.progress());
-    return computeCurvatureColumns(cloud, options, call.progress());
+    if (estimated) estimateAndOrient(cloud, k, "mst", std::nullopt, call.progress());
+    const auto start = std::chrono::steady_clock::now();
+    CurvatureSummary s = computeCurvatureColumns(cloud, options, call.progress());
+    librarySeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return s;
   });
   warn(summary.warnings);
   // The columns, moved out of the cloud (no copy), under the names `scalespace curvature` writes.
@@ -118,7 +126,18 @@ py::dict curvaturePy(const py::handle& points, const py::handle& normals,
     const bool integer = isIntegerType(column->type);
     out[py::str(name)] = columnToArray(std::move(*column), integer);
   }
-  return out;
+  if (!withSummary) return std::move(out);
+  // What `scalespace curvature` writes in its JSON summary.
+  py::dict s;
+  s["points"] = summary.points;
+  s["invalid_fits"] = summary.invalid;
+  s["mean_neighbors"] = summary.meanNeighbors;
+  s["median_scale"] = summary.medianScale;
+  s["seconds"] = summary.seconds;
+  s["library_seconds"] = librarySeconds;
+  s["normals_estimated"] = estimated;
+  s["warnings"] = summary.warnings;
+  return py::make_tuple(out, s);
 }
 
 py::array_t<std::uint8_t> renderPy(const py::handle& points, const py::handle& normals,
@@ -191,7 +210,8 @@ viewpoint=(x, y, z), a scanner position in the points' coordinates).
 Returns (normals (N, 3) float64, reliable (N,) bool: False where the orientation is a guess).)doc");
   m.def("curvature", &curvaturePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scale_k"_a = py::none(), "estimator"_a = "w3", "mls"_a = false,
-        "robust"_a = false, "k"_a = 10, "threads"_a = py::none(), "progress"_a = py::none(),
+        "robust"_a = false, "k"_a = 10, "summary"_a = false, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Normals, mean and principal curvatures and directions at one scale (Ch. 1).
 
 Give exactly one of scale (support radius t, in the points' units) and scale_k (per point,
@@ -201,7 +221,9 @@ w2 | w1 | plane | mean | quadric | jet. mls: iterate the MLS projection; robust:
 Returns a dict of (N,) arrays named as the columns `scalespace curvature` writes: nx ny nz
 curv_mean curv_max curv_min dir_max_x .. dir_min_z gls_tau gls_kappa gls_fitness anisotropy
 (float64), neighbors (int32), fit_valid (uint8; 0: invalid fit, zeros elsewhere).
-Most fits invalid: a RuntimeWarning says why.)doc");
+Most fits invalid: a RuntimeWarning says why. summary=True returns (columns, summary): the
+figures of the CLI's JSON summary (points, invalid_fits, mean_neighbors, median_scale, seconds:
+the fits' time, library_seconds: the whole library call's, normals_estimated, warnings).)doc");
   m.def("render", &renderPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "colors"_a = py::none(), "labels"_a = py::none(), "values"_a = py::none(), "view"_a = "iso",
         "up"_a = "z", "width"_a = 1024, "height"_a = 768, "point_radius"_a = -1, "shading"_a = true,
