@@ -32,6 +32,7 @@ from ._scalespace import (  # noqa: F401
     lines,
     open_stack,
     planes,
+    read_mesh,
     read_planes,
     render,
 )
@@ -39,7 +40,7 @@ from . import _scalespace
 
 __all__ = [
     "Cloud", "read", "write", "estimate_normals", "curvature", "compute_stack", "open_stack",
-    "Stack", "planes", "read_planes", "Planes", "render", "lines", "features", "Error",
+    "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "Error",
     "OptionError", "FileError", "Cancelled", "__version__",
 ]
 

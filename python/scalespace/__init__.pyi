@@ -93,14 +93,17 @@ def read_planes(directory: str) -> Planes: ...
 def render(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
            colors: Optional[ArrayLike] = ..., labels: Optional[ArrayLike] = ...,
            values: Optional[ArrayLike] = ..., view: str = ..., up: str = ..., width: int = ...,
-           height: int = ..., point_radius: int = ..., shading: bool = ...) -> np.ndarray: ...
+           height: int = ..., point_radius: int = ..., shading: bool = ...,
+           lines: Optional[Dict[str, np.ndarray]] = ..., line_color_by: str = ...) -> np.ndarray: ...
 def lines(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scale: Optional[float] = ...,
           scales: Optional[int] = ..., tmin: float = ..., tmax: float = ..., beta: float = ...,
           gamma: float = ..., alpha: float = ..., robust: bool = ..., max_steps: int = ...,
           threads: Optional[int] = ..., progress: Progress = ...) -> Dict[str, np.ndarray]: ...
+def read_mesh(path: str) -> Tuple[np.ndarray, np.ndarray]: ...
 def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
              spacing: float = ..., vote_threshold: float = ..., min_scales: int = ...,
              min_curvature: float = ..., salient_threshold: float = ..., min_extent: float = ...,
              all_salient: bool = ..., beta: float = ..., gamma: float = ...,
-             with_lines: bool = ..., threads: Optional[int] = ...,
+             with_lines: bool = ..., triangles: Optional[ArrayLike] = ...,
+             mesh_samples: int = ..., threads: Optional[int] = ...,
              progress: Progress = ...) -> Dict[str, object]: ...

@@ -158,12 +158,69 @@ def test_stack_in_memory_equals_the_stack_on_disk_and_the_export(data, tmp_path)
     assert np.isfinite(layer["curv_mean"]).all() and layer["normal"].flags.owndata is False
 
 
+def test_lines_and_features_equal_the_cli(data, tmp_path):
+    cli("lines", data / "house.ply", "-o", tmp_path / "l.ply", "--scale", 0.6)
+    cli("features", data / "house.ply", "-o", tmp_path / "f.ply")
+    cloud = ss.read(str(data / "house.ply"))
+    lines = ss.lines(cloud.points, cloud.normals, scale=0.6)
+    written = ss.read(str(tmp_path / "l.ply"))  # the vertex element: one row per line vertex
+    np.testing.assert_allclose(lines["vertices"], written.points, rtol=0, atol=1e-9)
+    for name in ("line_id", "k1", "k_gap"):
+        np.testing.assert_array_equal(lines[name].astype(written.attributes[name].dtype),
+                                      written.attributes[name], name)
+    features = ss.features(cloud.points, cloud.normals)
+    labelled = ss.read(str(tmp_path / "f.ply")).attributes
+    for name in ("feature_votes", "curve_id", "convexity"):
+        np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
+                                      labelled[name], name)
+    assert len(features["curves"]) == features["curve_id"].max() + 1
+
+
+def cube_obj(path, n=12):
+    """A unit cube, each face an n x n grid of vertices cut into triangles (faces not welded)."""
+    lines, base = [], 1
+    g = np.linspace(-1, 1, n)
+    for axis in range(3):
+        for side in (-1.0, 1.0):
+            for u in g:
+                for v in g:
+                    p = [u, v]
+                    p.insert(axis, side)
+                    lines.append("v %r %r %r" % tuple(p))
+            for i in range(n - 1):
+                for j in range(n - 1):
+                    a = base + i * n + j
+                    lines += ["f %d %d %d" % (a, a + n, a + 1), "f %d %d %d" % (a + 1, a + n, a + n + 1)]
+            base += n * n
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_features_on_a_mesh_equal_the_cli(tmp_path):
+    cube_obj(tmp_path / "cube.obj")
+    cli("features", tmp_path / "cube.obj", "-o", tmp_path / "f.ply")
+    vertices, triangles = ss.read_mesh(str(tmp_path / "cube.obj"))
+    assert vertices.shape == (864, 3) and triangles.shape == (6 * 2 * 121, 3)
+    with pytest.warns(RuntimeWarning, match="the mesh is coarse"):  # the CLI's warning, too
+        features = ss.features(vertices, triangles=triangles)
+    labelled = ss.read(str(tmp_path / "f.ply")).attributes
+    for name in ("feature_votes", "curve_id", "convexity"):
+        np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
+                                      labelled[name], name)
+    with pytest.raises(ValueError, match="triangles: row 0 names vertex 864"):
+        ss.features(vertices, triangles=np.full((1, 3), 864))
+
+
 def test_render_lines_features(data):
     cloud = ss.read(str(data / "house.ply"))
     image = ss.render(cloud.points, labels=cloud.attributes["gt_face"], width=80, height=60)
     assert image.shape == (60, 80, 3) and image.dtype == np.uint8 and image.std() > 0
     lines = ss.lines(cloud.points, scale=0.6)
     assert lines["offsets"][-1] == len(lines["vertices"]) > 0
+    over = ss.render(cloud.points, labels=cloud.attributes["gt_face"], width=80, height=60,
+                     lines=lines, line_color_by="k_gap")
+    assert over.shape == image.shape and (over != image).any()
+    with pytest.raises(ss.OptionError, match="line_color_by|no_such"):
+        ss.render(cloud.points, lines=lines, line_color_by="no_such")
     features = ss.features(cloud.points)
     assert features["curve_id"].shape == (12000,) and len(features["curves"]) > 0
 

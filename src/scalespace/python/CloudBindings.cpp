@@ -7,8 +7,10 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
 #include "scalespace/python/Bindings.hpp"
 #include "scalespace/python/Bridge.hpp"
+#include "scalespace/render/LineRenderer.hpp"
 #include "scalespace/render/PointRenderer.hpp"
 
 namespace scalespace::python {
@@ -140,11 +142,51 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
   return py::make_tuple(out, s);
 }
 
+// The dict lines() returns as the library's polylines: vertices (absolute), offsets, closed, and
+// its per-vertex arrays as columns (what line_color_by names).
+PolylineSet polylinesFrom(const py::handle& object) {
+  if (!py::isinstance<py::dict>(object))
+    throwType("lines: expected the dict that scalespace.lines() returns");
+  const py::dict d = py::reinterpret_borrow<py::dict>(object);
+  for (const char* key : {"vertices", "offsets"})
+    if (!d.contains(key)) throwValue(std::string("lines: no '") + key + "' entry");
+  PolylineSet set;
+  const py::array any = py::module_::import("numpy").attr("asarray")(d["vertices"]);
+  if (any.size() == 0) return set;
+  const Points vertices = asPoints(any, "lines['vertices']");
+  set.vertices.setAbsolutePositions(vertices.data, vertices.size);
+  const auto offsets = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(
+      py::module_::import("numpy").attr("asarray")(d["offsets"]));
+  if (!offsets || offsets.ndim() != 1) throwValue("lines['offsets']: expected a 1-D array");
+  set.offsets.clear();
+  for (py::ssize_t i = 0; i < offsets.size(); ++i) {
+    if (offsets.data()[i] < 0) throwValue("lines['offsets']: negative offset");
+    set.offsets.push_back(std::size_t(offsets.data()[i]));
+  }
+  if (d.contains("closed")) {
+    const auto closed =
+        py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(
+            py::module_::import("numpy").attr("asarray")(d["closed"]));
+    if (closed) set.closed.assign(closed.data(), closed.data() + closed.size());
+  }
+  for (const auto& [key, value] : d) {
+    const std::string name = py::cast<std::string>(key);
+    const py::array a = py::module_::import("numpy").attr("asarray")(value);
+    if (a.ndim() != 1 || std::size_t(a.size()) != vertices.size || name == "offsets") continue;
+    const auto values = DoubleArray::ensure(a);
+    set.vertices.addAttribute(name, ScalarType::Float64)
+        .values.assign(values.data(), values.data() + values.size());
+  }
+  validatePolylineSet(set, "lines");
+  return set;
+}
+
 py::array_t<std::uint8_t> renderPy(const py::handle& points, const py::handle& normals,
                                    const py::handle& colors, const py::handle& labels,
                                    const py::handle& values, const std::string& view,
                                    const std::string& up, int width, int height, int pointRadius,
-                                   bool shading) {
+                                   bool shading, const py::handle& lines,
+                                   const std::string& lineColorBy) {
   RenderOptions options;
   options.width = width;
   options.height = height;
@@ -179,10 +221,22 @@ py::array_t<std::uint8_t> renderPy(const py::handle& points, const py::handle& n
     for (std::size_t i = 0; i < n; ++i)
       options.colors[i] = Rgb{rgb.data()[3 * i], rgb.data()[3 * i + 1], rgb.data()[3 * i + 2]};
   }
+  // The lines first, as `render --lines` reads them: a bad colour attribute fails before drawing.
+  PolylineSet polylines;
+  LineRenderOptions lineOptions;
+  lineOptions.colorAttribute = lineColorBy;
+  if (!lines.is_none()) {
+    polylines = polylinesFrom(lines);
+    polylineColors(polylines, lineOptions);
+  } else if (!lineColorBy.empty()) {
+    throw OptionError("line_color_by goes with lines");
+  }
   Image image;
   {
     py::gil_scoped_release release;
-    image = renderPoints(cloud, options);
+    Rendering rendering = renderPointsWithDepth(cloud, options);
+    if (!lines.is_none()) drawPolylines(rendering, polylines, lineOptions);
+    image = std::move(rendering.image);
   }
   std::vector<std::uint8_t> pixels(3 * image.pixels.size());
   for (std::size_t i = 0; i < image.pixels.size(); ++i) {
@@ -227,11 +281,14 @@ the fits' time, library_seconds: the whole library call's, normals_estimated, wa
   m.def("render", &renderPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "colors"_a = py::none(), "labels"_a = py::none(), "values"_a = py::none(), "view"_a = "iso",
         "up"_a = "z", "width"_a = 1024, "height"_a = 768, "point_radius"_a = -1, "shading"_a = true,
+        "lines"_a = py::none(), "line_color_by"_a = "",
         R"doc(Renders the points (software, orthographic) to an (height, width, 3) uint8 image.
 
 Colour by colors (N, 3) uint8, or labels (N,) integers (distinct hues, -1 grey), or values (N,)
 (viridis over the 2nd-98th percentile); else light grey. view: front | top | iso | "X,Y,Z";
-up: the cloud's up axis (z | y | x | -z | -y | -x). point_radius -1: automatic.)doc");
+up: the cloud's up axis (z | y | x | -z | -y | -x). point_radius -1: automatic.
+lines: the dict lines() returns, drawn over the points where the surface does not hide them
+(solid red, or coloured by one of its per-vertex arrays: line_color_by="k_gap").)doc");
 }
 
 }  // namespace scalespace::python

@@ -8,6 +8,8 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/features/CurvatureLines.hpp"
 #include "scalespace/features/FeatureCurves.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/MeshFormat.hpp"
 #include "scalespace/python/Bindings.hpp"
 #include "scalespace/python/Bridge.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
@@ -101,10 +103,51 @@ py::dict linesPy(const py::handle& points, const py::handle& normals, std::optio
   return linesToDict(sets, cloud.origin());
 }
 
+/// Mesh inputs: triangles with a vertex normal this far from their own take the face normal
+/// (the CLI's kCreaseAngleDegrees, cli/FeatureCommands.cpp).
+constexpr double kCreaseAngleDegrees = 30;
+
+/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1), as the CLI takes
+/// it.
+double medianEdgeLength(const TriangleMesh& mesh) {
+  std::vector<double> lengths;
+  lengths.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c)
+      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
+                   lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
+  const py::array any = py::module_::import("numpy").attr("asarray")(triangles);
+  const char kind = any.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throwType("triangles: expected integer vertex indices of shape (T, 3)");
+  const auto t = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(any);
+  if (t.ndim() != 2 || t.shape(1) != 3 || t.shape(0) == 0)
+    throwValue("triangles: expected an array of shape (T, 3) with T >= 1");
+  TriangleMesh mesh;
+  mesh.vertices.assign(vertices.data, vertices.data + vertices.size);
+  mesh.triangles.resize(std::size_t(t.shape(0)));
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const long long v = t.data()[3 * f + std::size_t(c)];
+      if (v < 0 || std::size_t(v) >= vertices.size)
+        throwValue("triangles: row " + std::to_string(f) + " names vertex " + std::to_string(v) +
+                   ", not one of the " + std::to_string(vertices.size) + " points");
+      mesh.triangles[f][std::size_t(c)] = Index(v);
+    }
+  mesh.normals = areaWeightedVertexNormals(mesh);
+  return mesh;
+}
+
 py::dict featuresPy(const py::handle& points, const py::handle& normals, int scales, double spacing,
                     double voteThreshold, int minScales, double minCurvature,
                     double salientThreshold, double minExtent, bool allSalient, double beta,
-                    double gamma, bool withLines, std::optional<int> threads, py::object progress) {
+                    double gamma, bool withLines, const py::handle& triangles,
+                    std::size_t meshSamples, std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -117,12 +160,40 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   options.lines.beta = beta;
   options.lines.gamma = gamma;
   validateFeatureCurveOptions(options);
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  if (meshSamples < 1 || meshSamples > 10000)
+    throw OptionError("mesh_samples must be in [1, 10000]");
+  PointCloud cloud;
+  std::optional<TriangleMesh> mesh;
+  std::vector<std::string> warnings;
+  if (triangles.is_none()) {
+    cloud = makeCloud(asPoints(points), normals);
+  } else {
+    // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
+    // edges, as `scalespace features` does with an OFF/OBJ input.
+    if (!normals.is_none())
+      throw OptionError("normals go with a cloud; a mesh's come from its faces");
+    mesh = meshFrom(asPoints(points), triangles);
+  }
   Call call(std::move(progress), threads);
   FeatureCurveResult result = call([&] {
-    if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
-    return detectFeatureCurves(cloud, options, call.progress());
+    if (!mesh) {
+      if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+      return detectFeatureCurves(cloud, options, call.progress());
+    }
+    cloud = sampleMesh(*mesh, meshSamples * mesh->vertices.size(), 1, kCreaseAngleDegrees);
+    if (options.spacing == 0) {
+      options.spacing = medianEdgeLength(*mesh);
+      if (options.spacing > 0.05 * cloud.boundingBoxDiagonal())
+        warnings.push_back("the mesh is coarse (median edge " + std::to_string(options.spacing) +
+                           ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
+                           "faces; give a finer spacing, or remesh it");
+    }
+    std::vector<Vec3> targets = mesh->vertices;  // in the cloud's (recentred) frame
+    for (Vec3& v : targets) v -= cloud.origin();
+    const KnnGraph graph = buildMeshEdgeGraph(mesh->vertices.size(), mesh->triangles);
+    return detectFeatureCurves(cloud, options, targets, graph, call.progress());
   });
+  warn(warnings);
   py::dict d;
   d["feature_votes"] = toArray(std::move(result.votes));
   d["curve_id"] = toArray(std::move(result.curveId));
@@ -176,14 +247,33 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3,
         "min_curvature"_a = 0.6, "salient_threshold"_a = 0.5, "min_extent"_a = 1.0,
         "all_salient"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5, "with_lines"_a = false,
-        "threads"_a = py::none(), "progress"_a = py::none(),
+        "triangles"_a = py::none(), "mesh_samples"_a = 100, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
 
 Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
 (e), max_vote, curves (per curve: points, length, convexity, the scales that voted), scales (per
 scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
 traced (as lines() returns them). all_salient=True, min_scales=1, min_curvature=0 restore the
-thesis' rules.)doc");
+thesis' rules. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
+mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
+  m.def(
+      "read_mesh",
+      [](const std::string& path) {
+        TriangleMesh mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = readTriangleMesh(path);
+        }
+        std::vector<std::uint32_t> flat(3 * mesh.triangles.size());
+        for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+          for (std::size_t c = 0; c < 3; ++c) flat[3 * f + c] = mesh.triangles[f][c];
+        return py::make_tuple(vectorsToArray(mesh.vertices),
+                              toArray(std::move(flat), {py::ssize_t(mesh.triangles.size()), 3}));
+      },
+      "path"_a,
+      "The vertices (V, 3) float64 and triangles (T, 3) uint32 of an OFF or OBJ mesh (polygons "
+      "as fans).");
 }
 
 }  // namespace scalespace::python
