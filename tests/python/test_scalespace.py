@@ -225,6 +225,19 @@ def test_render_lines_features(data):
     assert features["curve_id"].shape == (12000,) and len(features["curves"]) > 0
 
 
+def test_any_layout_gives_the_same_result_and_inputs_stay_untouched():
+    p = sphere_points(3000)
+    before = p.copy()
+    c_order = ss.curvature(p, p, scale_k=20)
+    np.testing.assert_array_equal(p, before)
+    fortran = ss.curvature(np.asfortranarray(p), np.asfortranarray(p), scale_k=20)
+    strided = ss.curvature(np.repeat(p, 2, axis=0)[::2], p.tolist(), scale_k=20)
+    for name in c_order:
+        np.testing.assert_array_equal(fortran[name], c_order[name], name)
+        np.testing.assert_array_equal(strided[name], c_order[name], name)
+        assert c_order[name].flags.c_contiguous and c_order[name].shape == (3000,)
+
+
 # ----------------------------------------------------------------------------- bad inputs
 @pytest.mark.parametrize("points,error,message", [
     (np.zeros((10, 2)), ValueError, "points: expected an array of shape (N, 3), got shape (10, 2)"),
