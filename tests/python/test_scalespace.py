@@ -296,15 +296,17 @@ def test_progress_callback_cancels_and_leaves_no_stack(tmp_path):
         ss.curvature(p, p, scale_k=30, progress=boom)
 
 
-def test_ctrl_c_cancels_a_long_call():
+def test_ctrl_c_cancels_a_long_call_and_leaves_no_output(tmp_path):
     p = sphere_points(200000)
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
     start = time.monotonic()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        ss.compute_stack(p, p, scales=200)  # about a minute without the interrupt
+        # About a minute without the interrupt.
+        ss.compute_stack(p, p, scales=200, path=str(tmp_path / "s.stack"))
     assert time.monotonic() - start < 10
     timer.join()
+    assert list(tmp_path.iterdir()) == []  # nor any temporary folder
 
 
 def test_two_threads_overlap_in_time():
