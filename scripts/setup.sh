@@ -13,6 +13,7 @@ packages=(
   libpng-dev zlib1g-dev
   clang-format
   python3 python3-numpy
+  pybind11-dev python3-pybind11 python3-pytest
 )
 
 missing=()

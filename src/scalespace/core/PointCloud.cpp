@@ -52,9 +52,14 @@ bool isIntegerType(ScalarType type) {
 }
 
 void PointCloud::setAbsolutePositions(const std::vector<Vec3>& absolute) {
+  setAbsolutePositions(absolute.data(), absolute.size());
+}
+
+void PointCloud::setAbsolutePositions(const Vec3* absolute, std::size_t count) {
   Vec3 lo = Vec3::Constant(0), hi = Vec3::Constant(0);
   bool first = true;
-  for (const Vec3& p : absolute) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec3& p = absolute[i];
     if (!p.allFinite()) continue;  // readers reject non-finite points; be defensive here
     if (first) {
       lo = hi = p;
@@ -68,8 +73,8 @@ void PointCloud::setAbsolutePositions(const std::vector<Vec3>& absolute) {
   // whenever the cloud does not straddle far from its centre); small clouds keep origin 0.
   const Vec3 centre = 0.5 * lo + 0.5 * hi;  // lo + hi would overflow near DBL_MAX
   origin_ = centre.cwiseAbs().maxCoeff() < 1e3 ? Vec3::Zero() : Vec3(centre.array().round());
-  positions_.resize(absolute.size());
-  for (std::size_t i = 0; i < absolute.size(); ++i) positions_[i] = absolute[i] - origin_;
+  positions_.resize(count);
+  for (std::size_t i = 0; i < count; ++i) positions_[i] = absolute[i] - origin_;
   resizeColumns();
 }
 

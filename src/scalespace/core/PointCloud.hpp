@@ -87,6 +87,9 @@ class PointCloud {
   /// Replaces all positions with absolute coordinates and recentres them (see file comment).
   /// Attribute columns and normals are resized to the new size.
   void setAbsolutePositions(const std::vector<Vec3>& absolute);
+  /// Same from `count` packed positions (x y z doubles), e.g. a NumPy array's buffer, which then
+  /// needs no intermediate vector.
+  void setAbsolutePositions(const Vec3* absolute, std::size_t count);
   /// Positions relative to origin(); what every algorithm works on.
   const std::vector<Vec3>& positions() const { return positions_; }
   std::vector<Vec3>& positions() { return positions_; }

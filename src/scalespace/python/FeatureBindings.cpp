@@ -1,0 +1,279 @@
+// Curvature lines (Sec. 3.3) and feature curves (Sec. 3.4.1) from Python, with the options and
+// defaults of `scalespace lines` and `scalespace features` (cli/FeatureCommands.cpp), on points.
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/features/CurvatureLines.hpp"
+#include "scalespace/features/FeatureCurves.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/MeshFormat.hpp"
+#include "scalespace/python/Bindings.hpp"
+#include "scalespace/python/Bridge.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
+
+namespace scalespace::python {
+namespace {
+
+// Every line of `sets` as arrays: vertices line after line, with the per-vertex quantities the
+// CLI writes as PLY properties (line_id scale k1 k2 k_gap nu, the tangent and the normal) and
+// offsets (line l is vertices[offsets[l]:offsets[l + 1]]).
+py::dict linesToDict(const std::vector<CurvatureLineSet>& sets, const Vec3& origin) {
+  std::vector<Vec3> positions, normals, tangents;
+  std::vector<int> lineId;
+  std::vector<double> scale, k1, k2, gap, nu;
+  std::vector<std::uint64_t> offsets{0};
+  std::vector<std::uint8_t> closed;
+  std::vector<std::uint32_t> seeds;
+  int id = 0;
+  for (const CurvatureLineSet& set : sets)
+    for (const CurvatureLine& line : set.lines) {
+      for (const CurvatureLineVertex& v : line.vertices) {
+        positions.push_back(v.position);
+        normals.push_back(v.normal);
+        tangents.push_back(v.tangent);
+        lineId.push_back(id);
+        scale.push_back(set.scale);
+        k1.push_back(v.kappa1);
+        k2.push_back(v.kappa2);
+        gap.push_back(std::abs(v.kappa1) - std::abs(v.kappa2));
+        nu.push_back(v.geometricVariation);
+      }
+      offsets.push_back(positions.size());
+      closed.push_back(line.closed ? 1 : 0);
+      seeds.push_back(line.seed);
+      ++id;
+    }
+  py::dict d;
+  d["vertices"] = vectorsToArray(positions, origin);
+  d["normal"] = vectorsToArray(normals);
+  d["tangent"] = vectorsToArray(tangents);
+  d["line_id"] = toArray(std::move(lineId));
+  d["scale"] = toArray(std::move(scale));
+  d["k1"] = toArray(std::move(k1));
+  d["k2"] = toArray(std::move(k2));
+  d["k_gap"] = toArray(std::move(gap));
+  d["nu"] = toArray(std::move(nu));
+  d["offsets"] = toArray(std::move(offsets));
+  d["closed"] = toArray(std::move(closed));
+  d["seed"] = toArray(std::move(seeds));
+  return d;
+}
+
+py::dict linesPy(const py::handle& points, const py::handle& normals, std::optional<double> scale,
+                 std::optional<int> scales, double tmin, double tmax, double beta, double gamma,
+                 double alpha, bool robust, int maxSteps, std::optional<int> threads,
+                 py::object progress) {
+  if (scale.value_or(0) <= 0 && scales.value_or(0) <= 0)
+    throw OptionError("give the scale: scale=T, or scales=M for M scales");
+  if (scale && scales) throw OptionError("give scale or scales, not both");
+  if (scales) validateScaleCount(*scales);
+  CurvatureLineOptions options;
+  options.beta = beta;
+  options.gamma = gamma;
+  options.alpha = alpha;
+  options.maxSteps = maxSteps;
+  options.fit.robust = robust;
+  options.scale = scale.value_or(1);
+  validateCurvatureLineOptions(options);
+  PointCloud cloud = makeCloud(asPoints(points), normals);
+  Call call(std::move(progress), threads);
+  std::vector<CurvatureLineSet> sets = call([&] {
+    if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+    // The CLI's series for --scales: from the mean 16-NN distance to a tenth of the diagonal.
+    std::vector<double> ts{scale.value_or(0)};
+    if (scales) {
+      const double lo = tmin > 0 ? tmin : meanKthNeighborDistance(cloud.positions(), 16);
+      const double hi = tmax > 0 ? tmax : 0.1 * cloud.boundingBoxDiagonal();
+      ts = scaleSeries(lo, std::max(hi, lo), *scales, ScaleSpacing::Log);
+    }
+    std::vector<CurvatureLineSet> out;
+    for (std::size_t s = 0; s < ts.size(); ++s) {
+      options.scale = ts[s];
+      const ProgressCallback& progress = call.progress();
+      const auto scaleProgress = [&](double f, std::string_view stage) {
+        return progress((double(s) + f) / double(ts.size()), stage);
+      };
+      out.push_back(traceCurvatureLines(cloud, options, scaleProgress));
+    }
+    return out;
+  });
+  return linesToDict(sets, cloud.origin());
+}
+
+/// Mesh inputs: triangles with a vertex normal this far from their own take the face normal
+/// (the CLI's kCreaseAngleDegrees, cli/FeatureCommands.cpp).
+constexpr double kCreaseAngleDegrees = 30;
+
+/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1), as the CLI takes
+/// it.
+double medianEdgeLength(const TriangleMesh& mesh) {
+  std::vector<double> lengths;
+  lengths.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c)
+      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
+                   lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
+  const py::array any = py::module_::import("numpy").attr("asarray")(triangles);
+  const char kind = any.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throwType("triangles: expected integer vertex indices of shape (T, 3)");
+  const auto t = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(any);
+  if (t.ndim() != 2 || t.shape(1) != 3 || t.shape(0) == 0)
+    throwValue("triangles: expected an array of shape (T, 3) with T >= 1");
+  TriangleMesh mesh;
+  mesh.vertices.assign(vertices.data, vertices.data + vertices.size);
+  mesh.triangles.resize(std::size_t(t.shape(0)));
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const long long v = t.data()[3 * f + std::size_t(c)];
+      if (v < 0 || std::size_t(v) >= vertices.size)
+        throwValue("triangles: row " + std::to_string(f) + " names vertex " + std::to_string(v) +
+                   ", not one of the " + std::to_string(vertices.size) + " points");
+      mesh.triangles[f][std::size_t(c)] = Index(v);
+    }
+  mesh.normals = areaWeightedVertexNormals(mesh);
+  return mesh;
+}
+
+py::dict featuresPy(const py::handle& points, const py::handle& normals, int scales, double spacing,
+                    double voteThreshold, int minScales, double minCurvature,
+                    double salientThreshold, double minExtent, bool allSalient, double beta,
+                    double gamma, bool withLines, const py::handle& triangles,
+                    std::size_t meshSamples, std::optional<int> threads, py::object progress) {
+  FeatureCurveOptions options;
+  options.scaleCount = scales;
+  options.spacing = spacing;
+  options.voteThreshold = voteThreshold;
+  options.minVotingScales = minScales;
+  options.minSalientCurvature = minCurvature;
+  options.salientThreshold = salientThreshold;
+  options.minCurveExtent = minExtent;
+  options.ridgeOnly = !allSalient;
+  options.lines.beta = beta;
+  options.lines.gamma = gamma;
+  validateFeatureCurveOptions(options);
+  if (meshSamples < 1 || meshSamples > 10000)
+    throw OptionError("mesh_samples must be in [1, 10000]");
+  PointCloud cloud;
+  std::optional<TriangleMesh> mesh;
+  std::vector<std::string> warnings;
+  if (triangles.is_none()) {
+    cloud = makeCloud(asPoints(points), normals);
+  } else {
+    // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
+    // edges, as `scalespace features` does with an OFF/OBJ input.
+    if (!normals.is_none())
+      throw OptionError("normals go with a cloud; a mesh's come from its faces");
+    mesh = meshFrom(asPoints(points), triangles);
+  }
+  Call call(std::move(progress), threads);
+  FeatureCurveResult result = call([&] {
+    if (!mesh) {
+      if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+      return detectFeatureCurves(cloud, options, call.progress());
+    }
+    cloud = sampleMesh(*mesh, meshSamples * mesh->vertices.size(), 1, kCreaseAngleDegrees);
+    if (options.spacing == 0) {
+      options.spacing = medianEdgeLength(*mesh);
+      if (options.spacing > 0.05 * cloud.boundingBoxDiagonal())
+        warnings.push_back("the mesh is coarse (median edge " + std::to_string(options.spacing) +
+                           ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
+                           "faces; give a finer spacing, or remesh it");
+    }
+    std::vector<Vec3> targets = mesh->vertices;  // in the cloud's (recentred) frame
+    for (Vec3& v : targets) v -= cloud.origin();
+    const KnnGraph graph = buildMeshEdgeGraph(mesh->vertices.size(), mesh->triangles);
+    return detectFeatureCurves(cloud, options, targets, graph, call.progress());
+  });
+  warn(warnings);
+  py::dict d;
+  d["feature_votes"] = toArray(std::move(result.votes));
+  d["curve_id"] = toArray(std::move(result.curveId));
+  d["convexity"] = toArray(std::move(result.convexity));
+  d["spacing"] = result.spacing;
+  d["max_vote"] = result.maxVote;
+  py::list curves;
+  for (FeatureCurve& curve : result.curves) {
+    py::dict c;
+    std::vector<double> voted;
+    for (std::size_t s = 0; s < result.scales.size(); ++s)
+      if (curve.scaleMask >> s & 1) voted.push_back(result.scales[s].scale);
+    c["points"] = toArray(std::move(curve.points));
+    c["length"] = curve.length;
+    c["convexity"] = curve.convexity > 0 ? "convex" : "concave";
+    c["scales"] = toArray(std::move(voted));
+    curves.append(c);
+  }
+  d["curves"] = curves;
+  py::list perScale;
+  for (const FeatureCurveScale& s : result.scales) {
+    py::dict e;
+    e["scale"] = s.scale;
+    e["salient_bound"] = s.salientBound;
+    e["lines"] = s.lines;
+    e["vertices"] = s.vertices;
+    e["salient_vertices"] = s.salientVertices;
+    perScale.append(e);
+  }
+  d["scales"] = perScale;
+  if (withLines) d["lines"] = linesToDict(result.lineSets, cloud.origin());
+  return d;
+}
+
+}  // namespace
+
+void bindFeatures(py::module_& m) {
+  using namespace pybind11::literals;
+  m.def("lines", &linesPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
+        "scale"_a = py::none(), "scales"_a = py::none(), "tmin"_a = 0.0, "tmax"_a = 0.0,
+        "beta"_a = 0.5, "gamma"_a = 0.5, "alpha"_a = 0.1, "robust"_a = false, "max_steps"_a = 2000,
+        "threads"_a = py::none(), "progress"_a = py::none(),
+        R"doc(Minimal-curvature lines on the APSS (Sec. 3.3), as `scalespace lines`.
+
+Give scale=T, or scales=M (log-spaced from tmin, default the mean 16-NN distance, to tmax,
+default a tenth of the diagonal). beta: seeds' Poisson-disk radius / t; gamma: step / t;
+alpha: pyramid radius / t. Returns a dict: vertices (V, 3) absolute, normal, tangent (V, 3),
+line_id, scale, k1, k2, k_gap, nu (V,), offsets (L + 1,: line l is
+vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it started from).)doc");
+  m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
+        "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3,
+        "min_curvature"_a = 0.6, "salient_threshold"_a = 0.5, "min_extent"_a = 1.0,
+        "all_salient"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5, "with_lines"_a = false,
+        "triangles"_a = py::none(), "mesh_samples"_a = 100, "threads"_a = py::none(),
+        "progress"_a = py::none(),
+        R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
+
+Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
+(e), max_vote, curves (per curve: points, length, convexity, the scales that voted), scales (per
+scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
+traced (as lines() returns them). all_salient=True, min_scales=1, min_curvature=0 restore the
+thesis' rules. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
+mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
+  m.def(
+      "read_mesh",
+      [](const std::string& path) {
+        TriangleMesh mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = readTriangleMesh(path);
+        }
+        std::vector<std::uint32_t> flat(3 * mesh.triangles.size());
+        for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+          for (std::size_t c = 0; c < 3; ++c) flat[3 * f + c] = mesh.triangles[f][c];
+        return py::make_tuple(vectorsToArray(mesh.vertices),
+                              toArray(std::move(flat), {py::ssize_t(mesh.triangles.size()), 3}));
+      },
+      "path"_a,
+      "The vertices (V, 3) float64 and triangles (T, 3) uint32 of an OFF or OBJ mesh (polygons "
+      "as fans).");
+}
+
+}  // namespace scalespace::python

@@ -1,0 +1,327 @@
+"""The Python module against the CLI and its own promises (issue 22). Run by ctest (Python.Pytest)
+with PYTHONPATH=build/python and SCALESPACE_CLI=build/scalespace; by hand:
+PYTHONPATH=build/python SCALESPACE_CLI=build/scalespace /usr/bin/python3 -m pytest tests/python
+"""
+import gc
+import os
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import scalespace as ss
+
+CLI = os.environ.get("SCALESPACE_CLI", str(Path(__file__).resolve().parents[2] / "build" / "scalespace"))
+
+
+def cli(*args):
+    subprocess.run([CLI, *map(str, args), "-q"], check=True, capture_output=True)
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    d = tmp_path_factory.mktemp("data")
+    cli("generate", "sphere", "-n", 3000, "--noise", 0.002, "--seed", 3, "-o", d / "sphere.ply")
+    cli("generate", "house", "-n", 12000, "--seed", 1, "-o", d / "house.ply")
+    return d
+
+
+def columns(path):
+    """A curvature output's columns by name: its attributes, and nx ny nz (read as normals)."""
+    cloud = ss.read(str(path))
+    out = dict(cloud.attributes)
+    for c, name in enumerate(("nx", "ny", "nz")):
+        out[name] = cloud.normals[:, c].astype(np.float32)
+    return out
+
+
+def sphere_points(n=2000, seed=1):
+    p = np.random.default_rng(seed).normal(size=(n, 3))
+    return p / np.linalg.norm(p, axis=1)[:, None]
+
+
+# ------------------------------------------------------------------------------- round trips
+@pytest.mark.parametrize("name,ascii", [("a.ply", False), ("b.ply", True), ("c.xyz", False),
+                                        ("d.txt", False), ("e.csv", False), ("f.pts", False),
+                                        ("g.las", False), ("h.pcd", False), ("i.pcd", True)])
+def test_round_trip_every_writable_format(tmp_path, name, ascii):
+    rng = np.random.default_rng(7)
+    # Georeferenced-like coordinates on a millimetre grid: LAS stores scaled integers.
+    points = np.round(rng.uniform(-50, 50, size=(500, 3)), 3) + [651234.0, 5432100.0, 120.0]
+    normals = sphere_points(500, 2)
+    attributes = {"intensity": rng.integers(0, 65535, 500).astype(np.uint16),
+                  "curv": rng.normal(size=500).astype(np.float32),
+                  "label": rng.integers(-5, 100, 500).astype(np.int32)}
+    ss.write(tmp_path / name if False else str(tmp_path / name), points, normals, attributes,
+             ascii=ascii)
+    cloud = ss.read(str(tmp_path / name))
+    assert cloud.points.shape == (500, 3) and cloud.points.dtype == np.float64
+    np.testing.assert_allclose(cloud.points, points, rtol=0, atol=1e-3 if name.endswith(".las") else 1e-6)
+    assert cloud.normals is not None
+    np.testing.assert_allclose(cloud.normals, normals, atol=1e-6)
+    for key, values in attributes.items():
+        assert key in cloud.attributes, (key, list(cloud.attributes))
+        np.testing.assert_allclose(cloud.attributes[key].astype(np.float64),
+                                   values.astype(np.float64), rtol=1e-6)
+    if name.endswith(".ply") or name.endswith(".pcd"):  # typed formats keep the dtype
+        assert cloud.attributes["intensity"].dtype == np.uint16
+        assert cloud.attributes["curv"].dtype == np.float32
+
+
+def test_write_a_cloud_object_and_read_meshes(tmp_path):
+    cloud = ss.Cloud(sphere_points(100), None, {"flag": np.ones(100, bool)})
+    ss.write(str(tmp_path / "c.ply"), cloud)
+    back = ss.read(str(tmp_path / "c.ply"))
+    assert back.normals is None and back.attributes["flag"].dtype == np.uint8
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n")
+    assert ss.read(str(tmp_path / "m.obj")).points.shape == (4, 3)
+    sampled = ss.read(str(tmp_path / "m.obj"), sample=50)
+    assert sampled.points.shape == (50, 3) and sampled.normals is not None
+
+
+# ------------------------------------------------------------------------- equal to the CLI
+def test_curvature_equals_the_cli(data, tmp_path):
+    cli("curvature", data / "sphere.ply", "-o", tmp_path / "c.ply", "--scale-k", 20, "--robust")
+    expected = columns(tmp_path / "c.ply")
+    cloud = ss.read(str(data / "sphere.ply"))
+    got = ss.curvature(cloud.points, cloud.normals, scale_k=20, robust=True)
+    assert got["fit_valid"].sum() > 2900
+    for name, values in got.items():
+        # The file holds float32 columns of the same doubles: equal after the same rounding.
+        np.testing.assert_array_equal(values.astype(expected[name].dtype), expected[name], name)
+
+
+def test_curvature_without_normals_equals_the_cli(data, tmp_path):
+    points = ss.read(str(data / "house.ply")).points
+    ss.write(str(tmp_path / "bare.ply"), points)  # no normals: both estimate and orient them
+    cli("curvature", tmp_path / "bare.ply", "-o", tmp_path / "c.ply", "--scale", 0.3)
+    expected = columns(tmp_path / "c.ply")
+    got = ss.curvature(points, scale=0.3)
+    for name in ("curv_mean", "curv_max", "nx", "ny", "nz", "neighbors", "fit_valid"):
+        np.testing.assert_array_equal(got[name].astype(expected[name].dtype), expected[name], name)
+
+
+def test_planes_and_segments_equal_the_cli(data, tmp_path):
+    cli("planes", data / "house.ply", "-o", tmp_path / "planes", "--scales", 10)
+    cli("segment", tmp_path / "planes", "--min-persistence", 2, "-o", tmp_path / "p.ply")
+    cli("segment", tmp_path / "planes", "--scale", 0.5, "-o", tmp_path / "s.ply")
+    (tmp_path / "brush.txt").write_text(" ".join(map(str, range(0, 12000, 97))))
+    cli("segment", tmp_path / "planes", "--similar", 1, "--within", tmp_path / "brush.txt",
+        "-o", tmp_path / "w.ply")
+    cloud = ss.read(str(data / "house.ply"))
+    planes = ss.planes(cloud.points, cloud.normals, scales=10)
+    stored = ss.read_planes(str(tmp_path / "planes"))
+    assert len(stored.components["id"]) == len(planes.components["id"]) > 5
+    np.testing.assert_array_equal(stored.membership, planes.membership)
+    for key in ("birth_level", "death_level", "persistence", "point_count", "planar"):
+        np.testing.assert_array_equal(stored.components[key], planes.components[key], key)
+    for key in ("normal", "offset", "area", "birth_scale"):
+        np.testing.assert_allclose(stored.components[key], planes.components[key], rtol=1e-9,
+                                   atol=1e-9, err_msg=key)
+
+    def plane_id(name):
+        return ss.read(str(tmp_path / name)).attributes["plane_id"]
+    np.testing.assert_array_equal(planes.labels_by_persistence(2), plane_id("p.ply"))
+    np.testing.assert_array_equal(planes.labels_at_scale(0.5), plane_id("s.ply"))
+    within = np.arange(0, 12000, 97)
+    np.testing.assert_array_equal(planes.label_components(planes.find_similar(1, within)),
+                                  plane_id("w.ply"))
+    ranked = planes.rank_by_brush(within)
+    assert ranked["score"][0] == ranked["score"].max() and len(ranked["component"]) > 1
+
+
+def test_stack_in_memory_equals_the_stack_on_disk_and_the_export(data, tmp_path):
+    cloud = ss.read(str(data / "sphere.ply"))
+    cli("scales", data / "sphere.ply", "-o", tmp_path / "s.stack", "--scales", 4, "--encoding",
+        "float32")
+    cli("export", tmp_path / "s.stack", "--scale", 2, "-o", tmp_path / "e.ply")
+    exported = ss.read(str(tmp_path / "e.ply"))
+    memory = ss.compute_stack(cloud.points, cloud.normals, scales=4)
+    disk = ss.open_stack(str(tmp_path / "s.stack"))
+    assert memory.scale_count == disk.scale_count == 4 and memory.point_count == 3000
+    np.testing.assert_allclose(memory.scales, disk.scales, rtol=1e-12)
+    layer = memory.scale(2)
+    np.testing.assert_array_equal(layer["curv_mean"], disk.scale(2)["curv_mean"])
+    np.testing.assert_array_equal(layer["curv_mean"], exported.attributes["curv_mean"])
+    np.testing.assert_allclose(layer["projection"][:, 0], exported.attributes["proj_x"], rtol=0,
+                               atol=1e-12)
+    series = memory.point(17)
+    assert series["normal"].shape == (4, 3)
+    np.testing.assert_array_equal(series["curv_mean"], disk.point(17)["curv_mean"])
+    # Outputs own their memory: the stack may go, its arrays stay valid.
+    del memory
+    gc.collect()
+    assert np.isfinite(layer["curv_mean"]).all() and layer["normal"].flags.owndata is False
+
+
+def test_lines_and_features_equal_the_cli(data, tmp_path):
+    cli("lines", data / "house.ply", "-o", tmp_path / "l.ply", "--scale", 0.6)
+    cli("features", data / "house.ply", "-o", tmp_path / "f.ply")
+    cloud = ss.read(str(data / "house.ply"))
+    lines = ss.lines(cloud.points, cloud.normals, scale=0.6)
+    written = ss.read(str(tmp_path / "l.ply"))  # the vertex element: one row per line vertex
+    np.testing.assert_allclose(lines["vertices"], written.points, rtol=0, atol=1e-9)
+    for name in ("line_id", "k1", "k_gap"):
+        np.testing.assert_array_equal(lines[name].astype(written.attributes[name].dtype),
+                                      written.attributes[name], name)
+    features = ss.features(cloud.points, cloud.normals)
+    labelled = ss.read(str(tmp_path / "f.ply")).attributes
+    for name in ("feature_votes", "curve_id", "convexity"):
+        np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
+                                      labelled[name], name)
+    assert len(features["curves"]) == features["curve_id"].max() + 1
+
+
+def cube_obj(path, n=12):
+    """A unit cube, each face an n x n grid of vertices cut into triangles (faces not welded)."""
+    lines, base = [], 1
+    g = np.linspace(-1, 1, n)
+    for axis in range(3):
+        for side in (-1.0, 1.0):
+            for u in g:
+                for v in g:
+                    p = [u, v]
+                    p.insert(axis, side)
+                    lines.append("v %r %r %r" % tuple(p))
+            for i in range(n - 1):
+                for j in range(n - 1):
+                    a = base + i * n + j
+                    lines += ["f %d %d %d" % (a, a + n, a + 1), "f %d %d %d" % (a + 1, a + n, a + n + 1)]
+            base += n * n
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_features_on_a_mesh_equal_the_cli(tmp_path):
+    cube_obj(tmp_path / "cube.obj")
+    cli("features", tmp_path / "cube.obj", "-o", tmp_path / "f.ply")
+    vertices, triangles = ss.read_mesh(str(tmp_path / "cube.obj"))
+    assert vertices.shape == (864, 3) and triangles.shape == (6 * 2 * 121, 3)
+    with pytest.warns(RuntimeWarning, match="the mesh is coarse"):  # the CLI's warning, too
+        features = ss.features(vertices, triangles=triangles)
+    labelled = ss.read(str(tmp_path / "f.ply")).attributes
+    for name in ("feature_votes", "curve_id", "convexity"):
+        np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
+                                      labelled[name], name)
+    with pytest.raises(ValueError, match="triangles: row 0 names vertex 864"):
+        ss.features(vertices, triangles=np.full((1, 3), 864))
+
+
+def test_render_lines_features(data):
+    cloud = ss.read(str(data / "house.ply"))
+    image = ss.render(cloud.points, labels=cloud.attributes["gt_face"], width=80, height=60)
+    assert image.shape == (60, 80, 3) and image.dtype == np.uint8 and image.std() > 0
+    lines = ss.lines(cloud.points, scale=0.6)
+    assert lines["offsets"][-1] == len(lines["vertices"]) > 0
+    over = ss.render(cloud.points, labels=cloud.attributes["gt_face"], width=80, height=60,
+                     lines=lines, line_color_by="k_gap")
+    assert over.shape == image.shape and (over != image).any()
+    with pytest.raises(ss.OptionError, match="line_color_by|no_such"):
+        ss.render(cloud.points, lines=lines, line_color_by="no_such")
+    features = ss.features(cloud.points)
+    assert features["curve_id"].shape == (12000,) and len(features["curves"]) > 0
+
+
+def test_any_layout_gives_the_same_result_and_inputs_stay_untouched():
+    p = sphere_points(3000)
+    before = p.copy()
+    c_order = ss.curvature(p, p, scale_k=20)
+    np.testing.assert_array_equal(p, before)
+    fortran = ss.curvature(np.asfortranarray(p), np.asfortranarray(p), scale_k=20)
+    strided = ss.curvature(np.repeat(p, 2, axis=0)[::2], p.tolist(), scale_k=20)
+    for name in c_order:
+        np.testing.assert_array_equal(fortran[name], c_order[name], name)
+        np.testing.assert_array_equal(strided[name], c_order[name], name)
+        assert c_order[name].flags.c_contiguous and c_order[name].shape == (3000,)
+
+
+# ----------------------------------------------------------------------------- bad inputs
+@pytest.mark.parametrize("points,error,message", [
+    (np.zeros((10, 2)), ValueError, "points: expected an array of shape (N, 3), got shape (10, 2)"),
+    (np.zeros((0, 3)), ValueError, "points: the array holds no points (nothing to analyse)"),
+    (np.array([["a", "b", "c"]]), TypeError, "points: expected a float64 array of shape (N, 3) of numbers, got dtype <U1"),
+    (np.zeros(3), ValueError, "got shape (3,)"),
+])
+def test_bad_arrays_raise_with_the_message(points, error, message):
+    with pytest.raises(error) as e:
+        ss.curvature(points, scale=0.1)
+    assert message in str(e.value)
+
+
+def test_bad_values_and_options_raise_with_the_library_message(tmp_path):
+    p = sphere_points(500)
+    q = p.copy()
+    q[5, 1] = np.inf
+    with pytest.raises(ValueError, match=r"points: row 5: point 6 has a NaN, infinite or absurdly"):
+        ss.curvature(q, scale=0.1)
+    with pytest.raises(ss.OptionError, match=r"scale_k must be in \[1, 1000\], got 5000"):
+        ss.curvature(p, scale_k=5000)
+    with pytest.raises(ss.OptionError, match=r"give exactly one of .*\(scale\) or .*\(scale_k\)"):
+        ss.curvature(p, scale=0.1, scale_k=10)
+    with pytest.raises(ss.OptionError, match="scale_k 600 must be smaller than the number of points"):
+        ss.curvature(p, scale_k=600)
+    with pytest.raises(ValueError, match="estimator"):
+        ss.curvature(p, scale=0.1, estimator="w9")
+    with pytest.raises(ValueError, match="normals: expected 500 rows"):
+        ss.curvature(p, p[:10], scale=0.1)
+    with pytest.raises(ss.OptionError, match="scales"):
+        ss.compute_stack(p, scales=0)
+    with pytest.raises(ss.FileError, match="nothing.ply"):
+        ss.read(str(tmp_path / "nothing.ply"))
+    with pytest.raises(TypeError, match="int64|files hold"):
+        ss.write(str(tmp_path / "x.ply"), p, attributes={"a": np.zeros(500, np.int64)})
+
+
+# ---------------------------------------------------------------- cancel, Ctrl-C, the GIL
+def test_progress_callback_cancels_and_leaves_no_stack(tmp_path):
+    p = sphere_points(20000)
+    stages = []
+
+    def stop(fraction, stage):
+        stages.append(stage)
+        return False
+    with pytest.raises(ss.Cancelled):
+        ss.compute_stack(p, p, scales=20, path=str(tmp_path / "s.stack"), progress=stop)
+    assert stages and not (tmp_path / "s.stack").exists()
+
+    class Boom(Exception):
+        pass
+
+    def boom(fraction, stage):
+        raise Boom(stage)
+    with pytest.raises(Boom):
+        ss.curvature(p, p, scale_k=30, progress=boom)
+
+
+def test_ctrl_c_cancels_a_long_call_and_leaves_no_output(tmp_path):
+    p = sphere_points(200000)
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        # About a minute without the interrupt.
+        ss.compute_stack(p, p, scales=200, path=str(tmp_path / "s.stack"))
+    assert time.monotonic() - start < 10
+    timer.join()
+    assert list(tmp_path.iterdir()) == []  # nor any temporary folder
+
+
+def test_two_threads_overlap_in_time():
+    p = sphere_points(150000)
+    calls = {0: [], 1: []}
+
+    def run(k):
+        ss.curvature(p, p, scale_k=30, threads=1,
+                     progress=lambda f, s: calls[k].append(time.monotonic()))
+    threads = [threading.Thread(target=run, args=(k,)) for k in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    a, b = calls[0], calls[1]
+    assert len(a) > 2 and len(b) > 2
+    # With the GIL held the second call would start only after the first ended.
+    assert a[0] < b[-1] and b[0] < a[-1]
