@@ -85,20 +85,20 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
     nlohmann::json axis = nlohmann::json::array();
     for (const Vec3& p : t.axis) axis.push_back(point(p + origin));
     nlohmann::json item = {{"id", c.id},
-                          {"birth_level", c.birthLevel},
-                          {"birth_scale", c.birthScale},
-                          {"death_level", c.deathLevel},
-                          {"death_scale", c.deathScale},
-                          {"persistence", c.persistence},
-                          {"representative_level", c.representativeLevel},
-                          {"point_count", t.pointCount},
-                          {"straight", t.straight},
-                          {"radius", t.radius},
-                          {"rms", t.rms},
-                          {"length", t.length},
-                          {"arc_degrees", t.arcDegrees},
-                          {"axis", axis},
-                          {"radii", t.radii}};
+                           {"birth_level", c.birthLevel},
+                           {"birth_scale", c.birthScale},
+                           {"death_level", c.deathLevel},
+                           {"death_scale", c.deathScale},
+                           {"persistence", c.persistence},
+                           {"representative_level", c.representativeLevel},
+                           {"point_count", t.pointCount},
+                           {"straight", t.straight},
+                           {"radius", t.radius},
+                           {"rms", t.rms},
+                           {"length", t.length},
+                           {"arc_degrees", t.arcDegrees},
+                           {"axis", axis},
+                           {"radii", t.radii}};
     if (t.straight) {  // the straight axis means nothing for a bent tube
       item["direction"] = point(t.direction);
       item["centre"] = point(t.centre + origin);
@@ -206,13 +206,18 @@ void addCylindersCommand(CLI::App& app) {
                    WriteOptions{args->ascii});
     writeComponentsCsv(detection, cloud.origin(), (dir / "components.csv").string());
     nlohmann::json levels = nlohmann::json::array();
-    for (const CylinderLevel& l : detection.levels)
+    for (const CylinderLevel& l : detection.levels) {
+      nlohmann::json rejected = nlohmann::json::object();
+      for (std::size_t k = 1; k < l.rejections.size(); ++k)
+        rejected[tubeRejectionName(TubeRejection(k))] = l.rejections[k];
       levels.push_back({{"scale", l.scale},
+                        {"rejected", rejected},
                         {"lines", l.lines},
                         {"regular_lines", l.regularLines},
                         {"regions", l.regions},
                         {"tubes", l.tubes.size()},
                         {"seconds", l.seconds}});
+    }
     const CylinderOptions& o = args->cylinders;
     const nlohmann::json json = {
         {"result", "cylinders"},

@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <string>
 
@@ -200,21 +198,11 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     level.lines = lines.lines.size();
     level.regularLines = regular.size();
     level.regions = seg.regions.size();
+    level.rejections.assign(std::size_t(TubeRejection::Rough) + 1, 0);
+    for (const TubeFit& tube : tubes)
+      if (!tube.isTube()) ++level.rejections[std::size_t(tube.rejection)];
     RegionLevel regionLevel;
     regionLevel.t = t;
-    for (std::size_t r = 0; r < tubes.size(); ++r) {
-      if (std::getenv("SS_DEBUG") && tubes[r].pointCount >= 500) {
-        Vec3 c = Vec3::Zero();
-        for (Index i : seg.regions[r]) c += positions[i];
-        c /= double(seg.regions[r].size());
-        std::fprintf(
-            stderr,
-            "t=%.3f region %zu n=%zu %s straight=%d r=%.4f rms=%.4f arc=%.0f c=(%.2f %.2f %.2f)\n",
-            t, r, tubes[r].pointCount, tubeRejectionName(tubes[r].rejection),
-            int(tubes[r].straight), tubes[r].radius, tubes[r].rms, tubes[r].arcDegrees, c.x(),
-            c.y(), c.z());
-      }
-    }
     for (std::size_t r = 0; r < tubes.size(); ++r)
       if (tubes[r].isTube()) {
         regionLevel.regions.push_back(std::move(seg.regions[r]));

@@ -55,6 +55,8 @@ void validateCylinderOptions(const CylinderOptions& options);
 struct CylinderLevel {
   double scale = 0;
   std::size_t lines = 0, regularLines = 0, regions = 0;
+  /// How many regions each test of the tube fit turned down, indexed by TubeRejection.
+  std::vector<std::size_t> rejections;
   /// The tubes of this level, same order as the graph's regions at this level.
   std::vector<TubeFit> tubes;
   std::vector<float> anisotropy;  // per point, NaN where no regular line passes within t

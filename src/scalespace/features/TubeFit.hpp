@@ -40,6 +40,7 @@ struct TubeFitOptions {
   double straightRmsRatio = 1.5;
 };
 
+/// Why a region is no tube (None: it is one). Rough is the last.
 enum class TubeRejection : std::uint8_t { None, TooSmall, Flat, NarrowArc, Thin, Rough };
 const char* tubeRejectionName(TubeRejection rejection);
 
