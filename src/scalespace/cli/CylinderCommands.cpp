@@ -124,10 +124,7 @@ void addCylindersCommand(CLI::App& app) {
       "cylinders across scales (Sec. 3.5): regular minimal-curvature lines, their anisotropy, "
       "region growing, a tube per region (curved axis, radius profile), linked across scales "
       "into persistent components");
-  cmd->add_option("input", args->input.path, "input point cloud (oriented normals, or estimated)")
-      ->required();
-  cmd->add_flag("--drop-invalid", args->input.dropInvalid,
-                "skip points with NaN/Inf coordinates instead of failing");
+  addInputOptions(*cmd, args->input);
   cmd->add_option("-o,--output", args->output,
                   "output folder: cloud.ply (cylinder_id, anisotropy), components.json / .csv, "
                   "axes.ply")

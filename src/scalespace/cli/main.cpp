@@ -54,6 +54,13 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
     {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
     {"FeatureCurveOptions::minVotingScales", "--min-scales"},
+    {"CylinderOptions::scaleCount", "--scales"},
+    {"CylinderOptions::tMin", "--tmin"},
+    {"CylinderOptions::tMax", "--tmax"},
+    {"CylinderOptions::epsilon", "--epsilon"},
+    {"CylinderOptions::minAnisotropy", "--min-anisotropy"},
+    {"TubeFitOptions::minArcDegrees", "--min-arc"},
+    {"TubeFitOptions::maxRelativeRms", "--max-rms"},
     {"the thread count (threads option)", "--threads"},
     {"findSimilar: no component", "--similar: no component"},
 };

@@ -1,0 +1,123 @@
+// `scalespace cylinders`: the pipes of the generated rack found with their radii, the folder's
+// files readable by other tools, label queries by scale and persistence, clear errors, and a
+// user's folder never written into.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "cli/CliTestSupport.hpp"
+#include "scalespace/core/PipeScene.hpp"
+#include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+using test::Cli;
+using test::run;
+namespace fs = std::filesystem;
+
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+TEST_F(Cli, CylindersFindThePipesOfTheRack) {
+  ASSERT_EQ(run("generate pipes -n 150000 -q -o " + path("p.ply")).code, 0);
+  auto r = run("cylinders " + path("p.ply") + " -q -o " + path("out"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json result = readJson(path("out/components.json"));
+  EXPECT_EQ(result["result"], "cylinders");
+  EXPECT_EQ(result["levels"].size(), 8u);
+  const PointCloud cloud = readCloud(path("out/cloud.ply"));
+  ASSERT_EQ(cloud.size(), 150000u);
+  const AttributeColumn* id = cloud.findAttribute("cylinder_id");
+  const AttributeColumn* gt = cloud.findAttribute("gt_pipe");
+  ASSERT_NE(id, nullptr);
+  ASSERT_NE(cloud.findAttribute("anisotropy"), nullptr);
+  // Each straight pipe is mostly one component with its radius; the floor, wall and box none.
+  std::map<int, std::map<int, std::size_t>> votes;  // gt pipe -> component -> points
+  std::size_t planeLabelled = 0, planePoints = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int pipe = int(gt->values[i]), label = int(id->values[i]);
+    if (pipe < 0) {
+      ++planePoints;
+      planeLabelled += label >= 0;
+    } else if (label >= 0) {
+      ++votes[pipe][label];
+    }
+  }
+  EXPECT_LT(double(planeLabelled), 0.01 * double(planePoints));
+  for (const PipeTruth& truth : pipeSceneTruth()) {
+    if (truth.kind != PipeKind::Straight) continue;
+    SCOPED_TRACE(truth.name);
+    ASSERT_FALSE(votes[truth.id].empty());
+    auto best = votes[truth.id].begin();
+    for (auto it = votes[truth.id].begin(); it != votes[truth.id].end(); ++it)
+      if (it->second > best->second) best = it;
+    const nlohmann::json& component = result["components"][std::size_t(best->first)];
+    EXPECT_EQ(component["id"], best->first);
+    EXPECT_TRUE(component["straight"].get<bool>());
+    EXPECT_NEAR(component["radius"].get<double>(), truth.radius, 0.02 * truth.radius);
+  }
+  // The axes: one polyline per component, with the radius profile.
+  const PolylineSet axes = readPolylines(path("out/axes.ply"));
+  EXPECT_EQ(axes.lineCount(), result["components"].size());
+  ASSERT_NE(axes.vertices.findAttribute("radius"), nullptr);
+  std::ifstream csv(path("out/components.csv"));
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("id,birth_level,birth_scale,death_level,death_scale,persistence", 0), 0u);
+
+  // Labels at one scale, and only persistent components: fewer points labelled. The folder is an
+  // earlier result, so it is replaced.
+  r = run("cylinders " + path("p.ply") + " -q --scale 0.1 --min-persistence 2 -o " + path("out"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json again = readJson(path("out/components.json"));
+  EXPECT_EQ(again["labels"]["min_persistence"], 2);
+  EXPECT_TRUE(again["labels"]["scale"].is_number());
+  const PointCloud atScale = readCloud(path("out/cloud.ply"));
+  std::size_t before = 0, after = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    before += id->values[i] >= 0;
+    after += atScale.findAttribute("cylinder_id")->values[i] >= 0;
+  }
+  EXPECT_LE(after, before);
+}
+
+TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
+  ASSERT_EQ(run("generate cylinder -n 3000 -q -o " + path("c.ply")).code, 0);
+  auto r = run("cylinders " + path("c.ply") + " --epsilon 1 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--epsilon"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --min-arc 500 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--min-arc"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --tmin 1 --tmax 0.5 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--tmax"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --scale -1 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  // A folder holding someone's files is never written into.
+  fs::create_directories(path("mine"));
+  std::ofstream(path("mine/notes.txt")) << "keep";
+  r = run("cylinders " + path("c.ply") + " -q -o " + path("mine"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("refusing"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(path("mine/notes.txt")));
+  EXPECT_FALSE(fs::exists(path("mine/components.json")));
+  // Malformed input: one clear line, nothing written.
+  std::ofstream(path("bad.ply")) << "ply\nformat ascii 1.0\nelement vertex 2\nend_header\n1 2\n";
+  r = run("cylinders " + path("bad.ply") + " -q -o " + path("o2"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_FALSE(fs::exists(path("o2")));
+  // --one-sided belongs to the pipes scene.
+  r = run("generate box --one-sided -q -o " + path("x.ply"));
+  EXPECT_EQ(r.code, 2);
+}
