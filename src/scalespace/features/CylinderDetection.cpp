@@ -67,6 +67,7 @@ void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
     if (!tube.isTube()) continue;
     const double tolerance =
         std::max(coverage.rmsFactor * tube.rms, coverage.radiusFraction * tube.radius);
+    const TubeSurface surface(tube);
     frontier = regions[r];
     while (!frontier.empty()) {
       const Index p = frontier.back();
@@ -75,7 +76,7 @@ void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
         const Index q = graph.neighbors[e];
         if (owner[q] >= 0) continue;
         Vec3 radial;
-        if (std::abs(tubeResidual(tube, positions[q], &radial)) > tolerance ||
+        if (std::abs(surface.residual(positions[q], &radial)) > tolerance ||
             std::abs(radial.dot(normals[q])) < minCos)
           continue;
         owner[q] = int(r);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
 
 namespace scalespace {
 
@@ -19,6 +20,30 @@ constexpr double kPi = 3.14159265358979323846;
 
 Vec3 anyPerpendicular(const Vec3& d) {
   return (std::abs(d.x()) < 0.9 ? d.cross(Vec3::UnitX()) : d.cross(Vec3::UnitY())).normalized();
+}
+
+// Gauss-Newton on sum (|p - c| - r)^2 from the given centre; r starts at the mean distance.
+void fitCircle(const std::vector<Eigen::Vector2d>& flat, Eigen::Vector2d& centre, double& r) {
+  r = 0;
+  for (const auto& p : flat) r += (p - centre).norm();
+  r /= double(flat.size());
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (const auto& p : flat) {
+      const Eigen::Vector2d d = p - centre;
+      const double len = d.norm();
+      if (len == 0) continue;
+      const Eigen::Vector3d j(-d.x() / len, -d.y() / len, -1);
+      jtj += j * j.transpose();
+      jtr += j * (len - r);
+    }
+    const Eigen::Vector3d step = jtj.ldlt().solve(-jtr);
+    if (!step.allFinite()) break;
+    centre += step.head<2>();
+    r += step.z();
+    if (step.norm() < 1e-9 * (1 + std::abs(r))) break;
+  }
 }
 
 // The straight axis: direction, centre and radius. False when the normals do not turn around
@@ -51,32 +76,14 @@ bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>
   const Eigen::SelfAdjointEigenSolver<Mat3> check(lhs - n * a * a.transpose());
   if (!(check.eigenvalues()[1] > 1e-3 * n)) return false;
   Vec3 c = lhs.ldlt().solve(rhs);
-  // Geometric circle fit in the plane normal to a (Gauss-Newton on |p - c| - r), from there.
+  // Geometric circle fit in the plane normal to a, from there.
   const Vec3 e1 = anyPerpendicular(a), e2 = a.cross(e1);
   Eigen::Vector2d centre(e1.dot(c), e2.dot(c));
   std::vector<Eigen::Vector2d> flat;
   flat.reserve(points.size());
   for (const Index i : points) flat.emplace_back(e1.dot(positions[i]), e2.dot(positions[i]));
   double r = 0;
-  for (const auto& p : flat) r += (p - centre).norm();
-  r /= n;
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
-    for (const auto& p : flat) {
-      const Eigen::Vector2d d = p - centre;
-      const double len = d.norm();
-      if (len == 0) continue;
-      const Eigen::Vector3d j(-d.x() / len, -d.y() / len, -1);
-      jtj += j * j.transpose();
-      jtr += j * (len - r);
-    }
-    const Eigen::Vector3d step = jtj.ldlt().solve(-jtr);
-    if (!step.allFinite()) break;
-    centre += step.head<2>();
-    r += step.z();
-    if (step.norm() < 1e-9 * (1 + r)) break;
-  }
+  fitCircle(flat, centre, r);
   fit.direction = a;
   fit.centre = centre.x() * e1 + centre.y() * e2 + a.dot(centroid) * a;
   fit.straightRadius = std::abs(r);
@@ -172,24 +179,49 @@ std::vector<Vec3> curvedAxis(const std::vector<Vec3>& positions,
   return path;
 }
 
-struct Projection {
-  std::size_t segment = 0;
-  double along = 0;  // in [0, 1] on the segment
-  double distance = 0;
-};
+using Projection = AxisLocator::Projection;
 
-Projection project(const std::vector<Vec3>& axis, const Vec3& p) {
-  Projection best;
-  best.distance = std::numeric_limits<double>::infinity();
-  for (std::size_t s = 0; s + 1 < axis.size(); ++s) {
-    const Vec3 d = axis[s + 1] - axis[s];
-    const double len2 = d.squaredNorm();
-    const double u = len2 > 0 ? std::clamp((p - axis[s]).dot(d) / len2, 0.0, 1.0) : 0.0;
-    const double dist = (p - (axis[s] + u * d)).norm();
-    if (dist < best.distance) best = {s, u, dist};
+Projection projectOnSegment(const std::vector<Vec3>& axis, std::size_t s, const Vec3& p) {
+  const Vec3 d = axis[s + 1] - axis[s];
+  const double len2 = d.squaredNorm();
+  const double u = len2 > 0 ? std::clamp((p - axis[s]).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return {s, u, (p - (axis[s] + u * d)).norm()};
+}
+
+}  // namespace
+
+// The nearest point of the axis: among the segments at the few axis vertices nearest to p (a
+// kd-tree over the vertices) when the axis is long, else among all of them. A point of a tube
+// is within about a radius of its axis, and the vertices are at least that far apart, so its
+// segment ends at one of its nearest vertices.
+AxisLocator::AxisLocator(const std::vector<Vec3>& axis) : axis_(axis) {
+  if (axis.size() > kBruteForceVertices) index_ = makeSpatialIndex(axis_);
+}
+
+AxisLocator::~AxisLocator() = default;
+
+AxisLocator::Projection AxisLocator::project(const Vec3& p) const {
+  Projection best{0, 0, std::numeric_limits<double>::infinity()};
+  auto consider = [&](std::size_t s) {
+    const Projection q = projectOnSegment(axis_, s, p);
+    if (q.distance < best.distance || (q.distance == best.distance && s < best.segment)) best = q;
+  };
+  if (!index_) {
+    for (std::size_t s = 0; s + 1 < axis_.size(); ++s) consider(s);
+    return best;
+  }
+  thread_local std::vector<Neighbor> near;
+  index_->knnSearch(p, 4, near);
+  for (const Neighbor& v : near) {
+    if (v.index > 0) consider(v.index - 1);
+    if (v.index + 1 < axis_.size()) consider(v.index);
   }
   return best;
 }
+
+namespace {
+
+using Projection = AxisLocator::Projection;
 
 // An axis polyline judged against the points: radius profile (each point's distance to the axis
 // shared between the two ends of its segment), RMS about that profile, and the arcs covered
@@ -205,13 +237,14 @@ struct AxisEvaluation {
 };
 
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
-                  const std::vector<Index>& points, AxisEvaluation& e) {
+                  const std::vector<Index>& points, bool straight, AxisEvaluation& e) {
   const std::size_t m = e.axis.size();
   std::vector<Projection> proj(points.size());
   std::vector<double> sum(m, 0), weight(m, 0);
   e.meanDistance = 0;
+  const AxisLocator locator(e.axis);
   for (std::size_t k = 0; k < points.size(); ++k) {
-    proj[k] = project(e.axis, positions[points[k]]);
+    proj[k] = locator.project(positions[points[k]]);
     sum[proj[k].segment] += (1 - proj[k].along) * proj[k].distance;
     weight[proj[k].segment] += 1 - proj[k].along;
     sum[proj[k].segment + 1] += proj[k].along * proj[k].distance;
@@ -266,7 +299,10 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
       for (const std::uint32_t c : b) filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
       arcs.push_back(360.0 * filled / kBins);
     }
-    if (arcs.empty()) {  // a short or sparse region: one count over the whole axis
+    if (arcs.empty()) {
+      // A short or sparse region: one count over the whole axis, which only a straight axis
+      // (one frame) can give; a sparse bent one is not trusted.
+      if (!straight) return 0.0;
       std::uint32_t counted = 0;
       for (const std::uint32_t c : all) counted += c;
       int filled = 0;
@@ -284,16 +320,56 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   });
 }
 
+// Re-centres each vertex of a curved axis on its cross-section: the circle fitted to the points
+// nearest to it, in the plane normal to the axis there. The proposals x - n / kappa1 place the
+// axis only as well as kappa1 is known (poorly where a tube bends more tightly than twice its
+// radius, as on a knot); the points themselves do not depend on it.
+void recentreAxis(const std::vector<Vec3>& positions, const std::vector<Index>& points,
+                  std::vector<Vec3>& axis) {
+  const std::size_t m = axis.size();
+  if (m < 2) return;
+  std::vector<std::vector<Index>> near(m);
+  const AxisLocator locator(axis);
+  for (const Index i : points) {
+    const Projection q = locator.project(positions[i]);
+    near[q.along < 0.5 ? q.segment : q.segment + 1].push_back(i);
+  }
+  std::vector<Vec3> moved = axis;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (near[k].size() < 10) continue;
+    const Vec3 tangent = (axis[std::min(k + 1, m - 1)] - axis[k > 0 ? k - 1 : 0]).normalized();
+    const Vec3 e1 = anyPerpendicular(tangent), e2 = tangent.cross(e1);
+    std::vector<Eigen::Vector2d> flat;
+    for (const Index i : near[k]) {
+      const Vec3 d = positions[i] - axis[k];
+      flat.emplace_back(e1.dot(d), e2.dot(d));
+    }
+    double spread = 0;  // the section's size about the current vertex
+    for (const auto& p : flat) spread += p.norm();
+    spread /= double(flat.size());
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    double r = 0;
+    fitCircle(flat, centre, r);
+    // A section seen under a narrow angle can send the circle anywhere: only moves that keep it
+    // of the section's size are taken.
+    if (centre.allFinite() && std::isfinite(r) && centre.norm() < 0.5 * spread && r < 2 * spread)
+      moved[k] = axis[k] + centre.x() * e1 + centre.y() * e2;
+  }
+  axis.swap(moved);
+}
+
 }  // namespace
 
-double tubeResidual(const TubeFit& tube, const Vec3& p, Vec3* radial) {
-  const Projection q = project(tube.axis, p);
+TubeSurface::TubeSurface(const TubeFit& tube) : tube_(tube), locator_(tube.axis) {}
+
+double TubeSurface::residual(const Vec3& p, Vec3* radial) const {
+  const Projection q = locator_.project(p);
   const std::size_t s = q.segment;
   if (radial) {
-    const Vec3 foot = tube.axis[s] + q.along * (tube.axis[s + 1] - tube.axis[s]);
+    const Vec3 foot = tube_.axis[s] + q.along * (tube_.axis[s + 1] - tube_.axis[s]);
     *radial = q.distance > 0 ? Vec3((p - foot) / q.distance) : Vec3::Zero();
   }
-  return q.distance - ((1 - q.along) * tube.radii[s] + q.along * tube.radii[s + 1]);
+  return q.distance - ((1 - q.along) * tube_.radii[s] + q.along * tube_.radii[s + 1]);
 }
 
 const char* tubeRejectionName(TubeRejection rejection) {
@@ -362,13 +438,14 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
     for (int k = 0; k <= pieces; ++k)
       straight.axis.push_back(fit.centre + (lo + (hi - lo) * k / pieces) * fit.direction);
   }
-  evaluateAxis(positions, normals, points, straight);
+  evaluateAxis(positions, normals, points, true, straight);
   AxisEvaluation curved;
   curved.axis = curvedAxis(positions, scaleNormals, kappa1, points, cell);
+  for (int pass = 0; pass < 2; ++pass) recentreAxis(positions, points, curved.axis);
   // The straight axis unless the curved one describes the points clearly better (a bent pipe).
   fit.straight = true;
   if (curved.axis.size() >= 2) {
-    evaluateAxis(positions, normals, points, curved);
+    evaluateAxis(positions, normals, points, false, curved);
     fit.straight = straight.rms <= std::max(options.straightRmsRatio * curved.rms,
                                             curved.rms + 0.02 * curved.meanDistance);
   }

@@ -11,8 +11,10 @@
 // line, refined by a geometric circle fit) is kept unless the curved one fits the points clearly
 // better. The radius profile is the mean distance to the axis per axis vertex.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/core/Types.hpp"
 
 namespace scalespace {
@@ -67,10 +69,36 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
                 const std::vector<Vec3>& scaleNormals, const std::vector<float>& kappa1,
                 const std::vector<Index>& points, double t, const TubeFitOptions& options = {});
 
-/// Distance from p to the tube's surface (distance to the axis minus the radius profile at the
-/// nearest axis point; negative inside) and, in `radial`, the unit direction from that axis point
-/// to p. The tube must have an axis of >= 2 vertices.
-double tubeResidual(const TubeFit& tube, const Vec3& p, Vec3* radial = nullptr);
+/// The nearest point of a polyline (>= 2 vertices, kept by reference) to query points.
+class AxisLocator {
+ public:
+  struct Projection {
+    std::size_t segment = 0;  // from vertex segment to segment + 1
+    double along = 0;         // in [0, 1] on the segment
+    double distance = 0;
+  };
+  explicit AxisLocator(const std::vector<Vec3>& axis);
+  ~AxisLocator();
+  Projection project(const Vec3& p) const;
+
+ private:
+  static constexpr std::size_t kBruteForceVertices = 16;
+  const std::vector<Vec3>& axis_;
+  std::unique_ptr<SpatialIndex> index_;
+};
+
+/// A fitted tube's surface (tube.axis of >= 2 vertices; the tube is kept by reference).
+class TubeSurface {
+ public:
+  explicit TubeSurface(const TubeFit& tube);
+  /// Distance from p to the surface (distance to the axis minus the radius profile at the nearest
+  /// axis point; negative inside) and, in `radial`, the unit direction from that axis point to p.
+  double residual(const Vec3& p, Vec3* radial = nullptr) const;
+
+ private:
+  const TubeFit& tube_;
+  AxisLocator locator_;
+};
 
 /// OptionError naming the field unless every option is finite and in range.
 void validateTubeFitOptions(const TubeFitOptions& options);
