@@ -3,7 +3,8 @@
 // truth per point: core/PipeScene.hpp), full and one-sided ("half-pipe") scans, noise 0 and 1e-3
 // of the diagonal.
 //
-//   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--seed S]
+//   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--scan full|one-sided]
+//                   [--seed S]
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -201,7 +202,15 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
   for (const Detected& d : m.sets) {
     std::size_t onPlanes = 0;
     for (const Index i : d.points) onPlanes += pipe[i] < 0;
-    s.falseCylinders += 2 * onPlanes > d.points.size();
+    if (2 * onPlanes <= d.points.size()) continue;
+    ++s.falseCylinders;
+    if (print) {
+      Vec3 centre = Vec3::Zero();
+      for (const Index i : d.points) centre += cloud.absolutePosition(i);
+      centre /= double(d.points.size());
+      std::printf("    false cylinder (%s): %zu points around (%.2f, %.2f, %.2f), radius %.3g\n",
+                  d.where.c_str(), d.points.size(), centre.x(), centre.y(), centre.z(), d.radius);
+    }
   }
   (void)planar;
   return s;
@@ -212,6 +221,7 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
 int main(int argc, char** argv) {
   std::size_t points = 1000000;
   bool peers = true, cleanOnly = false;
+  std::string only;  // "full" or "one-sided": that scan alone
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -223,10 +233,12 @@ int main(int argc, char** argv) {
       peers = false;
     else if (a == "--clean-only")
       cleanOnly = true;
+    else if (a == "--scan" && i + 1 < argc)
+      only = argv[++i];
     else {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
-                   "[--seed S]\n");
+                   "[--scan full|one-sided] [--seed S]\n");
       return 2;
     }
   }
@@ -235,7 +247,8 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<Score>> totals;
   for (const bool oneSided : {false, true})
     for (const double noise : {0.0, 1e-3}) {
-      if (cleanOnly && noise > 0) continue;
+      if ((cleanOnly && noise > 0) || (!only.empty() && only != (oneSided ? "one-sided" : "full")))
+        continue;
       PipeSceneOptions options;
       options.pointCount = points;
       options.noise = noise;

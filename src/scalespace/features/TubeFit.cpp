@@ -22,26 +22,34 @@ Vec3 anyPerpendicular(const Vec3& d) {
   return (std::abs(d.x()) < 0.9 ? d.cross(Vec3::UnitX()) : d.cross(Vec3::UnitY())).normalized();
 }
 
-// Gauss-Newton on sum (|p - c| - r)^2 from the given centre; r starts at the mean distance.
-void fitCircle(const std::vector<Eigen::Vector2d>& flat, Eigen::Vector2d& centre, double& r) {
+// Gauss-Newton on sum (|p - c| - r - slope s)^2 from the given centre, p the points' coordinates
+// across the axis and s along it (centred): a circle (slope 0 and no s) or a cone. A cone seen
+// from one side is not concentric arcs of one circle: fitting one circle to it would move the
+// centre towards the points.
+void fitCircle(const std::vector<Eigen::Vector2d>& flat, const std::vector<double>& along,
+               Eigen::Vector2d& centre, double& r, double& slope) {
+  const bool cone = !along.empty();
   r = 0;
+  slope = 0;
   for (const auto& p : flat) r += (p - centre).norm();
   r /= double(flat.size());
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
-    for (const auto& p : flat) {
-      const Eigen::Vector2d d = p - centre;
-      const double len = d.norm();
+  for (int iteration = 0; iteration < 12; ++iteration) {
+    Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d jtr = Eigen::Vector4d::Zero();
+    for (std::size_t k = 0; k < flat.size(); ++k) {
+      const Eigen::Vector2d d = flat[k] - centre;
+      const double len = d.norm(), s = cone ? along[k] : 0.0;
       if (len == 0) continue;
-      const Eigen::Vector3d j(-d.x() / len, -d.y() / len, -1);
+      const Eigen::Vector4d j(-d.x() / len, -d.y() / len, -1, -s);
       jtj += j * j.transpose();
-      jtr += j * (len - r);
+      jtr += j * (len - r - slope * s);
     }
-    const Eigen::Vector3d step = jtj.ldlt().solve(-jtr);
+    if (!cone) jtj(3, 3) = 1;  // slope stays 0
+    const Eigen::Vector4d step = jtj.ldlt().solve(-jtr);
     if (!step.allFinite()) break;
     centre += step.head<2>();
-    r += step.z();
+    r += step[2];
+    slope += step[3];
     if (step.norm() < 1e-9 * (1 + std::abs(r))) break;
   }
 }
@@ -80,10 +88,15 @@ bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>
   const Vec3 e1 = anyPerpendicular(a), e2 = a.cross(e1);
   Eigen::Vector2d centre(e1.dot(c), e2.dot(c));
   std::vector<Eigen::Vector2d> flat;
+  std::vector<double> along;
   flat.reserve(points.size());
-  for (const Index i : points) flat.emplace_back(e1.dot(positions[i]), e2.dot(positions[i]));
-  double r = 0;
-  fitCircle(flat, centre, r);
+  along.reserve(points.size());
+  for (const Index i : points) {
+    flat.emplace_back(e1.dot(positions[i]), e2.dot(positions[i]));
+    along.push_back(a.dot(positions[i] - centroid));
+  }
+  double r = 0, slope = 0;
+  fitCircle(flat, along, centre, r, slope);
   fit.direction = a;
   fit.centre = centre.x() * e1 + centre.y() * e2 + a.dot(centroid) * a;
   fit.straightRadius = std::abs(r);
@@ -348,8 +361,8 @@ void recentreAxis(const std::vector<Vec3>& positions, const std::vector<Index>& 
     for (const auto& p : flat) spread += p.norm();
     spread /= double(flat.size());
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-    double r = 0;
-    fitCircle(flat, centre, r);
+    double r = 0, slope = 0;
+    fitCircle(flat, {}, centre, r, slope);
     // A section seen under a narrow angle can send the circle anywhere: only moves that keep it
     // of the section's size are taken.
     if (centre.allFinite() && std::isfinite(r) && centre.norm() < 0.5 * spread && r < 2 * spread)
