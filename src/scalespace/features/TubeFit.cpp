@@ -57,7 +57,7 @@ void fitCircle(const std::vector<Eigen::Vector2d>& flat, const std::vector<doubl
 // The straight axis: direction, centre and radius. False when the normals do not turn around
 // any axis (all parallel: a plane).
 bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& scaleNormals,
-                     const std::vector<Index>& points, TubeFit& fit) {
+                     const std::vector<Index>& points, const Vec3* direction, TubeFit& fit) {
   const double n = double(points.size());
   Mat3 spread = Mat3::Zero();
   Vec3 centroid = Vec3::Zero();
@@ -67,7 +67,7 @@ bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>
   }
   centroid /= n;
   const Eigen::SelfAdjointEigenSolver<Mat3> eig(spread);
-  const Vec3 a = eig.eigenvectors().col(0).normalized();
+  const Vec3 a = direction ? direction->normalized() : Vec3(eig.eigenvectors().col(0).normalized());
   // The centre nearest to every normal line x_i + s n_i, in the plane normal to a: with u_i the
   // in-plane direction across the normal, minimise sum ((c - x_i) . u_i)^2, the component of c
   // along a pinned to the centroid's.
@@ -435,30 +435,46 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   meanKappa /= double(points.size());
   fit.rejection = TubeRejection::Flat;
   if (std::abs(meanKappa) * t < options.minCurvatureFactor || radii.size() < 3) return fit;
-  if (!fitStraightAxis(positions, scaleNormals, points, fit)) return fit;
+  if (!fitStraightAxis(positions, scaleNormals, points, nullptr, fit)) return fit;
 
   std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(radii.size() / 2), radii.end());
   const double cell = std::max(t, radii[radii.size() / 2]);
-  AxisEvaluation straight;
-  {
+  auto straightAxis = [&](const TubeFit& f) {
+    AxisEvaluation e;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Index i : points) {
-      const double s = (positions[i] - fit.centre).dot(fit.direction);
+      const double s = (positions[i] - f.centre).dot(f.direction);
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
     const int pieces = std::max(1, int(std::lround((hi - lo) / cell)));
     for (int k = 0; k <= pieces; ++k)
-      straight.axis.push_back(fit.centre + (lo + (hi - lo) * k / pieces) * fit.direction);
-  }
-  evaluateAxis(positions, normals, points, true, straight);
+      e.axis.push_back(f.centre + (lo + (hi - lo) * k / pieces) * f.direction);
+    evaluateAxis(positions, normals, points, true, e);
+    return e;
+  };
+  AxisEvaluation straight = straightAxis(fit);
   AxisEvaluation curved;
   curved.axis = curvedAxis(positions, scaleNormals, kappa1, points, cell);
   for (int pass = 0; pass < 2; ++pass) recentreAxis(positions, points, curved.axis);
-  // The straight axis unless the curved one describes the points clearly better (a bent pipe).
   fit.straight = true;
   if (curved.axis.size() >= 2) {
     evaluateAxis(positions, normals, points, false, curved);
+    // The normals' least-spread direction leans where they do not turn all around the axis (a
+    // cone seen from one side); the chord of the re-centred curved axis does not. Keep the
+    // straight axis that fits better.
+    const Vec3 chord = curved.axis.back() - curved.axis.front();
+    TubeFit alongChord = fit;
+    if (chord.norm() > 0 && fitStraightAxis(positions, scaleNormals, points, &chord, alongChord)) {
+      AxisEvaluation other = straightAxis(alongChord);
+      if (other.rms < straight.rms) {
+        straight = std::move(other);
+        fit.direction = alongChord.direction;
+        fit.centre = alongChord.centre;
+        fit.straightRadius = alongChord.straightRadius;
+      }
+    }
+    // The straight axis unless the curved one describes the points clearly better (a bent pipe).
     fit.straight = straight.rms <= std::max(options.straightRmsRatio * curved.rms,
                                             curved.rms + 0.02 * curved.meanDistance);
   }
