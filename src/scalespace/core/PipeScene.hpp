@@ -1,9 +1,10 @@
 #pragma once
 // A pipe-rack scene in metres with ground truth, for the cylinders of Sec. 3.5: straight tubes of
-// radii 0.03, 0.1 and 0.35 m (ratio > 10), a bent pipe (radius 0.12 m) (straight, a 90-degree elbow of torus, straight), a
-// tapering pipe (cone), a cable of three strands twisted around a common axis (three thin tubes
-// at a small scale, one thick tube at a large one), and what must not become a cylinder: a floor,
-// a wall and a box standing on the floor. Sampled uniformly by area with exact outward normals.
+// radii 0.03, 0.1 and 0.35 m (ratio > 10), a bent pipe (radius 0.12 m) (straight, a 90-degree elbow
+// of torus, straight), a tapering pipe (cone), a cable of three strands twisted around a common
+// axis (three thin tubes at a small scale, one thick tube at a large one), and what must not become
+// a cylinder: a floor, a wall and a box standing on the floor. Sampled uniformly by area with exact
+// outward normals.
 //
 // Columns: "gt_pipe" (int32: PipeTruth::id, -1 on the floor, wall and box) and "gt_part" (int32:
 // for the bent pipe 0 / 1 / 2 = first straight / elbow / second straight, for the cable the strand
