@@ -11,6 +11,7 @@ raise :class:`FileError` (an OSError).
     cloud = ss.read("scan.ply")
     curv = ss.curvature(cloud.points, cloud.normals, scale_k=40)
     planes = ss.planes(cloud.points, scales=30)
+    pipes = ss.cylinders(cloud.points, cloud.normals)
 """
 from dataclasses import dataclass, field
 from typing import Dict, Mapping, Optional
@@ -19,6 +20,7 @@ import numpy as np
 
 from ._scalespace import (  # noqa: F401
     Cancelled,
+    Cylinders,
     Error,
     FileError,
     OptionError,
@@ -27,6 +29,7 @@ from ._scalespace import (  # noqa: F401
     __version__,
     compute_stack,
     curvature,
+    cylinders,
     estimate_normals,
     features,
     lines,
@@ -40,7 +43,8 @@ from . import _scalespace
 
 __all__ = [
     "Cloud", "read", "write", "estimate_normals", "curvature", "compute_stack", "open_stack",
-    "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "Error",
+    "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "cylinders",
+    "Cylinders", "Error",
     "OptionError", "FileError", "Cancelled", "__version__",
 ]
 

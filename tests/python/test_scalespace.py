@@ -3,6 +3,7 @@ with PYTHONPATH=build/python and SCALESPACE_CLI=build/scalespace; by hand:
 PYTHONPATH=build/python SCALESPACE_CLI=build/scalespace /usr/bin/python3 -m pytest tests/python
 """
 import gc
+import json
 import os
 import signal
 import subprocess
@@ -174,6 +175,109 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
         np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
                                       labelled[name], name)
     assert len(features["curves"]) == features["curve_id"].max() + 1
+
+
+@pytest.fixture(scope="module")
+def pipes(tmp_path_factory):
+    """The pipe rack, and `scalespace cylinders` on it: default labels and those at a scale."""
+    d = tmp_path_factory.mktemp("pipes")
+    cli("generate", "pipes", "-n", 60000, "-o", d / "pipes.ply")
+    cli("cylinders", d / "pipes.ply", "-o", d / "default")
+    scales = json.loads((d / "default" / "components.json").read_text())["levels"]
+    t = scales[len(scales) // 2]["scale"] * 1.01  # not a computed scale: the nearest is taken
+    cli("cylinders", d / "pipes.ply", "-o", d / "at", "--scale", t, "--min-persistence", 1)
+    cloud = ss.read(str(d / "pipes.ply"))
+    return d, cloud, ss.cylinders(cloud.points, cloud.normals), t
+
+
+def test_cylinders_equal_the_cli(pipes):
+    d, cloud, cylinders, t = pipes
+    written = json.loads((d / "default" / "components.json").read_text())
+    expected = written["components"]
+    got = cylinders.components
+    assert len(got) == len(expected) == len(cylinders) > 3
+    np.testing.assert_allclose(cylinders.scales, [l["scale"] for l in written["levels"]],
+                               rtol=1e-12)
+    for g, e in zip(got, expected):
+        for key in ("id", "birth_level", "death_level", "persistence", "representative_level",
+                    "point_count", "straight"):
+            assert g[key] == e[key], key
+        for key in ("birth_scale", "death_scale", "radius", "rms", "length", "arc_degrees"):
+            np.testing.assert_allclose(g[key], e[key], rtol=1e-9, err_msg=key)
+        np.testing.assert_allclose(g["axis"], e["axis"], rtol=1e-9, atol=1e-9)  # absolute
+        np.testing.assert_allclose(g["radii"], e["radii"], rtol=1e-9)
+        assert g["axis"].shape == (len(g["radii"]), 3)
+        if e["straight"]:
+            np.testing.assert_allclose(g["direction"], e["direction"], atol=1e-9)
+            np.testing.assert_allclose(g["centre"], e["centre"], rtol=1e-9, atol=1e-9)
+        else:
+            assert g["direction"] is None and g["centre"] is None
+    for g, e in zip(cylinders.levels, written["levels"]):
+        for key in ("lines", "regular_lines", "regions", "tubes", "rejected"):
+            assert g[key] == e[key], key
+
+    default = ss.read(str(d / "default" / "cloud.ply")).attributes
+    np.testing.assert_array_equal(cylinders.labels_by_persistence(), default["cylinder_id"])
+    at = ss.read(str(d / "at" / "cloud.ply")).attributes
+    level = cylinders.nearest_level(t)
+    labels = cylinders.labels_at_scale(t, min_persistence=1)
+    assert labels.dtype == np.int32 and (labels >= 0).any()
+    np.testing.assert_array_equal(labels, at["cylinder_id"])
+    np.testing.assert_array_equal(cylinders.labels_at_level(level, 1), labels)
+    # The CLI writes the anisotropy at that scale, -1 where none.
+    sigma = cylinders.anisotropy(level)
+    assert sigma.dtype == np.float32 and np.isnan(sigma).any()
+    np.testing.assert_array_equal(np.where(np.isnan(sigma), -1, sigma), at["anisotropy"])
+    # A component's points at a level are those labelled with it there.
+    everywhere = cylinders.labels_at_level(level)
+    for c in np.unique(everywhere[everywhere >= 0]):
+        np.testing.assert_array_equal(cylinders.points(int(c), level),
+                                      np.flatnonzero(everywhere == c))
+    first = got[0]
+    assert len(cylinders.points(0, first["representative_level"])) == first["point_count"]
+    if first["death_level"] + 1 < len(cylinders.scales):
+        assert len(cylinders.points(0, first["death_level"] + 1)) == 0
+
+
+def test_cylinders_without_normals_equal_the_cli(pipes, tmp_path):
+    _, cloud, _, _ = pipes
+    ss.write(str(tmp_path / "bare.ply"), cloud.points)  # both estimate and orient the normals
+    cli("cylinders", tmp_path / "bare.ply", "-o", tmp_path / "c")
+    expected = json.loads((tmp_path / "c" / "components.json").read_text())["components"]
+    cylinders = ss.cylinders(cloud.points)
+    assert len(cylinders) == len(expected) > 3
+    np.testing.assert_allclose([c["radius"] for c in cylinders.components],
+                               [c["radius"] for c in expected], rtol=1e-9)
+    np.testing.assert_array_equal(cylinders.labels_by_persistence(),
+                                  ss.read(str(tmp_path / "c" / "cloud.ply")).attributes["cylinder_id"])
+
+
+def test_cylinders_bad_options_and_cancel(pipes):
+    _, cloud, cylinders, _ = pipes
+    p = cloud.points[::20]
+    for kwargs, name in [({"epsilon": 1}, "epsilon"), ({"min_anisotropy": 2}, "min_anisotropy"),
+                         ({"scale_count": 0}, "scale_count"), ({"min_arc": 400}, "min_arc"),
+                         ({"max_rms": 0}, "max_rms"), ({"tmin": -1}, "tmin"),
+                         ({"scales": [0.2, 0.1]}, "scales")]:
+        with pytest.raises(ss.OptionError, match=name) as e:
+            ss.cylinders(p, **kwargs)
+        assert "Options::" not in str(e.value)
+    with pytest.raises(ss.OptionError, match="too few points .* for the automatic tmin"):
+        ss.cylinders(p[:8], cloud.normals[:8])
+    with pytest.raises(ss.OptionError, match="level 99"):
+        cylinders.anisotropy(99)
+    with pytest.raises(ss.OptionError, match="min_persistence"):
+        cylinders.labels_by_persistence(-1)
+    with pytest.raises(ss.OptionError, match="component"):
+        cylinders.points(len(cylinders), 0)
+    stages = []
+
+    def stop(fraction, stage):
+        stages.append(stage)
+        return len(stages) < 3  # the third call cancels
+    with pytest.raises(ss.Cancelled):
+        ss.cylinders(cloud.points, cloud.normals, progress=stop)
+    assert len(stages) == 3
 
 
 def cube_obj(path, n=12):

@@ -5,9 +5,10 @@
 
 namespace scalespace::python {
 
-void bindClouds(pybind11::module_& m);    // read, write, normals, curvature, render
-void bindStacks(pybind11::module_& m);    // the multi-scale stack, in memory and on disk
-void bindPlanes(pybind11::module_& m);    // planes, their result folders, the segment queries
-void bindFeatures(pybind11::module_& m);  // curvature lines, feature curves
+void bindClouds(pybind11::module_& m);     // read, write, normals, curvature, render
+void bindStacks(pybind11::module_& m);     // the multi-scale stack, in memory and on disk
+void bindPlanes(pybind11::module_& m);     // planes, their result folders, the segment queries
+void bindFeatures(pybind11::module_& m);   // curvature lines, feature curves
+void bindCylinders(pybind11::module_& m);  // cylinders across scales
 
 }  // namespace scalespace::python

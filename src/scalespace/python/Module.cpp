@@ -15,4 +15,5 @@ PYBIND11_MODULE(_scalespace, m) {
   scalespace::python::bindStacks(m);
   scalespace::python::bindPlanes(m);
   scalespace::python::bindFeatures(m);
+  scalespace::python::bindCylinders(m);
 }
