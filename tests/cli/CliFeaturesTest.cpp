@@ -27,11 +27,13 @@ nlohmann::json readJson(const std::string& path) {
 
 /// A unit cube as an OFF mesh whose faces are n x n grids of squares (two triangles each),
 /// outward: the mesh protocol of Sec. 3.4.1 needs vertices spread along the edges.
-void writeCube(const std::string& path, int n) {
+void writeCube(const std::string& path, int n, const Vec3& offset = Vec3::Zero()) {
   std::vector<Vec3> vertices;
   std::vector<std::array<Index, 3>> triangles;
   test::cubeMesh(n, vertices, triangles);
+  for (Vec3& v : vertices) v += offset;
   std::ofstream out(path);
+  out.precision(17);
   out << "OFF\n" << vertices.size() << " " << triangles.size() << " 0\n";
   for (const Vec3& p : vertices) out << p.x() << " " << p.y() << " " << p.z() << "\n";
   for (const auto& t : triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
@@ -75,27 +77,37 @@ TEST_F(Cli, FeaturesLabelPointsAndMeshVertices) {
   r = run("features " + path("cube.off") + " -q -o " + path("m.ply") + " --lines " +
           path("m_lines.ply"));
   ASSERT_EQ(r.code, 0) << r.err;
-  const PointCloud vertices = readCloud(path("m.ply"));
-  ASSERT_EQ(vertices.size(), 602u);
-  const AttributeColumn* convexity = vertices.findAttribute("convexity");
-  ASSERT_NE(convexity, nullptr);
-  std::size_t edgeVertices = 0, edgeConvex = 0, middleLabelled = 0;
-  for (std::size_t i = 0; i < vertices.size(); ++i) {
-    const Vec3 p = vertices.absolutePosition(i);
-    int onBorder = 0;  // coordinates at 0 or 1: 2 on an edge, 1 inside a face
-    for (int c = 0; c < 3; ++c) onBorder += std::abs(p[c]) < 1e-6 || std::abs(p[c] - 1) < 1e-6;
-    double inside = 1;
-    for (int c = 0; c < 3; ++c) inside = std::min({inside, std::abs(p[c]), std::abs(1 - p[c])});
-    if (onBorder >= 2) {
-      ++edgeVertices;
-      edgeConvex += convexity->values[i] == 1;
+  // The vertices on its edges are labelled convex, those of the faces' middles none.
+  auto checkCube = [](const PointCloud& vertices, const Vec3& offset) {
+    ASSERT_EQ(vertices.size(), 602u);
+    const AttributeColumn* convexity = vertices.findAttribute("convexity");
+    ASSERT_NE(convexity, nullptr);
+    std::size_t edgeVertices = 0, edgeConvex = 0, middleLabelled = 0;
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const Vec3 p = vertices.absolutePosition(i) - offset;
+      int onBorder = 0;  // coordinates at 0 or 1: 2 on an edge, 1 inside a face
+      for (int c = 0; c < 3; ++c) onBorder += std::abs(p[c]) < 1e-6 || std::abs(p[c] - 1) < 1e-6;
+      double inside = 1;
+      for (int c = 0; c < 3; ++c) inside = std::min({inside, std::abs(p[c]), std::abs(1 - p[c])});
+      if (onBorder >= 2) {
+        ++edgeVertices;
+        edgeConvex += convexity->values[i] == 1;
+      }
+      if (onBorder == 1 && inside >= 0.35) middleLabelled += convexity->values[i] != 0;
     }
-    if (onBorder == 1 && inside >= 0.35) middleLabelled += convexity->values[i] != 0;
-  }
-  EXPECT_GE(edgeConvex, std::size_t(0.9 * double(edgeVertices))) << edgeVertices;
-  EXPECT_EQ(middleLabelled, 0u);
+    EXPECT_GE(edgeConvex, std::size_t(0.9 * double(edgeVertices))) << edgeVertices;
+    EXPECT_EQ(middleLabelled, 0u);
+  };
+  checkCube(readCloud(path("m.ply")), Vec3::Zero());
   EXPECT_EQ(readJson(path("m.json"))["labelled"], "mesh vertices");
   EXPECT_GT(readPolylines(path("m_lines.ply")).lineCount(), 0u);
+
+  // The same cube far from the origin (georeferenced coordinates: the samples are stored relative
+  // to an origin of their own) labels its edges as well.
+  writeCube(path("far.off"), 10, Vec3(5e5, -3e5, 1e4));
+  r = run("features " + path("far.off") + " -q -o " + path("far.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  checkCube(readCloud(path("far.ply")), Vec3(5e5, -3e5, 1e4));
 }
 
 TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {

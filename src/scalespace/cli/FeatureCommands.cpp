@@ -271,7 +271,11 @@ void addFeaturesCommand(CLI::App& app) {
       const std::size_t count = args->samplesPerVertex * triangles.vertices.size();
       // Interpolated normals (Sec. 3.4.1) except on triangles at a sharp edge (THESIS_NOTES).
       cloud = sampleMesh(triangles, count, 1, kCreaseAngleDegrees);
-      targets.setRelativePositions(triangles.vertices, Vec3::Zero());
+      // The votes are cast in the samples' frame: relative to the cloud's origin, which is not 0
+      // for a mesh far from the origin (georeferenced coordinates).
+      std::vector<Vec3> relative = triangles.vertices;
+      for (Vec3& v : relative) v -= cloud.origin();
+      targets.setRelativePositions(std::move(relative), cloud.origin());
       if (options.spacing == 0) {
         options.spacing = medianEdgeLength(triangles);
         // The protocol of Sec. 3.4.1 is made for dense meshes (5k-215k vertices): on a coarse
@@ -286,7 +290,7 @@ void addFeaturesCommand(CLI::App& app) {
                      args->input.path.c_str(), triangles.vertices.size(),
                      triangles.triangles.size(), cloud.size(), options.spacing);
       const KnnGraph graph = buildMeshEdgeGraph(triangles.vertices.size(), triangles.triangles);
-      result = detectFeatureCurves(cloud, options, triangles.vertices, graph, progress);
+      result = detectFeatureCurves(cloud, options, targets.positions(), graph, progress);
     } else {
       cloud = loadCloud(args->input, args->quiet);
       ensureNormals(cloud, args->quiet);
