@@ -20,9 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Mesh inputs: triangles with a vertex normal this far from their own take the face normal.
-constexpr double kCreaseAngleDegrees = 30;
-
 /// Every line of `sets` as one polyline set with the per-vertex attributes of Sec. 3.3:
 /// line id, scale, kappa1, kappa2, |kappa1| - |kappa2|, nu, tangent (and the normal).
 PolylineSet toPolylines(const std::vector<CurvatureLineSet>& sets, const Vec3& origin) {
@@ -183,18 +180,6 @@ void addLinesCommand(CLI::App& app) {
 }
 
 // ---------------------------------------------------------------------------------- features
-/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1).
-double medianEdgeLength(const TriangleMesh& mesh) {
-  std::vector<double> lengths;
-  lengths.reserve(3 * mesh.triangles.size());
-  for (const auto& t : mesh.triangles)
-    for (int c = 0; c < 3; ++c)
-      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
-  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
-                   lengths.end());
-  return lengths[lengths.size() / 2];
-}
-
 void addFeaturesCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
@@ -268,29 +253,19 @@ void addFeaturesCommand(CLI::App& app) {
     const auto progress = makeProgressBar(args->quiet);
     if (mesh) {
       const TriangleMesh triangles = readTriangleMesh(args->input.path);
-      const std::size_t count = args->samplesPerVertex * triangles.vertices.size();
-      // Interpolated normals (Sec. 3.4.1) except on triangles at a sharp edge (THESIS_NOTES).
-      cloud = sampleMesh(triangles, count, 1, kCreaseAngleDegrees);
-      // The votes are cast in the samples' frame: relative to the cloud's origin, which is not 0
-      // for a mesh far from the origin (georeferenced coordinates).
-      std::vector<Vec3> relative = triangles.vertices;
-      for (Vec3& v : relative) v -= cloud.origin();
-      targets.setRelativePositions(std::move(relative), cloud.origin());
-      if (options.spacing == 0) {
-        options.spacing = medianEdgeLength(triangles);
-        // The protocol of Sec. 3.4.1 is made for dense meshes (5k-215k vertices): on a coarse
-        // one the scales [e, 3e] are as large as its faces.
-        if (options.spacing > 0.05 * cloud.boundingBoxDiagonal())
-          printWarnings({"the mesh is coarse (median edge " + std::to_string(options.spacing) +
-                         ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
-                         "faces; give a finer --spacing, or remesh it"});
-      }
+      MeshFeatureCurves onMesh =
+          detectMeshFeatureCurves(triangles, options, args->samplesPerVertex, progress);
+      if (onMesh.coarse)
+        printWarnings({"the mesh is coarse (median edge " + std::to_string(onMesh.curves.spacing) +
+                       ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
+                       "faces; give a finer --spacing, or remesh it"});
       if (!args->quiet)
         std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu samples, e = %.6g\n",
                      args->input.path.c_str(), triangles.vertices.size(),
-                     triangles.triangles.size(), cloud.size(), options.spacing);
-      const KnnGraph graph = buildMeshEdgeGraph(triangles.vertices.size(), triangles.triangles);
-      result = detectFeatureCurves(cloud, options, targets.positions(), graph, progress);
+                     triangles.triangles.size(), onMesh.samples.size(), onMesh.curves.spacing);
+      targets.setAbsolutePositions(triangles.vertices);
+      cloud = std::move(onMesh.samples);
+      result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
       ensureNormals(cloud, args->quiet);

@@ -321,3 +321,43 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
 }
 
 }  // namespace scalespace
+
+namespace scalespace {
+
+double medianEdgeLength(const TriangleMesh& mesh) {
+  std::vector<double> lengths;
+  lengths.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c)
+      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
+  if (lengths.empty()) return 0;
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
+                   lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+MeshFeatureCurves detectMeshFeatureCurves(const TriangleMesh& mesh, FeatureCurveOptions options,
+                                          std::size_t samplesPerVertex,
+                                          const ProgressCallback& progress) {
+  validateFeatureCurveOptions(options);
+  require(samplesPerVertex >= 1 && samplesPerVertex <= 10000,
+          "detectMeshFeatureCurves: samplesPerVertex must be in [1, 10000]");
+  require(!mesh.triangles.empty(), "detectMeshFeatureCurves: the mesh has no triangles");
+  // Interpolated normals (Sec. 3.4.1) except on triangles at a sharp edge (THESIS_NOTES).
+  constexpr double kCreaseAngleDegrees = 30;
+  MeshFeatureCurves out;
+  out.samples = sampleMesh(mesh, samplesPerVertex * mesh.vertices.size(), 1, kCreaseAngleDegrees);
+  if (options.spacing == 0) {
+    options.spacing = medianEdgeLength(mesh);
+    out.coarse = options.spacing > 0.05 * out.samples.boundingBoxDiagonal();
+  }
+  // The votes are cast in the samples' frame: relative to their origin, which is not 0 for a mesh
+  // far from the origin (georeferenced coordinates).
+  std::vector<Vec3> targets = mesh.vertices;
+  for (Vec3& v : targets) v -= out.samples.origin();
+  const KnnGraph graph = buildMeshEdgeGraph(mesh.vertices.size(), mesh.triangles);
+  out.curves = detectFeatureCurves(out.samples, options, targets, graph, progress);
+  return out;
+}
+
+}  // namespace scalespace

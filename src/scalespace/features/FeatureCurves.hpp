@@ -21,6 +21,7 @@
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/core/Types.hpp"
 #include "scalespace/features/CurvatureLines.hpp"
+#include "scalespace/io/MeshFormat.hpp"
 
 namespace scalespace {
 
@@ -105,6 +106,28 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                                        const std::vector<Vec3>& targets,
                                        const KnnGraph& targetGraph,
                                        const ProgressCallback& progress = {});
+
+struct MeshFeatureCurves {
+  FeatureCurveResult curves;  // per mesh vertex, in the mesh's order
+  /// The area samples the lines ran on: the lines' positions are relative to samples.origin().
+  PointCloud samples;
+  /// The spacing was taken from the mesh and is over 5% of its diagonal: Sec. 3.4.1's protocol is
+  /// made for dense meshes (5k-215k vertices); on a coarse one the scales [e, 3e] are as large as
+  /// its faces.
+  bool coarse = false;
+};
+
+/// Sec. 3.4.1's protocol on a triangle mesh: samplesPerVertex x (vertex count) samples by area
+/// with interpolated normals (face normals on triangles at a crease of 30 degrees or more,
+/// docs/THESIS_NOTES.md), e = the median edge length when options.spacing is 0, votes cast on the
+/// vertices and curves grown on the mesh edges. Throws OptionError for bad options or
+/// samplesPerVertex outside [1, 10000].
+MeshFeatureCurves detectMeshFeatureCurves(const TriangleMesh& mesh, FeatureCurveOptions options,
+                                          std::size_t samplesPerVertex = 100,
+                                          const ProgressCallback& progress = {});
+
+/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1).
+double medianEdgeLength(const TriangleMesh& mesh);
 
 /// The undirected edge graph of a triangle mesh over `vertexCount` vertices (each neighbour once,
 /// increasing), in KnnGraph's compressed rows.

@@ -103,23 +103,6 @@ py::dict linesPy(const py::handle& points, const py::handle& normals, std::optio
   return linesToDict(sets, cloud.origin());
 }
 
-/// Mesh inputs: triangles with a vertex normal this far from their own take the face normal
-/// (the CLI's kCreaseAngleDegrees, cli/FeatureCommands.cpp).
-constexpr double kCreaseAngleDegrees = 30;
-
-/// The median edge length of a mesh (the thesis' e for mesh inputs, Sec. 3.4.1), as the CLI takes
-/// it.
-double medianEdgeLength(const TriangleMesh& mesh) {
-  std::vector<double> lengths;
-  lengths.reserve(3 * mesh.triangles.size());
-  for (const auto& t : mesh.triangles)
-    for (int c = 0; c < 3; ++c)
-      lengths.push_back((mesh.vertices[t[c]] - mesh.vertices[t[(c + 1) % 3]]).norm());
-  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2),
-                   lengths.end());
-  return lengths[lengths.size() / 2];
-}
-
 TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
   const py::array any = py::module_::import("numpy").attr("asarray")(triangles);
   const char kind = any.dtype().kind();
@@ -180,18 +163,15 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
       if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
       return detectFeatureCurves(cloud, options, call.progress());
     }
-    cloud = sampleMesh(*mesh, meshSamples * mesh->vertices.size(), 1, kCreaseAngleDegrees);
-    if (options.spacing == 0) {
-      options.spacing = medianEdgeLength(*mesh);
-      if (options.spacing > 0.05 * cloud.boundingBoxDiagonal())
-        warnings.push_back("the mesh is coarse (median edge " + std::to_string(options.spacing) +
-                           ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
-                           "faces; give a finer spacing, or remesh it");
-    }
-    std::vector<Vec3> targets = mesh->vertices;  // in the cloud's (recentred) frame
-    for (Vec3& v : targets) v -= cloud.origin();
-    const KnnGraph graph = buildMeshEdgeGraph(mesh->vertices.size(), mesh->triangles);
-    return detectFeatureCurves(cloud, options, targets, graph, call.progress());
+    MeshFeatureCurves onMesh =
+        detectMeshFeatureCurves(*mesh, options, meshSamples, call.progress());
+    if (onMesh.coarse)
+      warnings.push_back("the mesh is coarse (median edge " +
+                         std::to_string(onMesh.curves.spacing) +
+                         ", over 5% of its diagonal): the scales [e, 3e] are as large as its "
+                         "faces; give a finer spacing, or remesh it");
+    cloud = std::move(onMesh.samples);
+    return std::move(onMesh.curves);
   });
   warn(warnings);
   py::dict d;
