@@ -89,6 +89,26 @@ TEST_F(Cli, CylindersFindThePipesOfTheRack) {
     after += atScale.findAttribute("cylinder_id")->values[i] >= 0;
   }
   EXPECT_LE(after, before);
+
+  // The same queries from the saved folder, without recomputing: identical labels.
+  auto labelsOf = [&](const std::string& file) {
+    return readCloud(path(file)).findAttribute("cylinder_id")->values;
+  };
+  r = run("cylinders-segment " + path("out") + " -q --scale 0.1 --min-persistence 2 -o " +
+          path("seg_scale.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(labelsOf("seg_scale.ply"), atScale.findAttribute("cylinder_id")->values);
+  r = run("cylinders-segment " + path("out") + " -q -o " + path("seg_default.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(labelsOf("seg_default.ply"), id->values);
+  // A folder that is no cylinders result, and a cloud of another size, are refused.
+  r = run("cylinders-segment " + path(".") + " -q -o " + path("x.ply"));
+  EXPECT_NE(r.code, 0);
+  ASSERT_EQ(run("generate cylinder -n 100 -q -o " + path("small.ply")).code, 0);
+  r = run("cylinders-segment " + path("out") + " --input " + path("small.ply") + " -q -o " +
+          path("x.ply"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("points"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {

@@ -37,3 +37,25 @@ TEST(RegionGraph, ChainsJaccardAndPersistence) {
   levels[3].regions.back() = {9};  // and so is a point past pointCount
   EXPECT_THROW(buildRegionGraph(levels, 9), OptionError);
 }
+
+TEST(RegionGraph, LabelQueriesOnAMembership) {
+  // 3 points, 2 levels: component 0 (persistence 1) holds point 0 at level 0, component 1
+  // (persistence 0) holds points 0 and 1 at level 1, point 2 is never held.
+  PointMembership m;
+  m.pointCount = 3;
+  m.levelCount = 2;
+  m.ids = {0, -1, -1, /* level 1 */ 1, 1, -1};
+  const std::vector<int> persistence{1, 0};
+  EXPECT_EQ(labelsByPersistence(m, persistence, 0), (std::vector<int>{0, 1, -1}));
+  EXPECT_EQ(labelsByPersistence(m, persistence, 1), (std::vector<int>{0, -1, -1}));
+  EXPECT_EQ(labelsAtLevel(m, persistence, 1), (std::vector<int>{1, 1, -1}));
+  EXPECT_EQ(labelsAtLevel(m, persistence, 1, 1), (std::vector<int>{-1, -1, -1}));
+  EXPECT_THROW(labelsAtLevel(m, persistence, 2), OptionError);
+  // Equal persistence: the lower id wins.
+  EXPECT_EQ(labelsByPersistence(m, {0, 0}, 0), (std::vector<int>{0, 1, -1}));
+  EXPECT_EQ(nearestScaleIndex({0.1, 0.2, 0.4}, 0.27), 1);
+  EXPECT_EQ(nearestScaleIndex({0.1, 0.2, 0.4}, 0.3), 2);  // log midpoint of 0.2, 0.4 is 0.283
+  EXPECT_EQ(nearestScaleIndex({0.1, 0.2, 0.4}, 1e-9), 0);
+  EXPECT_THROW(nearestScaleIndex({}, 1), OptionError);
+  EXPECT_THROW(nearestScaleIndex({0.1}, -1), OptionError);
+}

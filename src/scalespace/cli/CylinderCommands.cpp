@@ -15,6 +15,7 @@
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/io/Polylines.hpp"
+#include "scalespace/planes/PlaneExport.hpp"
 
 namespace scalespace::cli {
 namespace {
@@ -127,7 +128,7 @@ void addCylindersCommand(CLI::App& app) {
   addInputOptions(*cmd, args->input);
   cmd->add_option("-o,--output", args->output,
                   "output folder: cloud.ply (cylinder_id, anisotropy), components.json / .csv, "
-                  "axes.ply")
+                  "axes.ply, membership.bin (for cylinders-segment)")
       ->required();
   cmd->add_option("--scales", args->cylinders.scaleCount, "number of log-spaced scales")
       ->capture_default_str();
@@ -202,6 +203,8 @@ void addCylindersCommand(CLI::App& app) {
     writePolylines(axesOf(detection, cloud.origin()), (dir / "axes.ply").string(),
                    WriteOptions{args->ascii});
     writeComponentsCsv(detection, cloud.origin(), (dir / "components.csv").string());
+    // What `cylinders-segment` reloads to answer other queries without recomputing.
+    writeMembership(pointMembership(detection.graph), (dir / "membership.bin").string());
     nlohmann::json levels = nlohmann::json::array();
     for (const CylinderLevel& l : detection.levels) {
       nlohmann::json rejected = nlohmann::json::object();
@@ -251,6 +254,97 @@ void addCylindersCommand(CLI::App& app) {
   });
 }
 
+void addCylindersSegmentCommand(CLI::App& app) {
+  struct Args {
+    std::string directory, output, input;
+    int minPersistence = 0;
+    double scale = 0;
+    bool ascii = false, quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "cylinders-segment",
+      "label points with the cylinders of a `cylinders` folder, without recomputing them: the "
+      "most persistent component per point, or the components at one scale");
+  cmd->add_option("directory", args->directory, "output folder of `scalespace cylinders`")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("-o,--output", args->output, "output cloud (input points + cylinder_id)")
+      ->required();
+  cmd->add_option("--min-persistence", args->minPersistence,
+                  "label only components living at least this many scale steps")
+      ->capture_default_str();
+  auto* scale =
+      cmd->add_option("--scale", args->scale, "the components at the computed scale nearest to T");
+  cmd->add_option("--input", args->input,
+                  "the cloud the cylinders were computed on (default: the one recorded in DIR)");
+  cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
+  cmd->callback([args, scale] {
+    const auto start = Clock::now();
+    if (args->minPersistence < 0) throw OptionError("--min-persistence must be >= 0");
+    if (!isCylinderResult(args->directory))
+      throw FileError(args->directory, "", "holds no cylinders result (components.json)",
+                      "give the output folder of `scalespace cylinders`");
+    const fs::path dir(args->directory);
+    nlohmann::json result;
+    {
+      std::ifstream in(dir / "components.json");
+      result = nlohmann::json::parse(in, nullptr, false);
+    }
+    if (result.is_discarded() || !result.contains("levels") || !result.contains("components"))
+      throw FileError((dir / "components.json").string(), "", "is not a cylinders result",
+                      "run `scalespace cylinders` again");
+    std::vector<double> scales;
+    std::vector<int> persistence;
+    for (const auto& level : result["levels"]) scales.push_back(level["scale"].get<double>());
+    for (const auto& c : result["components"]) persistence.push_back(c["persistence"].get<int>());
+    const PointMembership membership = readMembership((dir / "membership.bin").string());
+    if (membership.levelCount != int(scales.size()))
+      throw FileError((dir / "membership.bin").string(), "",
+                      "does not match components.json (" + std::to_string(membership.levelCount) +
+                          " levels against " + std::to_string(scales.size()) + ")",
+                      "run `scalespace cylinders` again");
+    for (const int id : membership.ids)
+      if (id >= int(persistence.size()))
+        throw FileError(
+            (dir / "membership.bin").string(), "",
+            "names component " + std::to_string(id) + " of " + std::to_string(persistence.size()),
+            "run `scalespace cylinders` again");
+    InputOptions input;
+    input.path = args->input.empty() ? result.value("input", std::string()) : args->input;
+    std::error_code ec;
+    if (!fs::is_regular_file(input.path, ec))
+      throw FileError(
+          input.path, "",
+          "the cloud the cylinders in " + args->directory + " were computed on is not there",
+          "pass it with --input IN");
+    checkOutput(args->output, OutputKind::Cloud, {input.path, args->directory});
+    PointCloud cloud = loadCloud(input, args->quiet);
+    if (cloud.size() != membership.pointCount)
+      throw FileError(input.path, "",
+                      "has " + std::to_string(cloud.size()) + " points but the cylinders in " +
+                          args->directory + " were computed on " +
+                          std::to_string(membership.pointCount),
+                      "pass the original cloud with --input");
+    const std::vector<int> labels =
+        *scale ? labelsAtLevel(membership, persistence, nearestScaleIndex(scales, args->scale),
+                               args->minPersistence)
+               : labelsByPersistence(membership, persistence, args->minPersistence);
+    std::size_t labelled = 0;
+    AttributeColumn& ids = cloud.addAttribute("cylinder_id", ScalarType::Int32);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      ids.values[i] = labels[i];
+      labelled += labels[i] >= 0;
+    }
+    writeCloud(cloud, args->output, WriteOptions{args->ascii});
+    if (!args->quiet)
+      std::fprintf(stderr, "cylinders-segment: %zu of %zu points labelled -> %s\n", labelled,
+                   cloud.size(), args->output.c_str());
+    reportDone("cylinders-segment", start, args->quiet);
+  });
+}
+
 }  // namespace
 
 void checkCylinderResultDestination(const std::string& directory) {
@@ -266,6 +360,9 @@ void checkCylinderResultDestination(const std::string& directory) {
                     "choose a new or empty output folder");
 }
 
-void addCylinderCommands(CLI::App& app) { addCylindersCommand(app); }
+void addCylinderCommands(CLI::App& app) {
+  addCylindersCommand(app);
+  addCylindersSegmentCommand(app);
+}
 
 }  // namespace scalespace::cli

@@ -2,11 +2,65 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+#include <string>
 #include <unordered_map>
 
 #include "scalespace/core/Error.hpp"
 
 namespace scalespace {
+
+PointMembership pointMembership(const RegionGraph& graph) {
+  PointMembership m;
+  m.pointCount = graph.pointCount;
+  m.levelCount = int(graph.levels.size());
+  m.ids.reserve(graph.pointCount * graph.levels.size());
+  for (int j = 0; j < m.levelCount; ++j) {
+    const std::vector<int> labels = graph.componentLabels(j);
+    m.ids.insert(m.ids.end(), labels.begin(), labels.end());
+  }
+  return m;
+}
+
+std::vector<int> labelsByPersistence(const PointMembership& membership,
+                                     const std::vector<int>& persistence, int minPersistence) {
+  std::vector<int> labels(membership.pointCount, -1);
+  for (int j = 0; j < membership.levelCount; ++j)
+    for (std::size_t i = 0; i < membership.pointCount; ++i) {
+      const int c = membership.at(j, i);
+      if (c < 0 || persistence[std::size_t(c)] < minPersistence) continue;
+      const int b = labels[i];
+      // Higher persistence, then lower id.
+      if (b < 0 || persistence[std::size_t(c)] > persistence[std::size_t(b)] ||
+          (persistence[std::size_t(c)] == persistence[std::size_t(b)] && c < b))
+        labels[i] = c;
+    }
+  return labels;
+}
+
+std::vector<int> labelsAtLevel(const PointMembership& membership,
+                               const std::vector<int>& persistence, int level, int minPersistence) {
+  if (level < 0 || level >= membership.levelCount)
+    throw OptionError("level " + std::to_string(level) + " is outside [0, " +
+                      std::to_string(membership.levelCount) + ")");
+  std::vector<int> labels(membership.pointCount, -1);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const int c = membership.at(level, i);
+    if (c >= 0 && persistence[std::size_t(c)] >= minPersistence) labels[i] = c;
+  }
+  return labels;
+}
+
+int nearestScaleIndex(const std::vector<double>& scales, double t) {
+  if (scales.empty()) throw OptionError("there are no scales");
+  if (!(t > 0) || !std::isfinite(t)) throw OptionError("the scale t must be finite and > 0");
+  int best = 0;
+  for (int j = 1; j < int(scales.size()); ++j)
+    if (std::abs(std::log(scales[std::size_t(j)] / t)) <
+        std::abs(std::log(scales[std::size_t(best)] / t)))
+      best = j;
+  return best;
+}
 
 double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b) {
   std::size_t common = 0;

@@ -42,6 +42,34 @@ struct RegionGraph {
   std::vector<int> componentLabels(int level) const;
 };
 
+/// Per level and point, the component holding the point: ids[level * pointCount + i], or -1. What
+/// the label queries of Sec. 2.4.1-2.4.2 read, for any primitive, and what results save (planes
+/// and cylinders write it as membership.bin, planes/PlaneExport.hpp).
+struct PointMembership {
+  std::size_t pointCount = 0;
+  int levelCount = 0;
+  std::vector<int> ids;
+  int at(int level, std::size_t i) const { return ids[std::size_t(level) * pointCount + i]; }
+};
+
+/// The membership of every level of `graph` (componentLabels, level after level).
+PointMembership pointMembership(const RegionGraph& graph);
+
+/// Sec. 2.4.1: per point, the most persistent component (persistence[c], lower id on ties) with
+/// persistence >= minPersistence holding it at any level, or -1.
+std::vector<int> labelsByPersistence(const PointMembership& membership,
+                                     const std::vector<int>& persistence, int minPersistence);
+
+/// Sec. 2.4.2: per point, the component holding it at `level` if its persistence is >=
+/// minPersistence, else -1. Throws OptionError for a level out of range.
+std::vector<int> labelsAtLevel(const PointMembership& membership,
+                               const std::vector<int>& persistence, int level,
+                               int minPersistence = 0);
+
+/// The index of the scale nearest to t on a log scale (the scales are log-spaced, Eq. 1.40).
+/// Throws OptionError when `scales` is empty or t is not finite and > 0.
+int nearestScaleIndex(const std::vector<double>& scales, double t);
+
 /// Jaccard index |A n B| / |A u B| of two increasing index lists (Eq. 2.1).
 double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b);
 

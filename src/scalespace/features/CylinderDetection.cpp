@@ -243,15 +243,18 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
   return result;
 }
 
+namespace {
+std::vector<int> persistenceOf(const CylinderDetection& detection) {
+  std::vector<int> p;
+  for (const CylinderComponent& c : detection.components) p.push_back(c.persistence);
+  return p;
+}
+}  // namespace
+
 int nearestCylinderLevel(const CylinderDetection& detection, double t) {
-  if (detection.levels.empty()) throw OptionError("the detection has no scales");
-  if (!(t > 0) || !std::isfinite(t)) throw OptionError("the scale must be finite and > 0");
-  int best = 0;
-  for (int j = 1; j < detection.scaleCount(); ++j)
-    if (std::abs(std::log(detection.levels[std::size_t(j)].scale / t)) <
-        std::abs(std::log(detection.levels[std::size_t(best)].scale / t)))
-      best = j;
-  return best;
+  std::vector<double> scales;
+  for (const CylinderLevel& level : detection.levels) scales.push_back(level.scale);
+  return nearestScaleIndex(scales, t);
 }
 
 std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int level,
@@ -260,32 +263,20 @@ std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int l
     throw OptionError("level " + std::to_string(level) + " is outside [0, " +
                       std::to_string(detection.scaleCount()) + ")");
   std::vector<int> labels = detection.graph.componentLabels(level);
+  const std::vector<int> persistence = persistenceOf(detection);
   for (int& label : labels)
-    if (label >= 0 && detection.components[std::size_t(label)].persistence < minPersistence)
-      label = -1;
+    if (label >= 0 && persistence[std::size_t(label)] < minPersistence) label = -1;
   return labels;
 }
 
 std::vector<int> cylinderLabelsByPersistence(const CylinderDetection& detection,
                                              int minPersistence) {
-  std::vector<int> labels(detection.graph.pointCount, -1);
-  const auto& components = detection.components;
-  auto better = [&](int a, int b) {  // a beats the current b
-    if (b < 0) return true;
-    const int pa = components[std::size_t(a)].persistence,
-              pb = components[std::size_t(b)].persistence;
-    return pa > pb || (pa == pb && a < b);
-  };
-  for (int level = 0; level < detection.scaleCount(); ++level) {
-    const auto& regions = detection.graph.levels[std::size_t(level)].regions;
-    for (std::size_t r = 0; r < regions.size(); ++r) {
-      const int c = detection.graph.componentOf[std::size_t(level)][r];
-      if (components[std::size_t(c)].persistence < minPersistence) continue;
-      for (const Index i : regions[r])
-        if (better(c, labels[i])) labels[i] = c;
-    }
-  }
-  return labels;
+  return labelsByPersistence(pointMembership(detection.graph), persistenceOf(detection),
+                             minPersistence);
+}
+
+std::vector<int> cylinderPersistence(const CylinderDetection& detection) {
+  return persistenceOf(detection);
 }
 
 }  // namespace scalespace

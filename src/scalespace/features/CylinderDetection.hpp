@@ -94,6 +94,9 @@ int nearestCylinderLevel(const CylinderDetection& detection, double t);
 std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int level,
                                        int minPersistence = 0);
 
+/// Each component's persistence, by id (what core's label queries take with a PointMembership).
+std::vector<int> cylinderPersistence(const CylinderDetection& detection);
+
 /// Per point, the most persistent component (lower id on ties) with persistence >= minPersistence
 /// holding it at any level, or -1 (Sec. 2.4.1's query for planes).
 std::vector<int> cylinderLabelsByPersistence(const CylinderDetection& detection,

@@ -14,26 +14,11 @@ PlaneModel makePlaneModel(const PlaneDetection& detection) {
   const RegionGraph& g = detection.graph;
   for (const auto& level : g.levels) model.scales.push_back(level.t);
   model.components = detection.components;
-  model.membership.pointCount = g.pointCount;
-  model.membership.levelCount = int(g.levels.size());
-  model.membership.ids.reserve(g.pointCount * g.levels.size());
-  for (int j = 0; j < int(g.levels.size()); ++j) {
-    const std::vector<int> labels = g.componentLabels(j);
-    model.membership.ids.insert(model.membership.ids.end(), labels.begin(), labels.end());
-  }
+  model.membership = pointMembership(g);
   return model;
 }
 
 namespace {
-// "a is preferred to b": higher persistence, then lower id.
-bool morePersistent(const PlaneModel& m, int a, int b) {
-  if (b < 0) return a >= 0;
-  if (a < 0) return false;
-  const int pa = m.components[std::size_t(a)].persistence;
-  const int pb = m.components[std::size_t(b)].persistence;
-  return pa != pb ? pa > pb : a < b;
-}
-
 void checkIndices(const PlaneModel& model, const std::vector<Index>& indices, const char* what) {
   for (Index i : indices)
     if (i >= model.membership.pointCount)
@@ -53,38 +38,27 @@ std::set<int> componentsHolding(const PlaneModel& model, const std::vector<Index
 }
 }  // namespace
 
+namespace {
+std::vector<int> persistenceOf(const PlaneModel& model) {
+  std::vector<int> p;
+  for (const PlaneComponent& c : model.components) p.push_back(c.persistence);
+  return p;
+}
+}  // namespace
+
 std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence) {
-  const std::size_t n = model.membership.pointCount;
-  std::vector<int> labels(n, -1);
-  for (int j = 0; j < model.membership.levelCount; ++j)
-    for (std::size_t i = 0; i < n; ++i) {
-      const int c = model.membership.at(j, i);
-      if (c >= 0 && model.components[std::size_t(c)].persistence >= minPersistence &&
-          morePersistent(model, c, labels[i]))
-        labels[i] = c;
-    }
-  return labels;
+  return labelsByPersistence(model.membership, persistenceOf(model), minPersistence);
 }
 
 int nearestLevel(const PlaneModel& model, double t) {
   if (model.scales.empty()) throw OptionError("the plane model has no scales");
   if (!(t > 0)) throw OptionError("labelsAtScale: the scale t must be > 0");
-  int best = 0;
-  for (int j = 1; j < model.scaleCount(); ++j)
-    if (std::abs(std::log(model.scales[std::size_t(j)] / t)) <
-        std::abs(std::log(model.scales[std::size_t(best)] / t)))
-      best = j;
-  return best;
+  return nearestScaleIndex(model.scales, t);
 }
 
 std::vector<int> labelsAtScale(const PlaneModel& model, double t, int minPersistence) {
-  const int level = nearestLevel(model, t);
-  std::vector<int> labels(model.membership.pointCount, -1);
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    const int c = model.membership.at(level, i);
-    if (c >= 0 && model.components[std::size_t(c)].persistence >= minPersistence) labels[i] = c;
-  }
-  return labels;
+  return labelsAtLevel(model.membership, persistenceOf(model), nearestLevel(model, t),
+                       minPersistence);
 }
 
 std::vector<BrushMatch> rankByBrush(const PlaneModel& model, const std::vector<Index>& query) {

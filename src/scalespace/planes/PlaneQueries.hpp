@@ -8,14 +8,6 @@
 
 namespace scalespace {
 
-/// ids[level * pointCount + i] = component holding point i at that level, or -1.
-struct PointMembership {
-  std::size_t pointCount = 0;
-  int levelCount = 0;
-  std::vector<int> ids;
-  int at(int level, std::size_t i) const { return ids[std::size_t(level) * pointCount + i]; }
-};
-
 /// What the tools need, and what `scalespace planes` saves (PlaneExport.hpp).
 struct PlaneModel {
   std::vector<double> scales;  // t_j, increasing
