@@ -29,6 +29,9 @@ def best_of(runs, f):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=1_000_000)
+    parser.add_argument("--retain", action="store_true",
+                        help="call scalespace.retain_freed_memory() first (repeated calls reuse "
+                             "memory instead of faulting fresh pages in)")
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--scale-k", type=int, default=40)
     args = parser.parse_args()
@@ -37,6 +40,8 @@ def main():
     normals = rng.normal(size=(args.points, 3))
     normals /= np.linalg.norm(normals, axis=1)[:, None]
     points = normals * (1 + 0.001 * rng.normal(size=(args.points, 1)))  # a noisy unit sphere
+    if args.retain:
+        print(f"retain_freed_memory(): {ss.retain_freed_memory()}")
     print(f"{args.points} points, curvature scale_k={args.scale_k}, W3, {args.runs} runs each")
 
     walls, libs = [], []

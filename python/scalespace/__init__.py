@@ -38,13 +38,14 @@ from ._scalespace import (  # noqa: F401
     read_mesh,
     read_planes,
     render,
+    retain_freed_memory,
 )
 from . import _scalespace
 
 __all__ = [
     "Cloud", "read", "write", "estimate_normals", "curvature", "compute_stack", "open_stack",
     "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "cylinders",
-    "Cylinders", "Error",
+    "Cylinders", "Error", "retain_freed_memory",
     "OptionError", "FileError", "Cancelled", "__version__",
 ]
 

@@ -127,6 +127,11 @@ class Cylinders:
     def points(self, component: int, level: int) -> np.ndarray: ...
     def __len__(self) -> int: ...
 
+def retain_freed_memory() -> bool:
+    """Keep freed memory in the process for reuse (glibc): repeated calls skip page faults;
+    changes the allocator of the whole process. Returns whether it applied."""
+    ...
+
 def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               scales: Optional[Sequence[float]] = ..., scale_count: int = ..., tmin: float = ...,
               tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,

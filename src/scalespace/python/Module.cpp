@@ -3,6 +3,7 @@
 // the library includes it.
 #include <pybind11/pybind11.h>
 
+#include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/python/Bindings.hpp"
 #include "scalespace/python/Bridge.hpp"
 
@@ -16,4 +17,13 @@ PYBIND11_MODULE(_scalespace, m) {
   scalespace::python::bindPlanes(m);
   scalespace::python::bindFeatures(m);
   scalespace::python::bindCylinders(m);
+  m.def("retain_freed_memory", &scalespace::retainFreedMemory,
+        R"doc(Keep freed memory in the process for reuse (glibc only; returns whether it applied).
+
+Every call copies its input into the library's arrays and each scale allocates arrays of tens of
+MB; by default glibc returns such blocks to the system when they are freed, so the next call
+touches fresh pages, which costs milliseconds per million points (page faults). After this, freed
+blocks stay in the process and are reused: repeated calls are faster, at the price of a higher
+resident memory. It changes the allocator of the whole Python process, so the module never does
+it by itself; the `scalespace` CLI does it at start-up.)doc");
 }
