@@ -4,7 +4,7 @@
 // of the diagonal.
 //
 //   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--scan full|one-sided]
-//                   [--seed S]
+//                   [--scales M (ours: 8)] [--seed S]
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -63,11 +63,11 @@ double iou(const std::vector<Index>& a, const std::vector<Index>& b) {
   return double(both) / double(a.size() + b.size() - both);
 }
 
-Method runOurs(const PointCloud& cloud) {
+Method runOurs(const PointCloud& cloud, const CylinderOptions& options) {
   Method m;
   m.name = "scalespace";
   const auto start = std::chrono::steady_clock::now();
-  const CylinderDetection d = detectCylinders(cloud, CylinderOptions{});
+  const CylinderDetection d = detectCylinders(cloud, options);
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (int level = 0; level < d.scaleCount(); ++level) {
     const auto& regions = d.graph.levels[std::size_t(level)].regions;
@@ -222,6 +222,7 @@ int main(int argc, char** argv) {
   std::size_t points = 1000000;
   bool peers = true, cleanOnly = false;
   std::string only;  // "full" or "one-sided": that scan alone
+  CylinderOptions ours;
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -235,10 +236,12 @@ int main(int argc, char** argv) {
       cleanOnly = true;
     else if (a == "--scan" && i + 1 < argc)
       only = argv[++i];
+    else if (a == "--scales" && i + 1 < argc)
+      ours.scaleCount = std::stoi(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
-                   "[--scan full|one-sided] [--seed S]\n");
+                   "[--scan full|one-sided] [--scales M] [--seed S]\n");
       return 2;
     }
   }
@@ -257,7 +260,7 @@ int main(int argc, char** argv) {
       const PointCloud cloud = generatePipeScene(options);
       std::printf("\n%s scan, noise %g of the diagonal (%zu points)\n",
                   oneSided ? "one-sided" : "full", noise, cloud.size());
-      std::vector<Method> methods{runOurs(cloud)};
+      std::vector<Method> methods{runOurs(cloud, ours)};
       if (peers) {
         // Mean spacing of an area-uniform sample: sqrt(area / n), the scene's area ~52 m^2.
         const double spacing = std::sqrt(52.0 / double(cloud.size()));
