@@ -137,6 +137,20 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("bad.ply") + " -q -o " + path("o2"));
   EXPECT_NE(r.code, 0);
   EXPECT_FALSE(fs::exists(path("o2")));
+  // Too few points, or all at one place: a clear error naming the cause.
+  {
+    std::ofstream five(path("five.xyz"));
+    for (int i = 0; i < 5; ++i) five << i << " " << i * i << " 0\n";
+    std::ofstream same(path("same.xyz"));
+    for (int i = 0; i < 500; ++i) same << "1 2 3\n";
+  }
+  r = run("cylinders " + path("five.xyz") + " -q -o " + path("o3"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("5 points"), std::string::npos) << r.err;
+  r = run("cylinders " + path("same.xyz") + " -q -o " + path("o4"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("coincide"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("o4")));
   // --one-sided belongs to the pipes scene.
   r = run("generate box --one-sided -q -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);

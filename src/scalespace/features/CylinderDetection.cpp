@@ -93,12 +93,21 @@ std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph
                                   const CylinderOptions& options) {
   if (!options.scales.empty()) return options.scales;
   double tMin = options.tMin, tMax = options.tMax;
+  if ((tMin == 0 || tMax == 0) && !(cloud.boundingBoxDiagonal() > 0))
+    throw OptionError("all " + std::to_string(cloud.size()) +
+                      " points coincide: there is no surface, and no automatic scale");
   if (tMin == 0) {
     if (graph.kthDistance.empty())
-      throw OptionError(
-          "the cloud has too few points (<= CylinderOptions::graphNeighbors) for the automatic "
-          "CylinderOptions::tMin");
+      throw OptionError("the cloud has " + std::to_string(cloud.size()) +
+                        " points; the automatic CylinderOptions::tMin needs more than " +
+                        std::to_string(options.graphNeighbors) + " (a distance to the " +
+                        std::to_string(options.graphNeighbors) + "th neighbour)");
     tMin = 2 * lowerMedian(graph.kthDistance);
+    if (!(tMin > 0))
+      throw OptionError(
+          "most points have 10 duplicates: the automatic CylinderOptions::tMin is 0 "
+          "(remove the duplicates or give "
+          "CylinderOptions::tMin)");
   }
   if (tMax == 0) tMax = cloud.boundingBoxDiagonal() / 10;
   if (!(tMax > tMin))

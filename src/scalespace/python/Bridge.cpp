@@ -58,7 +58,6 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::minCurveExtent", "min_extent"},
     {"FeatureCurveOptions::minSalientCurvature", "min_curvature"},
     {"FeatureCurveOptions::minVotingScales", "min_scales"},
-    {"(<= CylinderOptions::graphNeighbors)", "(<= 10, the neighbours of its k-NN graph)"},
     {"CylinderOptions::scaleCount", "scale_count"},
     {"CylinderOptions::scales", "scales"},
     {"CylinderOptions::tMin", "tmin"},
