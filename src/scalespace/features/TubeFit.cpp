@@ -399,6 +399,8 @@ const char* tubeRejectionName(TubeRejection rejection) {
       return "thin";
     case TubeRejection::Rough:
       return "rough";
+    case TubeRejection::Merged:
+      return "merged";
   }
   return "?";
 }

@@ -42,8 +42,9 @@ struct TubeFitOptions {
   double straightRmsRatio = 1.5;
 };
 
-/// Why a region is no tube (None: it is one). Rough is the last.
-enum class TubeRejection : std::uint8_t { None, TooSmall, Flat, NarrowArc, Thin, Rough };
+/// Why a region is no tube (None: it is one; Merged: it joined a touching tube,
+/// features/CylinderDetection). Merged is the last.
+enum class TubeRejection : std::uint8_t { None, TooSmall, Flat, NarrowArc, Thin, Rough, Merged };
 const char* tubeRejectionName(TubeRejection rejection);
 
 struct TubeFit {
