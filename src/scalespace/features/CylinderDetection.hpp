@@ -9,8 +9,8 @@
 //      every point with sigma >= minAnisotropy (not in the thesis, which grows from every point:
 //      without it the isotropic rest of the cloud forms regions too), most anisotropic first;
 //   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped;
-//   5. (not in the thesis) each tube takes the free points lying on it next to it
-//      (TubeCoverageOptions).
+//   5. (not in the thesis) touching tubes whose union is still a tube merge, and each tube takes
+//      the free points lying on it next to it (TubeCoverageOptions).
 // Then, as the planes of Ch. 2, the tubes of consecutive scales with Jaccard index > 0.5 are
 // linked into components with a birth and a death scale (core/RegionGraph).
 #include <vector>
