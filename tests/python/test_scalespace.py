@@ -416,8 +416,12 @@ def test_ctrl_c_cancels_a_long_call_and_leaves_no_output(tmp_path):
 def test_two_threads_overlap_in_time():
     p = sphere_points(150000)
     calls = {0: [], 1: []}
+    # Both calls start together: under load (ctest -j2) a thread could otherwise start after the
+    # other's call had ended, which says nothing about the GIL.
+    start = threading.Barrier(2)
 
     def run(k):
+        start.wait()
         ss.curvature(p, p, scale_k=30, threads=1,
                      progress=lambda f, s: calls[k].append(time.monotonic()))
     threads = [threading.Thread(target=run, args=(k,)) for k in (0, 1)]
