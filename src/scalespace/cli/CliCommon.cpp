@@ -160,6 +160,26 @@ void checkOutput(const std::string& output, OutputKind kind,
                     "choose another output folder or check its permissions");
 }
 
+PointCloud loadResultInput(const std::string& recorded, const std::string& override,
+                           const std::string& directory, const std::string& what,
+                           std::size_t pointCount, const std::string& output, bool quiet) {
+  InputOptions input;
+  input.path = override.empty() ? recorded : override;
+  std::error_code ec;
+  if (override.empty() && !std::filesystem::is_regular_file(recorded, ec))
+    throw FileError(recorded, "",
+                    "the cloud the " + what + " in " + directory + " were computed on is not there",
+                    "pass it with --input IN");
+  checkOutput(output, OutputKind::Cloud, {input.path, directory});
+  PointCloud cloud = loadCloud(input, quiet);
+  if (cloud.size() != pointCount)
+    throw FileError(input.path, "",
+                    "has " + std::to_string(cloud.size()) + " points but the " + what + " in " +
+                        directory + " were computed on " + std::to_string(pointCount),
+                    "pass the original cloud with --input");
+  return cloud;
+}
+
 void printWarnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 }

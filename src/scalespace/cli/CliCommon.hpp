@@ -23,6 +23,14 @@ void addInputOptions(CLI::App& command, InputOptions& input);
 /// Reads the cloud; throws if it has no points (nothing to analyse).
 PointCloud loadCloud(const InputOptions& input, bool quiet);
 
+/// The cloud a saved result (`planes`, `cylinders`) was computed on: `override` when given, else
+/// `recorded` (the path the result names), checked to exist and to hold `pointCount` points, after
+/// checkOutput(output) (the output is neither of them). `what` names the result in messages
+/// ("planes", "cylinders"). Throws FileError naming the file and what to pass.
+PointCloud loadResultInput(const std::string& recorded, const std::string& override,
+                           const std::string& directory, const std::string& what,
+                           std::size_t pointCount, const std::string& output, bool quiet);
+
 /// Estimates (PCA, 10 neighbours) and orients (MST) normals when the cloud has none; says so on
 /// stderr unless quiet. The APSS fits need oriented normals.
 void ensureNormals(PointCloud& cloud, bool quiet);

@@ -219,10 +219,12 @@ void addCylindersCommand(CLI::App& app) {
                         {"seconds", l.seconds}});
     }
     const CylinderOptions& o = args->cylinders;
+    // Absolute, as `planes` records it: cylinders-segment finds it from any folder.
+    const std::string inputPath = fs::absolute(args->input.path, ec).string();
     const nlohmann::json json = {
         {"result", "cylinders"},
         {"version", SCALESPACE_VERSION},
-        {"input", args->input.path},
+        {"input", inputPath},
         {"point_count", cloud.size()},
         {"labels",
          {{"scale", level >= 0 ? nlohmann::json(detection.levels[std::size_t(level)].scale)
@@ -311,22 +313,9 @@ void addCylindersSegmentCommand(CLI::App& app) {
             (dir / "membership.bin").string(), "",
             "names component " + std::to_string(id) + " of " + std::to_string(persistence.size()),
             "run `scalespace cylinders` again");
-    InputOptions input;
-    input.path = args->input.empty() ? result.value("input", std::string()) : args->input;
-    std::error_code ec;
-    if (!fs::is_regular_file(input.path, ec))
-      throw FileError(
-          input.path, "",
-          "the cloud the cylinders in " + args->directory + " were computed on is not there",
-          "pass it with --input IN");
-    checkOutput(args->output, OutputKind::Cloud, {input.path, args->directory});
-    PointCloud cloud = loadCloud(input, args->quiet);
-    if (cloud.size() != membership.pointCount)
-      throw FileError(input.path, "",
-                      "has " + std::to_string(cloud.size()) + " points but the cylinders in " +
-                          args->directory + " were computed on " +
-                          std::to_string(membership.pointCount),
-                      "pass the original cloud with --input");
+    PointCloud cloud =
+        loadResultInput(result.value("input", std::string()), args->input, args->directory,
+                        "cylinders", membership.pointCount, args->output, args->quiet);
     const std::vector<int> labels =
         *scale ? labelsAtLevel(membership, persistence, nearestScaleIndex(scales, args->scale),
                                args->minPersistence)

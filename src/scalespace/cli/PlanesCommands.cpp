@@ -215,22 +215,8 @@ void addSegmentCommand(CLI::App& app) {
     validate(args->similarity);
     std::string recorded;
     PlaneModel model = readPlaneModel(args->directory, &recorded);
-    InputOptions input;
-    input.path = args->input.empty() ? recorded : args->input;
-    std::error_code ec;
-    if (args->input.empty() && !std::filesystem::is_regular_file(recorded, ec))
-      throw FileError(
-          recorded, "",
-          "the cloud the planes in " + args->directory + " were computed on is not there",
-          "pass it with --input IN");
-    checkOutput(args->output, OutputKind::Cloud, {input.path, args->directory});
-    PointCloud cloud = loadCloud(input, args->quiet);
-    if (cloud.size() != model.membership.pointCount)
-      throw FileError(input.path, "",
-                      "has " + std::to_string(cloud.size()) + " points but the planes in " +
-                          args->directory + " were computed on " +
-                          std::to_string(model.membership.pointCount),
-                      "pass the original cloud with --input");
+    PointCloud cloud = loadResultInput(recorded, args->input, args->directory, "planes",
+                                       model.membership.pointCount, args->output, args->quiet);
     // The saved offsets are absolute; the algorithms work on positions relative to the origin.
     for (auto& c : model.components) c.plane.offset -= c.plane.normal.dot(cloud.origin());
 

@@ -50,6 +50,16 @@ struct AlignedLines {
   }
 };
 
+/// Per point, the region of the tube holding it, or -1 (regions that are no tube hold none).
+std::vector<int> tubeOwners(std::size_t pointCount, const std::vector<TubeFit>& tubes,
+                            const std::vector<std::vector<Index>>& regions) {
+  std::vector<int> owner(pointCount, -1);
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    if (tubes[r].isTube())
+      for (const Index i : regions[r]) owner[i] = int(r);
+  return owner;
+}
+
 /// (Not in the thesis.) Tubes of one scale whose regions touch (k-NN edges between them) are
 /// merged when their radii agree within 25% and their union is still one tube: fitTube accepts it
 /// with an RMS at most 1.25 x the larger of theirs plus 2% of the radius. Noise breaks the lines
@@ -60,10 +70,7 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
                         const std::vector<Vec3>& normals, const LineAnisotropyField& field,
                         double t, const TubeFitOptions& options, std::vector<TubeFit>& tubes,
                         std::vector<std::vector<Index>>& regions) {
-  std::vector<int> owner(positions.size(), -1);
-  for (std::size_t r = 0; r < regions.size(); ++r)
-    if (tubes[r].isTube())
-      for (const Index i : regions[r]) owner[i] = int(r);
+  const std::vector<int> owner = tubeOwners(positions.size(), tubes, regions);
   std::map<std::pair<int, int>, std::size_t> edges;
   for (std::size_t p = 0; p < positions.size(); ++p) {
     if (owner[p] < 0) continue;
@@ -114,10 +121,7 @@ void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
                  const std::vector<Vec3>& normals, std::vector<TubeFit>& tubes,
                  std::vector<std::vector<Index>>& regions, const TubeCoverageOptions& coverage) {
   if (!coverage.enabled) return;
-  std::vector<int> owner(positions.size(), -1);
-  for (std::size_t r = 0; r < regions.size(); ++r)
-    if (tubes[r].isTube())
-      for (const Index i : regions[r]) owner[i] = int(r);
+  std::vector<int> owner = tubeOwners(positions.size(), tubes, regions);
   const double minCos = std::cos(coverage.maxAngleDegrees * 3.14159265358979323846 / 180);
   std::vector<Index> frontier;
   for (std::size_t r = 0; r < regions.size(); ++r) {
@@ -331,11 +335,9 @@ std::vector<int> cylinderLabelsAtLevel(const CylinderDetection& detection, int l
   if (level < 0 || level >= detection.scaleCount())
     throw OptionError("level " + std::to_string(level) + " is outside [0, " +
                       std::to_string(detection.scaleCount()) + ")");
-  std::vector<int> labels = detection.graph.componentLabels(level);
-  const std::vector<int> persistence = persistenceOf(detection);
-  for (int& label : labels)
-    if (label >= 0 && persistence[std::size_t(label)] < minPersistence) label = -1;
-  return labels;
+  // The one level as a membership of one level: core's query does the rest.
+  const PointMembership one{detection.graph.pointCount, 1, detection.graph.componentLabels(level)};
+  return labelsAtLevel(one, persistenceOf(detection), 0, minPersistence);
 }
 
 std::vector<int> cylinderLabelsByPersistence(const CylinderDetection& detection,

@@ -42,10 +42,8 @@ LineAnisotropyField lineAnisotropy(const std::vector<Vec3>& positions,
     std::vector<Neighbor> near;
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       index->radiusSearch(positions[i], t, near);
-      // Sum in index order: the kd-tree returns neighbours in an order that does not depend on
-      // the thread, but summing sorted keeps the float result independent of the tree layout too.
-      std::sort(near.begin(), near.end(),
-                [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
+      // The kd-tree is built the same way whatever the thread count and returns a query's
+      // neighbours in the same order: the sums below do not depend on the threads.
       Mat3 sigma = Mat3::Zero();
       Vec3 normal = Vec3::Zero();
       double weightSum = 0, kappa = 0;

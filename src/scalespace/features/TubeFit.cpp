@@ -66,8 +66,10 @@ bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>
     centroid += positions[i];
   }
   centroid /= n;
-  const Eigen::SelfAdjointEigenSolver<Mat3> eig(spread);
-  const Vec3 a = direction ? direction->normalized() : Vec3(eig.eigenvectors().col(0).normalized());
+  const Vec3 a =
+      direction
+          ? direction->normalized()
+          : Vec3(Eigen::SelfAdjointEigenSolver<Mat3>(spread).eigenvectors().col(0).normalized());
   // The centre nearest to every normal line x_i + s n_i, in the plane normal to a: with u_i the
   // in-plane direction across the normal, minimise sum ((c - x_i) . u_i)^2, the component of c
   // along a pinned to the centroid's.
