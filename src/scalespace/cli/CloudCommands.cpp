@@ -9,6 +9,7 @@
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/CylinderCommands.hpp"
 #include "scalespace/cli/FeatureCommands.hpp"
+#include "scalespace/cli/ParamCommands.hpp"
 #include "scalespace/cli/PlanesCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/cli/ScalesCommands.hpp"
@@ -21,6 +22,7 @@
 #include "scalespace/fit/CurvatureEstimation.hpp"
 #include "scalespace/fit/FitDiagnosis.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/param/ParamShapes.hpp"
 
 namespace scalespace::cli {
 namespace {
@@ -100,7 +102,9 @@ void addGenerateCommand(CLI::App& app) {
       "as gt_pipe, elbow parts and cable strands as gt_part)");
   cmd->add_option("shape", args->shape,
                   "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | "
-                  "house | yard | pipes")
+                  "house | yard | pipes | bumpy-disk | hemisphere | relief | holed-sheet | "
+                  "partial-sphere | triaxial | blob | rounded-cube | tube | ring (the shapes of "
+                  "`parametrize`)")
       ->required();
   cmd->add_option("-n,--points", args->options.pointCount, "number of points")
       ->capture_default_str();
@@ -129,6 +133,12 @@ void addGenerateCommand(CLI::App& app) {
       o.seed = args->options.seed;
       o.oneSided = args->oneSided;
       cloud = generatePipeScene(o);
+    } else if (isParamShapeName(args->shape)) {
+      ParamShapeOptions o;
+      o.pointCount = args->options.pointCount;
+      o.noise = args->options.noise;
+      o.seed = args->options.seed;
+      cloud = generateParamShape(parseParamShape(args->shape), o);
     } else if (!generateScene(args->shape, args->options, cloud)) {
       SurfaceSampleOptions o;
       o.shape = parseSurfaceShape(args->shape);  // OptionError names the accepted shapes
@@ -348,6 +358,7 @@ void addCloudCommands(CLI::App& app) {
   addPlanesCommands(app);
   addFeatureCommands(app);
   addCylinderCommands(app);
+  addParamCommands(app);
 }
 
 }  // namespace scalespace::cli

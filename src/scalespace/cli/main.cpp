@@ -61,6 +61,10 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"CylinderOptions::minAnisotropy", "--min-anisotropy"},
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
     {"TubeFitOptions::maxRelativeRms", "--max-rms"},
+    {"FlatteningOptions::scaleCount", "--scales"},
+    {"FlatteningOptions::K", "--k"},
+    {"FlatteningOptions::tMax", "--tmax"},
+    {"DistortionOptions::neighbors", "--scales-k"},
     {"the thread count (threads option)", "--threads"},
     {"findSimilar: no component", "--similar: no component"},
 };

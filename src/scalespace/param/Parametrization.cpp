@@ -1,0 +1,70 @@
+#include "scalespace/param/Parametrization.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/core/Parallel.hpp"
+
+namespace scalespace {
+namespace {
+
+std::string percent(std::size_t part, std::size_t whole) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g%%", whole ? 100.0 * double(part) / double(whole) : 0.0);
+  return text;
+}
+
+/// The part [from, to] of a progress callback.
+ProgressCallback subProgress(const ProgressCallback& progress, double from, double to) {
+  if (!progress) return {};
+  return [progress, from, to](double f, std::string_view stage) {
+    return progress(from + f * (to - from), stage);
+  };
+}
+
+}  // namespace
+
+Parametrization parametrize(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                            const ParametrizationOptions& options,
+                            const ProgressCallback& progress) {
+  if (!(options.maxDefectFraction >= 0 && options.maxDefectFraction <= 1))
+    throw OptionError("ParametrizationOptions::maxDefectFraction must be in [0, 1]");
+  if (!(options.maxFailedStepFraction >= 0 && options.maxFailedStepFraction <= 1))
+    throw OptionError("ParametrizationOptions::maxFailedStepFraction must be in [0, 1]");
+  validateMapDefectOptions(options.defects);
+  ThreadLimit limit(options.flattening.threads);
+  Parametrization result;
+  result.flattening =
+      flattenScaleSpace(positions, normals, options.flattening, subProgress(progress, 0, 0.9));
+  result.domain = mapToDomain(result.flattening, options.domain);
+  result.warnings = result.domain.warnings;
+  result.defects = findMapDefects(positions, normals, result.domain, options.defects,
+                                  subProgress(progress, 0.9, 1));
+
+  const std::size_t n = positions.size();
+  const double maxFailed = options.maxFailedStepFraction * options.flattening.scaleCount;
+  result.valid.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    result.valid[i] = result.flattening.failedSteps[i] <= maxFailed;
+    result.invalid += !result.valid[i];
+  }
+  if (result.invalid > 0)
+    result.warnings.push_back(
+        std::to_string(result.invalid) + " points (" + percent(result.invalid, n) +
+        ") had no valid fit at more than " +
+        percent(std::size_t(std::lround(100 * options.maxFailedStepFraction)), 100) +
+        " of the scales: isolated or duplicate points (column param_valid)");
+  const std::size_t flagged = result.defects.folds + result.defects.overlaps;
+  result.oneToOne = double(flagged) <= options.maxDefectFraction * double(n);
+  if (!result.oneToOne)
+    result.warnings.push_back(
+        "the map is not one-to-one: " + std::to_string(result.defects.folds) + " points fold (" +
+        percent(result.defects.folds, n) + ") and " + std::to_string(result.defects.overlaps) +
+        " overlap (" + percent(result.defects.overlaps, n) +
+        "). A surface that is not of genus 0 (a torus, a handle) cannot be flattened without a "
+        "cut; otherwise try more scales (columns fold and overlap)");
+  return result;
+}
+
+}  // namespace scalespace
