@@ -1,0 +1,223 @@
+// The meshless parametrization of Chapter 4 on shapes with known answers: a plane stays a plane
+// up to a similarity, a sphere's points stay where they are, a hemisphere maps without folds, a
+// torus is flagged; the same result for any thread count; bad inputs rejected.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/param/ParamShapes.hpp"
+#include "scalespace/param/Parametrization.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Cloud {
+  std::vector<Vec3> positions, normals;
+};
+
+Cloud shape(ParamShape kind, std::size_t count, double noise = 0) {
+  ParamShapeOptions o;
+  o.pointCount = count;
+  o.noise = noise;
+  o.seed = 7;
+  const PointCloud c = generateParamShape(kind, o);
+  Cloud out;
+  for (std::size_t i = 0; i < c.size(); ++i) out.positions.push_back(c.absolutePosition(i));
+  out.normals = c.normals();
+  return out;
+}
+
+/// Random points of a disk of radius 1 in the plane through `origin` spanned by a, b (unit,
+/// orthogonal), normals a x b; `local` receives their (x, y) in that frame.
+Cloud planarDisk(std::size_t count, const Vec3& origin, const Vec3& a, const Vec3& b,
+                 std::vector<Vec2>& local) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Cloud c;
+  while (c.positions.size() < count) {
+    const Vec2 p(u(rng), u(rng));
+    if (p.squaredNorm() > 1) continue;
+    local.push_back(p);
+    c.positions.push_back(origin + p.x() * a + p.y() * b);
+    c.normals.push_back(a.cross(b));
+  }
+  return c;
+}
+
+ParametrizationOptions fewScales() {
+  ParametrizationOptions o;
+  o.flattening.scaleCount = 20;
+  return o;
+}
+
+}  // namespace
+
+TEST(Parametrization, APlaneStaysAPlaneUpToASimilarity) {
+  const Vec3 a = Vec3(1, 2, 0.5).normalized();
+  const Vec3 b = a.cross(Vec3(0.3, -0.1, 1)).normalized();
+  std::vector<Vec2> local;
+  const Cloud c = planarDisk(4000, Vec3(100, -20, 5), a, b, local);
+  const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+  ASSERT_EQ(p.domain.kind, DomainKind::Plane);
+  EXPECT_TRUE(p.domain.globalFitIsPlane);
+  EXPECT_EQ(p.defects.folds + p.defects.overlaps, 0u);
+  EXPECT_TRUE(p.oneToOne);
+  // The best similarity (Procrustes) from the disk's own coordinates to (u, v) explains them.
+  Vec2 meanL = Vec2::Zero(), meanU = Vec2::Zero();
+  for (std::size_t i = 0; i < local.size(); ++i) {
+    meanL += local[i];
+    meanU += p.domain.uv[i];
+  }
+  meanL /= double(local.size());
+  meanU /= double(local.size());
+  // 2D Procrustes without a mirror, in closed form: the rotation angle atan2(b, a) and the scale
+  // sqrt(a^2 + b^2) / var with a = sum l.u and b = sum l x u over centred coordinates.
+  double dot = 0, cross = 0, var = 0;
+  for (std::size_t i = 0; i < local.size(); ++i) {
+    const Vec2 l = local[i] - meanL, w = p.domain.uv[i] - meanU;
+    dot += l.dot(w);
+    cross += l.x() * w.y() - l.y() * w.x();
+    var += l.squaredNorm();
+  }
+  const double angle = std::atan2(cross, dot), scale = std::hypot(dot, cross) / var;
+  Eigen::Matrix2d rotation;
+  rotation << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  EXPECT_NEAR(scale, 1, 1e-9);  // orthonormal plane coordinates
+  // A rotation explains every point: no mirror, (u, v, normal) right-handed.
+  double worst = 0;
+  for (std::size_t i = 0; i < local.size(); ++i)
+    worst =
+        std::max(worst, (meanU + scale * rotation * (local[i] - meanL) - p.domain.uv[i]).norm());
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(Parametrization, ASpheresPointsStayWhereTheyAre) {
+  // A whole sphere: the flow has nothing to change, the domain is the sphere itself.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  Cloud c;
+  const Vec3 centre(3, -1, 2);
+  for (int i = 0; i < 6000; ++i) {
+    const Vec3 d = Vec3(g(rng), g(rng), g(rng)).normalized();
+    c.positions.push_back(centre + 2 * d);
+    c.normals.push_back(d);
+  }
+  const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+  ASSERT_EQ(p.domain.kind, DomainKind::Sphere);
+  EXPECT_NEAR(p.domain.radius, 2, 1e-6);
+  EXPECT_LT((p.domain.centre - centre).norm(), 1e-6);
+  double worst = 0;
+  for (std::size_t i = 0; i < c.positions.size(); ++i)
+    worst = std::max(worst, (p.domain.direction[i] - c.normals[i]).norm());
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_EQ(p.defects.folds + p.defects.overlaps, 0u);
+  // Longitude and latitude read the direction about the world z axis.
+  const Vec3& d = p.domain.direction[0];
+  EXPECT_NEAR(p.domain.latitude[0], std::asin(d.z()) * 180 / kPi, 1e-9);
+  EXPECT_NEAR(p.domain.longitude[0], std::atan2(d.y(), d.x()) * 180 / kPi, 1e-9);
+}
+
+TEST(Parametrization, AHemisphereMapsWithoutFolds) {
+  for (double noise : {0.0, 1e-3}) {
+    SCOPED_TRACE(noise);
+    const Cloud c = shape(ParamShape::Hemisphere, 8000, noise);
+    const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+    EXPECT_EQ(p.defects.folds, 0u);
+    EXPECT_EQ(p.defects.overlaps, 0u);
+    EXPECT_TRUE(p.oneToOne);
+    EXPECT_EQ(p.invalid, 0u);
+    EXPECT_NEAR(p.domain.capDegrees, 90, 3);
+  }
+}
+
+TEST(Parametrization, ADiskLikeSurfaceGoesToThePlaneAndAClosedOneToTheSphere) {
+  const Cloud disk = shape(ParamShape::BumpyDisk, 6000, 1e-3);
+  const Parametrization flat = parametrize(disk.positions, disk.normals, fewScales());
+  EXPECT_EQ(flat.domain.kind, DomainKind::Plane);
+  EXPECT_EQ(flat.defects.folds + flat.defects.overlaps, 0u);
+  const Cloud closed = shape(ParamShape::Triaxial, 6000);
+  const Parametrization round = parametrize(closed.positions, closed.normals, fewScales());
+  EXPECT_EQ(round.domain.kind, DomainKind::Sphere);
+  EXPECT_GT(round.domain.capDegrees, 170);
+  EXPECT_EQ(round.defects.folds + round.defects.overlaps, 0u);
+  // The plane domain forced on the closed surface: a stereographic map, still one-to-one.
+  ParametrizationOptions plane = fewScales();
+  plane.domain.kind = DomainKind::Plane;
+  const Parametrization stereo = parametrize(closed.positions, closed.normals, plane);
+  EXPECT_EQ(stereo.domain.kind, DomainKind::Plane);
+  EXPECT_FALSE(stereo.domain.globalFitIsPlane);
+  EXPECT_LT(stereo.defects.folds, 6u);
+}
+
+TEST(Parametrization, ATorusIsFlagged) {
+  const Cloud c = shape(ParamShape::Torus, 8000);
+  const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+  EXPECT_FALSE(p.oneToOne);
+  EXPECT_GT(p.defects.folds + p.defects.overlaps, 80u);  // > 1% of the points
+  ASSERT_FALSE(p.warnings.empty());
+  EXPECT_NE(p.warnings.back().find("genus 0"), std::string::npos);
+}
+
+TEST(Parametrization, IdenticalForAnyThreadCount) {
+  const Cloud c = shape(ParamShape::Blob, 5000, 1e-3);
+  ParametrizationOptions one = fewScales(), two = fewScales();
+  one.flattening.threads = 1;
+  two.flattening.threads = 2;
+  const Parametrization a = parametrize(c.positions, c.normals, one);
+  const Parametrization b = parametrize(c.positions, c.normals, two);
+  ASSERT_EQ(a.domain.direction.size(), b.domain.direction.size());
+  for (std::size_t i = 0; i < a.domain.direction.size(); ++i)
+    ASSERT_EQ(a.domain.direction[i], b.domain.direction[i]) << i;
+  EXPECT_EQ(a.defects.fold, b.defects.fold);
+  EXPECT_EQ(a.defects.overlap, b.defects.overlap);
+}
+
+TEST(Parametrization, BadInputsAreRejected) {
+  const Cloud c = shape(ParamShape::Hemisphere, 200);
+  ParametrizationOptions o;
+  o.flattening.scaleCount = 1;
+  EXPECT_THROW(parametrize(c.positions, c.normals, o), OptionError);
+  o = {};
+  o.flattening.K = 0;
+  EXPECT_THROW(parametrize(c.positions, c.normals, o), OptionError);
+  o = {};
+  o.flattening.alpha = -1;
+  EXPECT_THROW(parametrize(c.positions, c.normals, o), OptionError);
+  o = {};
+  o.flattening.fit.mls = false;
+  EXPECT_THROW(parametrize(c.positions, c.normals, o), OptionError);
+  o = {};
+  o.defects.overlapFactor = 0.5;
+  EXPECT_THROW(parametrize(c.positions, c.normals, o), OptionError);
+  // Too few points, normals missing or zero, every point equal.
+  const std::vector<Vec3> few(c.positions.begin(), c.positions.begin() + 5);
+  const std::vector<Vec3> fewNormals(c.normals.begin(), c.normals.begin() + 5);
+  EXPECT_THROW(parametrize(few, fewNormals), OptionError);
+  EXPECT_THROW(parametrize(c.positions, {}), OptionError);
+  std::vector<Vec3> zero = c.normals;
+  zero[7] = Vec3::Zero();
+  EXPECT_THROW(parametrize(c.positions, zero), OptionError);
+  const std::vector<Vec3> same(50, Vec3(1, 2, 3));
+  EXPECT_THROW(parametrize(same, std::vector<Vec3>(50, Vec3::UnitZ())), OptionError);
+}
+
+TEST(Parametrization, DuplicatePointsStillMap) {
+  // Every point twice: per-point scales of zero at the first steps must not break the flow.
+  Cloud c = shape(ParamShape::Hemisphere, 3000);
+  const std::size_t n = c.positions.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    c.positions.push_back(c.positions[i]);
+    c.normals.push_back(c.normals[i]);
+  }
+  const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+  EXPECT_EQ(p.defects.folds, 0u);
+  for (std::size_t i = 0; i < n; ++i)
+    ASSERT_LT((p.domain.direction[i] - p.domain.direction[i + n]).norm(), 1e-9);
+}
