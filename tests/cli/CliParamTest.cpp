@@ -33,7 +33,7 @@ TEST_F(Cli, ParametrizeWritesTheDomainAndDistortionReadsItBack) {
   EXPECT_EQ(fs::last_write_time(path("d.ply")), before);
   const PointCloud p = readCloud(path("p.ply"));
   ASSERT_EQ(p.size(), 6000u);
-  for (const char* column : {"u", "v", "checker", "param_valid", "fold", "overlap", "local_scale"})
+  for (const char* column : {"u", "v", "param_valid", "fold", "overlap", "local_scale"})
     EXPECT_NE(p.findAttribute(column), nullptr) << column;
   EXPECT_EQ(p.findAttribute("s_x"), nullptr);
   const nlohmann::json summary = readJson(path("p.json"));
@@ -55,6 +55,17 @@ TEST_F(Cli, ParametrizeWritesTheDomainAndDistortionReadsItBack) {
   ASSERT_EQ(d["sizes"].size(), 2u);
   EXPECT_GE(d["sizes"][0]["median_conformal"].get<double>(), 1.0);
   EXPECT_LT(d["sizes"][0]["median_conformal"].get<double>(), 1.1);
+  // The picture of the map: u through viridis, a checkerboard over (u, v).
+  r = run("render " + path("p.ply") + " --color u --checker u,v -q -o " + path("map.png"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fs::file_size(path("map.png")), 1000u);
+  r = run("render " + path("p.ply") + " --checker u -q -o " + path("bad.png"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("is not two attribute names"), std::string::npos) << r.err;
+  r = run("render " + path("p.ply") + " --checker u,w -q -o " + path("bad.png"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no attribute 'w'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("bad.png")));
   r = run("distortion " + path("p.ply") + " -q -o " + path("e2.ply"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(readJson(path("e2.json"))["sizes"].size(), 3u);

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "scalespace/core/Error.hpp"
+#include "scalespace/param/MeshlessDistortion.hpp"
 #include "scalespace/param/ParamShapes.hpp"
 #include "scalespace/param/Parametrization.hpp"
 
@@ -220,4 +221,30 @@ TEST(Parametrization, DuplicatePointsStillMap) {
   EXPECT_EQ(p.defects.folds, 0u);
   for (std::size_t i = 0; i < n; ++i)
     ASSERT_LT((p.domain.direction[i] - p.domain.direction[i + n]).norm(), 1e-9);
+}
+
+TEST(Parametrization, RelaxationLowersTheConformalDistortionWithoutFolds) {
+  const Cloud c = shape(ParamShape::Relief, 12000);
+  ParametrizationOptions plain = fewScales(), relaxed = fewScales();
+  relaxed.relaxation.iterations = 5;
+  const Parametrization a = parametrize(c.positions, c.normals, plain);
+  const Parametrization b = parametrize(c.positions, c.normals, relaxed);
+  ASSERT_EQ(a.domain.kind, DomainKind::Plane);
+  ASSERT_TRUE(b.relaxation.applied) << b.relaxation.reason;
+  EXPECT_EQ(b.defects.folds + b.defects.overlaps, 0u);
+  const DistortionOptions k16{{16}};
+  const double before =
+      measureDistortion(c.positions, c.normals, a.domain, k16).sizes[0].medianConformal;
+  const double after =
+      measureDistortion(c.positions, c.normals, b.domain, k16).sizes[0].medianConformal;
+  EXPECT_LT(after - 1, 0.5 * (before - 1)) << before << " -> " << after;
+  // A sphere domain is left alone, and says why.
+  const Cloud closed = shape(ParamShape::Blob, 3000);
+  const Parametrization s = parametrize(closed.positions, closed.normals, relaxed);
+  EXPECT_FALSE(s.relaxation.applied);
+  EXPECT_NE(s.relaxation.reason.find("plane domains"), std::string::npos);
+  RelaxationOptions bad;
+  bad.neighbors = 2;
+  DomainMap copy = a.domain;
+  EXPECT_THROW(relaxConformally(c.positions, c.normals, copy, bad), OptionError);
 }

@@ -19,36 +19,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// 0/1 by the parity of the cell of (a, b) in a grid of cell `cell`: the checkerboard texture
-/// that shows a map's angles and areas in a picture.
-double checker(double a, double b, double cell) {
-  const long long i = (long long)std::floor(a / cell), j = (long long)std::floor(b / cell);
-  return double((i + j) & 1);
-}
-
 /// The domain's coordinates as columns (what `distortion` and users read back).
 void addDomainColumns(const DomainMap& domain, PointCloud& cloud) {
   const std::size_t n = cloud.size();
-  AttributeColumn& tile = cloud.addAttribute("checker", ScalarType::UInt8);
   if (domain.kind == DomainKind::Plane) {
     AttributeColumn& u = cloud.addAttribute("u", ScalarType::Float64);
     AttributeColumn& v = cloud.addAttribute("v", ScalarType::Float64);
-    double lo = 0, hi = 0;
     for (std::size_t i = 0; i < n; ++i) {
       u.values[i] = domain.uv[i].x();
       v.values[i] = domain.uv[i].y();
-      lo = std::min({lo, domain.uv[i].x(), domain.uv[i].y()});
-      hi = std::max({hi, domain.uv[i].x(), domain.uv[i].y()});
     }
-    // Twelve cells across the median point's neighbourhood of the domain would depend on the
-    // map; twelve across the domain's extent reads the same on every shape.
-    std::vector<double> extent;
-    extent.reserve(n);
-    for (const Vec2& p : domain.uv) extent.push_back(p.norm());
-    std::nth_element(extent.begin(), extent.begin() + std::ptrdiff_t(n * 9 / 10), extent.end());
-    const double cell = std::max(extent[n * 9 / 10], 1e-300) / 6;
-    for (std::size_t i = 0; i < n; ++i)
-      tile.values[i] = checker(domain.uv[i].x(), domain.uv[i].y(), cell);
     return;
   }
   const char* names[3] = {"s_x", "s_y", "s_z"};
@@ -58,8 +38,6 @@ void addDomainColumns(const DomainMap& domain, PointCloud& cloud) {
   }
   cloud.addAttribute("longitude", ScalarType::Float64).values = domain.longitude;
   cloud.addAttribute("latitude", ScalarType::Float64).values = domain.latitude;
-  for (std::size_t i = 0; i < n; ++i)
-    tile.values[i] = checker(domain.longitude[i], domain.latitude[i], 15);
 }
 
 /// The domain stored in a cloud's columns: u, v or s_x, s_y, s_z. FileError naming the file
@@ -126,6 +104,10 @@ void addParametrizeCommand(CLI::App& app) {
   cmd->add_option("--alpha", args->options.flattening.alpha,
                   "pyramid decimation: samples at least 2 alpha t apart (Sec. 1.5.2)")
       ->capture_default_str();
+  cmd->add_option("--relax", args->options.relaxation.iterations,
+                  "beyond the thesis: local-global iterations that lower the conformal "
+                  "distortion of a plane domain (0: none); not applied if it would add folds")
+      ->capture_default_str();
   cmd->add_option("--flattened", args->flattened,
                   "also write the flowed points, on their sphere or plane, to this cloud");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
@@ -136,6 +118,7 @@ void addParametrizeCommand(CLI::App& app) {
     ThreadScope threads(args->threads);
     args->options.domain.kind = parseDomainKind(args->domain);
     validateFlatteningOptions(args->options.flattening);
+    validateRelaxationOptions(args->options.relaxation);
     std::vector<std::string> inputs{args->input.path};
     checkOutput(args->output, OutputKind::Cloud, inputs);
     if (!args->flattened.empty()) {
@@ -207,6 +190,11 @@ void addParametrizeCommand(CLI::App& app) {
                                  {"overlaps", result.defects.overlaps},
                                  {"undetermined_local_maps", result.defects.undetermined},
                                  {"invalid_points", result.invalid},
+                                 {"relaxation",
+                                  {{"iterations", args->options.relaxation.iterations},
+                                   {"applied", result.relaxation.applied},
+                                   {"reason", result.relaxation.reason},
+                                   {"seconds", result.relaxation.seconds}}},
                                  {"flattening",
                                   {{"scales", args->options.flattening.scaleCount},
                                    {"k", args->options.flattening.K},

@@ -55,8 +55,8 @@ void addRenderCommand(CLI::App& app) {
   struct Args {
     InputOptions input;
     std::string output, color, labels, view = "iso", up = "z", size = "1024x768";
-    std::string lines, lineColor;
-    int radius = -1;
+    std::string lines, lineColor, checker;
+    int radius = -1, checkerCells = 12;
     bool noShading = false, quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -77,6 +77,14 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--point-radius", args->radius, "splat radius in pixels (-1 = automatic)")
       ->capture_default_str();
   cmd->add_flag("--no-shading", args->noShading, "flat colours (no shading from normals)");
+  auto* checker =
+      cmd->add_option("--checker", args->checker,
+                      "A,B: darken alternate cells of a grid over attributes A and B (e.g. u,v or "
+                      "longitude,latitude of `parametrize`)");
+  cmd->add_option("--checker-cells", args->checkerCells,
+                  "checker cells across the larger of the two attributes' ranges")
+      ->capture_default_str()
+      ->needs(checker);
   auto* lines = cmd->add_option("--lines", args->lines,
                                 "draw these polylines (.ply with vertex and edge elements) over "
                                 "the points, hidden where the surface is in front of them");
@@ -95,6 +103,14 @@ void addRenderCommand(CLI::App& app) {
     options.colorAttribute = args->color;
     options.labelAttribute = args->labels;
     options.pointRadius = args->radius;
+    if (!args->checker.empty()) {
+      const std::size_t comma = args->checker.find(',');
+      if (comma == std::string::npos || comma == 0 || comma + 1 == args->checker.size() ||
+          args->checker.find(',', comma + 1) != std::string::npos)
+        throw OptionError("--checker '" + args->checker + "' is not two attribute names A,B");
+      options.checkerAttributes = {args->checker.substr(0, comma), args->checker.substr(comma + 1)};
+      options.checkerCells = args->checkerCells;
+    }
     if (args->radius > kMaxPointRadius && !args->quiet)
       std::fprintf(stderr, "warning: --point-radius %d is drawn as %d pixels (the largest)\n",
                    args->radius, kMaxPointRadius);

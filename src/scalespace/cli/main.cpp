@@ -40,6 +40,8 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"StackWriteOptions::encoding", "--encoding"},
     {"RenderOptions::up", "--up"},
     {"RenderOptions::view", "--view"},
+    {"RenderOptions::checkerCells", "--checker-cells"},
+    {"RenderOptions::checkerAttributes", "--checker"},
     {"LineRenderOptions::colorAttribute", "--line-color-by"},
     {"RenderOptions::width and height", "--size width and height"},
     {"SceneOptions::noise", "--noise"},
@@ -65,6 +67,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FlatteningOptions::K", "--k"},
     {"FlatteningOptions::tMax", "--tmax"},
     {"DistortionOptions::neighbors", "--scales-k"},
+    {"RelaxationOptions::iterations", "--relax"},
     {"the thread count (threads option)", "--threads"},
     {"findSimilar: no component", "--similar: no component"},
 };

@@ -33,12 +33,20 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
   if (!(options.maxFailedStepFraction >= 0 && options.maxFailedStepFraction <= 1))
     throw OptionError("ParametrizationOptions::maxFailedStepFraction must be in [0, 1]");
   validateMapDefectOptions(options.defects);
+  validateRelaxationOptions(options.relaxation);
   ThreadLimit limit(options.flattening.threads);
   Parametrization result;
-  result.flattening =
-      flattenScaleSpace(positions, normals, options.flattening, subProgress(progress, 0, 0.9));
+  const bool relax = options.relaxation.iterations > 0;
+  result.flattening = flattenScaleSpace(positions, normals, options.flattening,
+                                        subProgress(progress, 0, relax ? 0.8 : 0.9));
   result.domain = mapToDomain(result.flattening, options.domain);
   result.warnings = result.domain.warnings;
+  if (relax) {
+    result.relaxation = relaxConformally(positions, normals, result.domain, options.relaxation,
+                                         subProgress(progress, 0.8, 0.9));
+    if (!result.relaxation.applied)
+      result.warnings.push_back("relaxation not applied: " + result.relaxation.reason);
+  }
   result.defects = findMapDefects(positions, normals, result.domain, options.defects,
                                   subProgress(progress, 0.9, 1));
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/param/ConformalRelaxation.hpp"
 #include "scalespace/param/MapDefects.hpp"
 #include "scalespace/param/ParamDomain.hpp"
 #include "scalespace/param/ScaleSpaceFlattening.hpp"
@@ -16,6 +17,8 @@ struct ParametrizationOptions {
   FlatteningOptions flattening;
   DomainOptions domain;
   MapDefectOptions defects;
+  /// Beyond the thesis: conformal relaxation of a plane domain (off by default: 0 iterations).
+  RelaxationOptions relaxation{0};
   /// The share of points flagged (folds plus overlaps) above which the map is reported as not
   /// one-to-one (the target for genus-0 surfaces: below 0.1%).
   double maxDefectFraction = 0.001;
@@ -27,6 +30,7 @@ struct Parametrization {
   FlatteningResult flattening;
   DomainMap domain;
   MapDefects defects;
+  RelaxationResult relaxation;
   std::vector<std::uint8_t> valid;  // per point
   std::size_t invalid = 0;
   bool oneToOne = true;  // defects below maxDefectFraction

@@ -54,7 +54,44 @@ const AttributeColumn& requireAttribute(const PointCloud& cloud, const std::stri
 }
 }  // namespace
 
+namespace {
+
+std::vector<Rgb> baseColors(const PointCloud& cloud, const RenderOptions& options);
+
+/// Darkens the colours of the points in odd cells of the checker grid (RenderOptions).
+void applyChecker(const PointCloud& cloud, const RenderOptions& options, std::vector<Rgb>& colors) {
+  if (options.checkerAttributes.empty()) return;
+  if (options.checkerAttributes.size() != 2)
+    throw OptionError("RenderOptions::checkerAttributes needs two attribute names");
+  if (options.checkerCells < 1 || options.checkerCells > 10000)
+    throw OptionError("RenderOptions::checkerCells must be in [1, 10000]");
+  const auto& a = requireAttribute(cloud, options.checkerAttributes[0]).values;
+  const auto& b = requireAttribute(cloud, options.checkerAttributes[1]).values;
+  const ScalarRange ra = robustRange(a), rb = robustRange(b);
+  const double aLo = ra.lo, bLo = rb.lo;
+  const double span = std::max(ra.hi - ra.lo, rb.hi - rb.lo);
+  if (!(span > 0)) return;
+  const double cell = span / options.checkerCells;
+  for (std::size_t i = 0; i < colors.size(); ++i) {
+    if (!std::isfinite(a[i]) || !std::isfinite(b[i])) continue;
+    const double x = std::floor((a[i] - aLo) / cell), y = std::floor((b[i] - bLo) / cell);
+    if (std::fmod(std::abs(x + y), 2.0) < 0.5) continue;
+    Rgb& c = colors[i];
+    c = Rgb{std::uint8_t(c.r * 0.55), std::uint8_t(c.g * 0.55), std::uint8_t(c.b * 0.55)};
+  }
+}
+
+}  // namespace
+
 std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& options) {
+  std::vector<Rgb> colors = baseColors(cloud, options);
+  applyChecker(cloud, options, colors);
+  return colors;
+}
+
+namespace {
+
+std::vector<Rgb> baseColors(const PointCloud& cloud, const RenderOptions& options) {
   const std::size_t n = cloud.size();
   if (!options.colors.empty()) {
     if (options.colors.size() != n)
@@ -95,6 +132,8 @@ std::vector<Rgb> pointColors(const PointCloud& cloud, const RenderOptions& optio
   }
   return std::vector<Rgb>(n, Rgb{200, 200, 200});
 }
+
+}  // namespace
 
 ScreenFrame frameCloud(const PointCloud& cloud, const RenderOptions& options) {
   if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)

@@ -28,6 +28,11 @@ struct RenderOptions {
   std::vector<Rgb> colors;
   std::string labelAttribute;
   std::string colorAttribute;
+  /// Two attribute names (e.g. "u", "v" of a parametrization): the colours above are darkened
+  /// on alternate cells of a grid over these two values, `checkerCells` cells across the larger
+  /// of their 2nd-98th percentile ranges: a checkerboard shows how a map bends angles and areas.
+  std::vector<std::string> checkerAttributes;
+  int checkerCells = 12;
   /// Splat radius in pixels; negative = automatic from the point density on screen. Larger than
   /// kMaxPointRadius draws with kMaxPointRadius.
   int pointRadius = -1;
