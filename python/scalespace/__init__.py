@@ -12,6 +12,7 @@ raise :class:`FileError` (an OSError).
     curv = ss.curvature(cloud.points, cloud.normals, scale_k=40)
     planes = ss.planes(cloud.points, scales=30)
     pipes = ss.cylinders(cloud.points, cloud.normals)
+    uv = ss.parametrize(cloud.points, cloud.normals)["uv"]
 """
 from dataclasses import dataclass, field
 from typing import Dict, Mapping, Optional
@@ -30,10 +31,12 @@ from ._scalespace import (  # noqa: F401
     compute_stack,
     curvature,
     cylinders,
+    distortion,
     estimate_normals,
     features,
     lines,
     open_stack,
+    parametrize,
     planes,
     read_mesh,
     read_planes,
@@ -45,7 +48,7 @@ from . import _scalespace
 __all__ = [
     "Cloud", "read", "write", "estimate_normals", "curvature", "compute_stack", "open_stack",
     "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "cylinders",
-    "Cylinders", "Error", "retain_freed_memory",
+    "Cylinders", "parametrize", "distortion", "Error", "retain_freed_memory",
     "OptionError", "FileError", "Cancelled", "__version__",
 ]
 

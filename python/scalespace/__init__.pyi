@@ -137,3 +137,21 @@ def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,
               min_arc: float = ..., max_rms: float = ..., threads: Optional[int] = ...,
               progress: Progress = ...) -> Cylinders: ...
+
+def parametrize(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
+                domain: str = ..., k: int = ..., tmax: float = ..., alpha: float = ...,
+                relax: int = ..., threads: Optional[int] = ...,
+                progress: Progress = ...) -> Dict[str, object]:
+    """Meshless parametrization (Sec. 4.3): a dict with domain ("plane" | "sphere"), uv (N, 2)
+    or direction (N, 3) with longitude and latitude, valid, fold, overlap, local_scale,
+    flattened, centre, radius, cap_degrees, one_to_one, folds, overlaps, relaxed, warnings,
+    seconds."""
+    ...
+
+def distortion(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
+               uv: Optional[ArrayLike] = ..., direction: Optional[ArrayLike] = ...,
+               scales_k: Sequence[int] = ..., threads: Optional[int] = ...,
+               progress: Progress = ...) -> Dict[str, object]:
+    """Meshless distortion (Sec. 4.4) of the map given as uv or direction: per size the
+    eps_conf / eps_auth arrays and their median and 90th percentile; fold and overlap flags."""
+    ...

@@ -433,3 +433,48 @@ def test_two_threads_overlap_in_time():
     assert len(a) > 2 and len(b) > 2
     # With the GIL held the second call would start only after the first ended.
     assert a[0] < b[-1] and b[0] < a[-1]
+
+
+# -------------------------------------------------------------------------- parametrization
+def test_parametrize_equals_the_cli(tmp_path):
+    cli("generate", "bumpy-disk", "-n", 4000, "--noise", 0.001, "-o", tmp_path / "d.ply")
+    cli("parametrize", tmp_path / "d.ply", "--scales", 15, "-o", tmp_path / "p.ply")
+    written = ss.read(str(tmp_path / "p.ply"))
+    cloud = ss.read(str(tmp_path / "d.ply"))
+    got = ss.parametrize(cloud.points, cloud.normals, scales=15)
+    assert got["domain"] == "plane" and got["direction"] is None
+    assert got["uv"].shape == (4000, 2)
+    np.testing.assert_allclose(got["uv"][:, 0], written.attributes["u"], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(got["uv"][:, 1], written.attributes["v"], rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(got["fold"], written.attributes["fold"])
+    assert got["folds"] == 0 and got["overlaps"] == 0 and got["one_to_one"]
+    d = ss.distortion(cloud.points, cloud.normals, uv=got["uv"], scales_k=[16, 64])
+    cli("distortion", tmp_path / "d.ply", tmp_path / "p.ply", "--scales-k", "16,64",
+        "-o", tmp_path / "e.ply")
+    expected = json.loads((tmp_path / "e.json").read_text())["sizes"]
+    for g, e in zip(d["sizes"], expected):
+        assert g["neighbors"] == e["neighbors"]
+        np.testing.assert_allclose(g["median_conformal"], e["median_conformal"], rtol=1e-6)
+        np.testing.assert_allclose(g["median_authalic"], e["median_authalic"], rtol=1e-6)
+        assert g["conformal"].shape == (4000,) and g["conformal"].dtype == np.float32
+
+
+def test_parametrize_a_sphere_and_bad_arguments():
+    p = sphere_points(3000, 4) * 2 + [10, 0, 0]
+    got = ss.parametrize(p, (p - [10, 0, 0]) * 3, scales=10)  # normals of any length
+    assert got["domain"] == "sphere" and got["uv"] is None
+    np.testing.assert_allclose(got["radius"], 2, rtol=1e-6)
+    np.testing.assert_allclose(got["direction"], (p - [10, 0, 0]) / 2, atol=1e-6)
+    assert got["longitude"].shape == (3000,)
+    with pytest.raises(ss.OptionError, match="scales"):
+        ss.parametrize(p, scales=1)
+    with pytest.raises(ss.OptionError, match="expected auto, plane or sphere"):
+        ss.parametrize(p, domain="cone")
+    with pytest.raises(ss.OptionError, match="either uv"):
+        ss.distortion(p)
+    with pytest.raises(ss.OptionError, match="scales_k"):
+        ss.distortion(p, direction=p, scales_k=[2])
+    with pytest.raises(ValueError):
+        ss.distortion(p, uv=np.zeros((10, 2)))
+    with pytest.raises(ss.Cancelled):
+        ss.parametrize(p, scales=10, progress=lambda f, stage: False)

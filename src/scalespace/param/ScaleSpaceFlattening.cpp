@@ -123,9 +123,12 @@ FlatteningResult flattenScaleSpace(const std::vector<Vec3>& inputPositions,
   const std::vector<Index> order = spatialOrder(inputPositions);
   std::vector<Vec3> current = applyPermutation(inputPositions, order);
   std::vector<Vec3> currentNormals = applyPermutation(inputNormals, order);
-  for (const Vec3& m : currentNormals)
+  // The fits read unit normals (a longer normal weighs more in Eq. 1.7-1.9).
+  for (Vec3& m : currentNormals) {
     if (!m.allFinite() || !(m.squaredNorm() > 0))
       throw OptionError("the flattening needs finite non-zero normals at every point");
+    m.normalize();
+  }
 
   // Per-point first scale: the point's K-NN distance (the heterogeneous series of Sec. 1.5.1).
   std::vector<double> tMin;

@@ -10,5 +10,6 @@ void bindStacks(pybind11::module_& m);     // the multi-scale stack, in memory a
 void bindPlanes(pybind11::module_& m);     // planes, their result folders, the segment queries
 void bindFeatures(pybind11::module_& m);   // curvature lines, feature curves
 void bindCylinders(pybind11::module_& m);  // cylinders across scales
+void bindParametrization(pybind11::module_& m);  // parametrize, distortion
 
 }  // namespace scalespace::python

@@ -17,6 +17,7 @@ PYBIND11_MODULE(_scalespace, m) {
   scalespace::python::bindPlanes(m);
   scalespace::python::bindFeatures(m);
   scalespace::python::bindCylinders(m);
+  scalespace::python::bindParametrization(m);
   m.def("retain_freed_memory", &scalespace::retainFreedMemory,
         R"doc(Keep freed memory in the process for reuse (glibc only; returns whether it applied).
 
