@@ -22,6 +22,10 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The fewest samples a pyramid level keeps (Sec. 1.5.2 decimates without a floor): a few
+/// times the neighbours a fit needs, so every point of a shrunken cloud still has a fit.
+constexpr std::size_t kMinSamples = 64;
+
 double diagonalOf(const std::vector<Vec3>& positions) {
   Vec3 lo = positions.front(), hi = positions.front();
   for (const Vec3& p : positions) {
@@ -158,10 +162,15 @@ FlatteningResult flattenScaleSpace(const std::vector<Vec3>& inputPositions,
       scales[k] = tMin[k] + f * (result.tMax - tMin[k]);
       separations[k] = poissonDiskSeparation(options.alpha, scales[k]);
     }
-    // The pyramid level of this step, drawn from the previous level on the moved points.
-    members = options.alpha > 0 ? poissonDiskSampleAdaptive(current, members, separations,
-                                                            pyramidLevelSeed(options.seed, j))
-                                : members;
+    // The pyramid level of this step, drawn from the previous level on the moved points. A
+    // cloud that shrank as it flowed (thin parts merging, a rounded body) would be decimated to
+    // a handful of samples at the largest scales, too few for any fit: below kMinSamples the
+    // previous level is kept.
+    if (options.alpha > 0) {
+      std::vector<Index> level = poissonDiskSampleAdaptive(current, members, separations,
+                                                           pyramidLevelSeed(options.seed, j));
+      if (level.size() >= std::min(members.size(), kMinSamples)) members = std::move(level);
+    }
     std::vector<Vec3> samplePositions(members.size()), sampleNormals(members.size());
     for (std::size_t s = 0; s < members.size(); ++s) {
       samplePositions[s] = current[members[s]];
