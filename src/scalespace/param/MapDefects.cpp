@@ -41,35 +41,27 @@ MapDefects findMapDefects(const std::vector<Vec3>& positions, const std::vector<
   std::vector<double> radius(n, 0);
   ProgressTracker tracker(progress, "folds", 2 * n);
   const std::size_t k = std::size_t(options.neighbors);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n, 512),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        LocalMapSample sample;
-        std::vector<Neighbor> scratch;
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          gatherLocalMap(i, k, positions, normals.empty() ? Vec3::Zero() : normals[i], *index,
-                         domain, sample, scratch);
-          radius[i] = sample.radius;
-          Eigen::Matrix2d aa = Eigen::Matrix2d::Zero(), ba = Eigen::Matrix2d::Zero();
-          for (std::size_t s = 0; s < sample.weight.size(); ++s) {
-            aa += sample.weight[s] * sample.tangent[s] * sample.tangent[s].transpose();
-            ba += sample.weight[s] * sample.domain[s] * sample.tangent[s].transpose();
-          }
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(aa);
-          const double lo = eig.eigenvalues()(0), hi = eig.eigenvalues()(1);
-          const double c2 = options.maxConditionNumber * options.maxConditionNumber;
-          if (!(hi > 0) || !(lo * c2 > hi)) continue;  // collinear neighbours
-          const Eigen::Matrix2d a = ba * aa.inverse();
-          const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a);
-          const double s0 = svd.singularValues()(0), s1 = svd.singularValues()(1);
-          if (!std::isfinite(s0) || !(s0 > 0) || !(s1 * options.maxConditionNumber > s0))
-            continue;  // the domain collapses the neighbourhood onto a line
-          jacobian[i] = a;
-          determined[i] = 1;
-          result.localScale[i] = float(std::sqrt(std::abs(a.determinant())));
-        }
-        tracker.advance(range.size());
-      });
+  forEachLocalMap(positions, normals, *index, domain, k, tracker,
+                  [&](std::size_t i, const LocalMapSample& sample, LocalMapSample&) {
+                    radius[i] = sample.radius;
+                    Eigen::Matrix2d aa = Eigen::Matrix2d::Zero(), ba = Eigen::Matrix2d::Zero();
+                    for (std::size_t s = 0; s < sample.weight.size(); ++s) {
+                      aa += sample.weight[s] * sample.tangent[s] * sample.tangent[s].transpose();
+                      ba += sample.weight[s] * sample.domain[s] * sample.tangent[s].transpose();
+                    }
+                    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(aa);
+                    const double lo = eig.eigenvalues()(0), hi = eig.eigenvalues()(1);
+                    const double c2 = options.maxConditionNumber * options.maxConditionNumber;
+                    if (!(hi > 0) || !(lo * c2 > hi)) return;  // collinear neighbours
+                    const Eigen::Matrix2d a = ba * aa.inverse();
+                    const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a);
+                    const double s0 = svd.singularValues()(0), s1 = svd.singularValues()(1);
+                    if (!std::isfinite(s0) || !(s0 > 0) || !(s1 * options.maxConditionNumber > s0))
+                      return;  // the domain collapses the neighbourhood onto a line
+                    jacobian[i] = a;
+                    determined[i] = 1;
+                    result.localScale[i] = float(std::sqrt(std::abs(a.determinant())));
+                  });
   std::size_t positive = 0, negative = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!determined[i]) {

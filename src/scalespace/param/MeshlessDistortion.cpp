@@ -78,22 +78,14 @@ DistortionResult measureDistortion(const std::vector<Vec3>& positions,
     const std::size_t kMax =
         std::size_t(*std::max_element(options.neighbors.begin(), options.neighbors.end()));
     ProgressTracker tracker(progress, "distortion", n);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, n, 256),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          LocalMapSample all, sample;
-          std::vector<Neighbor> scratch;
-          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            gatherLocalMap(i, kMax, positions, normals.empty() ? Vec3::Zero() : normals[i], *index,
-                           domain, all, scratch);
-            for (std::size_t s = 0; s < sizes; ++s) {
-              truncateLocalMap(all, std::size_t(options.neighbors[s]), sample);
-              in3d[s][i] = ellipseOf(weightedCovariance(sample.tangent, sample.weight));
-              in2d[s][i] = ellipseOf(weightedCovariance(sample.domain, sample.weight));
-            }
-          }
-          tracker.advance(range.size());
-        });
+    forEachLocalMap(positions, normals, *index, domain, kMax, tracker,
+                    [&](std::size_t i, const LocalMapSample& all, LocalMapSample& sample) {
+                      for (std::size_t s = 0; s < sizes; ++s) {
+                        truncateLocalMap(all, std::size_t(options.neighbors[s]), sample);
+                        in3d[s][i] = ellipseOf(weightedCovariance(sample.tangent, sample.weight));
+                        in2d[s][i] = ellipseOf(weightedCovariance(sample.domain, sample.weight));
+                      }
+                    });
     tracker.finish();
   }
   for (std::size_t s = 0; s < sizes; ++s) {
