@@ -93,6 +93,9 @@ TEST_F(Cli, ParametrizeAndDistortionRejectBadInput) {
   r = run("parametrize " + path("h.ply") + " --scales 1 -o " + path("p.ply"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--scales must be in [2,"), std::string::npos) << r.err;
+  r = run("parametrize " + path("h.ply") + " --k 5000 -o " + path("p.ply"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--k must be in [1, 1000]"), std::string::npos) << r.err;
   r = run("parametrize " + path("h.ply") + " -o " + path("h.ply"));
   EXPECT_NE(r.code, 0);
   r = run("parametrize " + path("h.ply") + " -o " + path("p.ply") + " --flattened " +

@@ -51,7 +51,9 @@ void validateFlatteningOptions(const FlatteningOptions& options) {
     throw OptionError("FlatteningOptions::scaleCount must be in [2, " +
                       std::to_string(kMaxScaleCount) + "], got " +
                       std::to_string(options.scaleCount));
-  if (options.K < 1) throw OptionError("FlatteningOptions::K must be >= 1");
+  if (options.K < 1 || std::size_t(options.K) > kMaxNeighborCount)
+    throw OptionError("FlatteningOptions::K must be in [1, " + std::to_string(kMaxNeighborCount) +
+                      "]");
   if (!std::isfinite(options.tMax) || options.tMax < 0)
     throw OptionError("FlatteningOptions::tMax must be finite and >= 0 (0: the diagonal)");
   validatePyramidAlpha(options.alpha);

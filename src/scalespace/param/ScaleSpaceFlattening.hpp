@@ -30,7 +30,8 @@ struct FlatteningOptions {
   int threads = 0;         // 0: all cores
 };
 
-/// OptionError naming the field unless 2 <= scaleCount <= kMaxScaleCount, K >= 1, tMax finite
+/// OptionError naming the field unless 2 <= scaleCount <= kMaxScaleCount, 1 <= K <=
+/// kMaxNeighborCount, tMax finite
 /// and >= 0, alpha finite and >= 0, the fit options valid with fit.mls on.
 void validateFlatteningOptions(const FlatteningOptions& options);
 
