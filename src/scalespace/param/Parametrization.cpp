@@ -70,8 +70,9 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
         "the map is not one-to-one: " + std::to_string(result.defects.folds) + " points fold (" +
         percent(result.defects.folds, n) + ") and " + std::to_string(result.defects.overlaps) +
         " overlap (" + percent(result.defects.overlaps, n) +
-        "). A surface that is not of genus 0 (a torus, a handle) cannot be flattened without a "
-        "cut; otherwise try more scales (columns fold and overlap)");
+        "). A surface that is not of genus 0 (a torus, a handle), several separate surfaces (a "
+        "table above a floor) or thin parts the flow squashed together (legs) cannot be "
+        "flattened one-to-one (columns fold and overlap)");
   return result;
 }
 

@@ -1,0 +1,98 @@
+// Merging the touching tubes of one scale (features/TubeMerging): two pieces of one pipe become
+// one tube, two strands side by side and a step in radius stay apart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/features/TubeMerging.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Scene {
+  std::vector<Vec3> positions, normals;
+  std::vector<float> kappa1;
+  std::vector<int> part;  // which region each point starts in
+};
+
+/// Points of a tube of radius r around the axis through `centre` along x, for x in [x0, x1),
+/// with exact outward normals and kappa1 = 1 / r (convex).
+void addTube(Scene& s, const Vec3& centre, double r, double x0, double x1, int part,
+             std::size_t count, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double a = 2 * kPi * u(rng), x = x0 + (x1 - x0) * u(rng);
+    const Vec3 n(0, std::cos(a), std::sin(a));
+    s.positions.push_back(centre + Vec3(x, 0, 0) + r * n);
+    s.normals.push_back(n);
+    s.kappa1.push_back(float(1 / r));
+    s.part.push_back(part);
+  }
+}
+
+struct Merged {
+  std::vector<TubeFit> tubes;
+  std::vector<std::vector<Index>> regions;
+};
+
+/// One region per part, a tube fitted to each, then the merge.
+Merged fitAndMerge(const Scene& s, int parts, double t) {
+  LineAnisotropyField field;
+  field.scale = t;
+  field.normal = s.normals;
+  field.kappa1 = s.kappa1;
+  Merged m;
+  m.regions.resize(std::size_t(parts));
+  for (std::size_t i = 0; i < s.part.size(); ++i)
+    m.regions[std::size_t(s.part[i])].push_back(Index(i));
+  for (const auto& region : m.regions)
+    m.tubes.push_back(fitTube(s.positions, s.normals, field.normal, field.kappa1, region, t));
+  for (const TubeFit& tube : m.tubes)
+    EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
+  const KnnGraph graph = buildKnnGraph(s.positions, 10);
+  mergeTouchingTubes(graph, s.positions, s.normals, field, t, {}, m.tubes, m.regions);
+  return m;
+}
+
+}  // namespace
+
+TEST(TubeMerging, TwoPiecesOfOnePipeBecomeOneTube) {
+  std::mt19937_64 rng(1);
+  Scene s;
+  addTube(s, Vec3::Zero(), 0.1, -0.6, 0.0, 0, 4000, rng);
+  addTube(s, Vec3::Zero(), 0.1, 0.0, 0.6, 1, 4000, rng);
+  const Merged m = fitAndMerge(s, 2, 0.05);
+  EXPECT_TRUE(m.tubes[0].isTube());
+  EXPECT_EQ(m.tubes[1].rejection, TubeRejection::Merged);
+  EXPECT_EQ(m.regions[0].size(), 8000u);
+  EXPECT_TRUE(m.regions[1].empty());
+  EXPECT_TRUE(std::is_sorted(m.regions[0].begin(), m.regions[0].end()));
+  EXPECT_NEAR(m.tubes[0].radius, 0.1, 0.002);
+  EXPECT_NEAR(m.tubes[0].length, 1.2, 0.05);
+  const std::vector<int> owner = tubeOwners(s.positions.size(), m.tubes, m.regions);
+  EXPECT_EQ(std::count(owner.begin(), owner.end(), 0), 8000);
+}
+
+TEST(TubeMerging, StrandsSideBySideAndAStepInRadiusStayApart) {
+  std::mt19937_64 rng(2);
+  Scene strands;  // two touching strands of radius 0.05, axes 0.1 apart
+  addTube(strands, Vec3(0, -0.05, 0), 0.05, -0.5, 0.5, 0, 4000, rng);
+  addTube(strands, Vec3(0, 0.05, 0), 0.05, -0.5, 0.5, 1, 4000, rng);
+  const Merged a = fitAndMerge(strands, 2, 0.03);
+  EXPECT_TRUE(a.tubes[0].isTube());
+  EXPECT_TRUE(a.tubes[1].isTube());
+  EXPECT_EQ(a.regions[1].size(), 4000u);
+
+  Scene step;  // radius 0.1 then 0.06 along one axis: 40% apart
+  addTube(step, Vec3::Zero(), 0.1, -0.6, 0.0, 0, 4000, rng);
+  addTube(step, Vec3::Zero(), 0.06, 0.0, 0.6, 1, 4000, rng);
+  const Merged b = fitAndMerge(step, 2, 0.04);
+  EXPECT_TRUE(b.tubes[0].isTube());
+  EXPECT_TRUE(b.tubes[1].isTube());
+  EXPECT_NEAR(b.tubes[1].radius, 0.06, 0.002);
+}
