@@ -1,7 +1,7 @@
 #include "scalespace/param/ConformalRelaxation.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -104,13 +104,14 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
   Eigen::SparseMatrix<double> laplacian(rows, rows);
   laplacian.setFromTriplets(triplets.begin(), triplets.end());
   triplets = {};
-  // Conjugate gradients started from the current positions: each iteration corrects the map
-  // locally, so a few hundred matrix products suffice where a factorization of a million-point
-  // graph's Laplacian took 96 s (bench_parametrize, 1M points).
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
-  solver.setTolerance(1e-5);
-  solver.setMaxIterations(200);
-  solver.compute(laplacian);
+  // The matrix does not change between iterations: factorized once. (Conjugate gradients from
+  // the current map were slower at 100k and at 1M points: the pinned graph Laplacian is badly
+  // conditioned, bench/README.md.)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
+  if (solver.info() != Eigen::Success) {
+    result.reason = "the k-NN graph's Laplacian could not be factorized";
+    return result;
+  }
 
   std::vector<Vec2> uv = domain.uv;
   Vec2 centroid;
@@ -149,9 +150,7 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
         rhs.row(int(j)) += w * r.transpose();
         rhs.row(int(i)) -= w * r.transpose();
       }
-    Eigen::MatrixXd guess(int(n), 2);
-    for (std::size_t i = 0; i < n; ++i) guess.row(int(i)) = uv[i].transpose();
-    const Eigen::MatrixXd solved = solver.solveWithGuess(rhs, guess);
+    const Eigen::MatrixXd solved = solver.solve(rhs);
     // The energy has no scale of its own: keep the domain's spread and centroid.
     std::vector<Vec2> next(n);
     for (std::size_t i = 0; i < n; ++i) next[i] = solved.row(int(i)).transpose();

@@ -7,7 +7,8 @@
 //           map is mirrored) that best takes its neighbours' tangent-plane offsets a_ij to their
 //           domain offsets u_j - u_i;
 //   global: the domain positions minimizing sum_i sum_j w_ij |u_j - u_i - S_i a_ij|^2, a sparse
-//           Laplacian system solved by conjugate gradients from the current positions.
+//           Laplacian system whose matrix does not change between iterations (factorized once;
+//           about 1.5 s at 100k points, 96 s at 1M: meant for clouds up to a few 100k points).
 // The domain's size is kept (RMS distance to the centroid) so the scale-free energy cannot
 // shrink it. A relaxation that would add folds (MapDefects) is not applied.
 #include <vector>
