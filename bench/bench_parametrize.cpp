@@ -222,6 +222,13 @@ int main(int argc, char** argv) {
         Score sr = scoreMap("scalespace+relax", positions, normals, relaxed, seconds + r.seconds);
         sr.note = r.applied ? "relaxed in " + std::to_string(r.seconds) + " s" : r.reason;
         print(name, noise, sr);
+        DomainMap rigid = ours.domain;
+        RelaxationOptions rigidOptions;
+        rigidOptions.rigid = true;
+        const RelaxationResult rr = relaxConformally(positions, normals, rigid, rigidOptions);
+        Score sg = scoreMap("scalespace+rigid", positions, normals, rigid, seconds + rr.seconds);
+        sg.note = rr.applied ? "relaxed in " + std::to_string(rr.seconds) + " s" : rr.reason;
+        print(name, noise, sg);
       }
 
       const bool disk = topology == ParamTopology::Disk;

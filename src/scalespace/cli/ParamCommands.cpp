@@ -108,6 +108,10 @@ void addParametrizeCommand(CLI::App& app) {
                   "beyond the thesis: local-global iterations that lower the conformal "
                   "distortion of a plane domain (0: none); not applied if it would add folds")
       ->capture_default_str();
+  cmd->add_flag("--rigid", args->options.relaxation.rigid,
+                "with --relax: rotations instead of similarities (as rigid as possible): keeps "
+                "lengths, so areas too, where the surface allows, and gives the domain the "
+                "surface's units");
   cmd->add_option("--flattened", args->flattened,
                   "also write the flowed points, on their sphere or plane, to this cloud");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
@@ -192,6 +196,7 @@ void addParametrizeCommand(CLI::App& app) {
                                  {"invalid_points", result.invalid},
                                  {"relaxation",
                                   {{"iterations", args->options.relaxation.iterations},
+                                   {"rigid", args->options.relaxation.rigid},
                                    {"applied", result.relaxation.applied},
                                    {"reason", result.relaxation.reason},
                                    {"seconds", result.relaxation.seconds}}},

@@ -131,7 +131,12 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
         norm += w * x.squaredNorm();
       }
       Eigen::Matrix2d s;
-      if (norm > 0) {
+      if (options.rigid) {
+        // The rotation of the similarity (its angle), at unit scale: as rigid as possible.
+        const double length = std::hypot(a, b);
+        a = length > 0 ? a / length : 1;
+        b = length > 0 ? b / length : 0;
+      } else if (norm > 0) {
         a /= norm;
         b /= norm;
       }
@@ -151,7 +156,8 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
         rhs.row(int(i)) -= w * r.transpose();
       }
     const Eigen::MatrixXd solved = solver.solve(rhs);
-    // The energy has no scale of its own: keep the domain's spread and centroid.
+    // The similarity energy has no scale of its own: keep the domain's spread and centroid
+    // (the rigid one takes the surface's lengths).
     std::vector<Vec2> next(n);
     for (std::size_t i = 0; i < n; ++i) next[i] = solved.row(int(i)).transpose();
     Vec2 c;
@@ -160,7 +166,8 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
       result.reason = "the relaxation collapsed the domain";
       return result;
     }
-    for (std::size_t i = 0; i < n; ++i) uv[i] = centroid + (next[i] - c) * (size / s);
+    const double factor = options.rigid ? 1.0 : size / s;
+    for (std::size_t i = 0; i < n; ++i) uv[i] = centroid + (next[i] - c) * factor;
     tracker.advance(1);
   }
   tracker.finish();

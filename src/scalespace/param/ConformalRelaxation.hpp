@@ -22,6 +22,10 @@ namespace scalespace {
 struct RelaxationOptions {
   int iterations = 5;  // local-global iterations (0: none)
   int neighbors = 10;  // k of the k-NN graph
+  /// Rotations instead of similarities ("as rigid as possible"): the map then also keeps the
+  /// surface's lengths where it can, which lowers the authalic distortion as well on nearly
+  /// developable surfaces, and gives the domain the surface's units.
+  bool rigid = false;
 };
 
 /// OptionError naming the field unless iterations >= 0 and 3 <= neighbors <= 64.
