@@ -12,6 +12,7 @@
 #include "scalespace/cli/PlanesCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/cli/ScalesCommands.hpp"
+#include "scalespace/cli/ViewCommands.hpp"
 #include "scalespace/core/AnalyticSurface.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
@@ -348,6 +349,7 @@ void addCloudCommands(CLI::App& app) {
   addPlanesCommands(app);
   addFeatureCommands(app);
   addCylinderCommands(app);
+  addViewCommand(app);
 }
 
 }  // namespace scalespace::cli
