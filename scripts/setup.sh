@@ -14,7 +14,12 @@ packages=(
   clang-format
   python3 python3-numpy
   pybind11-dev python3-pybind11 python3-pytest
+  libcpp-httplib-dev  # `scalespace view`: the local HTTP server
+  chromium            # `scalespace view`'s end-to-end test drives it headless (never downloaded)
 )
+# The viewer page is bundled with npm packages (scripts/setup_web.sh); Debian's nodejs and npm
+# unless a Node.js with npm is installed already (NodeSource's nodejs package brings its own npm).
+command -v npm >/dev/null || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -22,8 +27,11 @@ for p in "${packages[@]}"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
+web() { "$(dirname "$0")/setup_web.sh"; }
+
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  web
   exit 0
 fi
 
@@ -39,3 +47,4 @@ if ! "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"; th
   "${sudo[@]}" apt-get update
   "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
 fi
+web
