@@ -12,9 +12,12 @@ struct ViewerRequest {
   std::string path;         // decoded, without the query string
   std::string host;         // the Host header ("" when absent)
   std::string tokenHeader;  // the X-Scalespace-Token header ("" when absent)
-  /// Query parameters; a name given twice is refused before the router (ambiguous).
+  /// Query parameters (a name given twice sets `malformed`: ambiguous).
   std::map<std::string, std::string> params;
   std::string body;
+  /// Why the HTTP layer found the request malformed (a parameter given twice, a Content-Length
+  /// that is no number), "" when it did not: a 400 after the guard's checks.
+  std::string malformed;
 };
 
 struct ViewerResponse {

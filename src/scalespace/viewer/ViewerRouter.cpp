@@ -82,6 +82,7 @@ ViewerResponse ViewerRouter::dispatch(const ViewerRequest& request) const {
 
 ViewerResponse ViewerRouter::route(const ViewerRequest& request) const {
   if (auto refused = refusal(request, guard_)) return *refused;
+  if (!request.malformed.empty()) return errorResponse(400, "bad request: " + request.malformed);
   try {
     return dispatch(request);
   } catch (const RequestError& e) {

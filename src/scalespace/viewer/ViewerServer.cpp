@@ -34,22 +34,17 @@ void answer(const ViewerRouter& router, const httplib::Request& req, httplib::Re
   ViewerRequest request;
   request.method = req.method == "HEAD" ? "GET" : req.method;
   request.path = req.path;
-  if (req.get_header_value_count("Host") > 1) {
-    res.status = 400;
-    res.set_content("bad request: more than one Host header\n", "text/plain; charset=utf-8");
-    addSecurityHeaders(res);
-    return;
-  }
-  request.host = req.get_header_value("Host");
+  // Two Host headers: none is trusted (the guard then refuses the empty one).
+  if (req.get_header_value_count("Host") == 1) request.host = req.get_header_value("Host");
   request.tokenHeader = req.get_header_value("X-Scalespace-Token");
-  for (const auto& [name, value] : req.params) {
-    if (!request.params.emplace(name, value).second) {
-      res.status = 400;
-      res.set_content("bad request: parameter " + name + " given twice\n",
-                      "text/plain; charset=utf-8");
-      addSecurityHeaders(res);
-      return;
-    }
+  for (const auto& [name, value] : req.params)
+    if (!request.params.emplace(name, value).second)
+      request.malformed = "parameter " + name + " given twice";
+  // httplib reads a Content-Length that is not a number as 0 and goes on: refuse it instead.
+  if (req.has_header("Content-Length")) {
+    const std::string length = req.get_header_value("Content-Length");
+    if (length.empty() || length.find_first_not_of("0123456789") != std::string::npos)
+      request.malformed = "Content-Length '" + length + "' is not a number";
   }
   request.body = req.body;
   ViewerResponse response = router.route(request);
@@ -79,6 +74,13 @@ int ViewerServer::start() {
   server.Patch(".*", handler);
   server.Delete(".*", handler);
   server.Options(".*", handler);
+  // httplib's default also sets SO_REUSEPORT, with which a second server (ours or another program
+  // of the same user) binds the same port and silently takes half of the connections: only
+  // SO_REUSEADDR (a restart right after a stop still binds), so a port in use is an error.
+  server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   server.set_payload_max_length(options_.maxBodyBytes);
   server.set_read_timeout(10, 0);
   server.set_write_timeout(60, 0);
