@@ -196,7 +196,7 @@ function setSelection(ids) {
     const c = state.components[id];
     const row = body.insertRow();
     for (const v of [c.id, c.birth_level, c.death_level, c.persistence, c.area.toPrecision(4),
-      `(${c.nx.toFixed(3)}, ${c.ny.toFixed(3)}, ${c.nz.toFixed(3)}) · p = ${c.offset.toPrecision(6)}`]) {
+      `${c.nx.toFixed(3)} ${c.ny.toFixed(3)} ${c.nz.toFixed(3)} | ${c.offset.toPrecision(5)}`]) {
       row.insertCell().textContent = v;
     }
   }
@@ -295,6 +295,7 @@ async function loadPlanes() {
   }
   diagram = new PersistenceDiagram($('diagram'), state.components, p.scales, (id, add) =>
     setSelection(add ? [...state.selection, id] : [id]));
+  state.diagram = diagram;
   const pers = $('persistence'), scale = $('scale');
   pers.max = String(p.max_persistence);
   pers.value = String(Math.round(p.max_persistence / 2));
