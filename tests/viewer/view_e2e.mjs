@@ -22,7 +22,8 @@ const option = (name, fallback) => {
 };
 const pointCount = Number(option('--points', '20000'));
 const screenshots = option('--screenshots', null);
-const measureOnly = rest.includes('--measure');
+const measureOnly = rest.includes('--measure') || rest.includes('--cloud-only');
+const cloudOnly = rest.includes('--cloud-only');  // view the generated cloud itself (no planes)
 const chromiumPath = process.env.SCALESPACE_CHROMIUM || '/usr/bin/chromium';
 
 let chromium;
@@ -61,15 +62,39 @@ function sameLabels(a, b) {
   return differ === 0 ? '' : `${differ} points differ`;
 }
 
+// Resident memory (MB) of this run's Chromium processes: the renderer (the tab) and the GPU
+// process (SwiftShader's WebGL buffers live there), found under the browser process, which is the
+// one started with our --user-data-dir.
+function chromiumMemory(profile) {
+  const rows = execFileSync('ps', ['-eo', 'pid=,ppid=,rss=,args='], { encoding: 'utf8' }).trim().split('\n')
+    .map((l) => l.trim().match(/^(\d+)\s+(\d+)\s+(\d+)\s+(.*)$/)).filter(Boolean)
+    .map((m) => ({ pid: +m[1], ppid: +m[2], rss: +m[3], args: m[4] }));
+  const root = rows.find((r) => r.args.includes(`--user-data-dir=${profile}`) && !r.args.includes('--type='));
+  if (!root) return {};
+  const tree = new Set([root.pid]);
+  for (let grown = true; grown;) {
+    grown = false;
+    for (const r of rows) if (tree.has(r.ppid) && !tree.has(r.pid)) { tree.add(r.pid); grown = true; }
+  }
+  const mb = (f) => Math.round(rows.filter((r) => tree.has(r.pid) && f(r)).reduce((a, r) => a + r.rss, 0) / 1024);
+  return {
+    rendererRssMB: mb((r) => r.args.includes('--type=renderer')),
+    gpuRssMB: mb((r) => r.args.includes('--type=gpu-process')),
+    chromiumRssMB: mb(() => true),
+  };
+}
+
 fs.rmSync(work, { recursive: true, force: true });
 fs.mkdirSync(path.join(work, 'exports'), { recursive: true });
 const cloud = path.join(work, 'house.ply');
 const planes = path.join(work, 'house.planes');
 run('generate', 'house', '-n', String(pointCount), '--noise', '0.001', '--seed', '3', '-o', cloud, '-q');
-run('planes', cloud, '-o', planes, '--scales', measureOnly ? '30' : '16', '-q');
+const tPlanes = performance.now();
+if (!cloudOnly) run('planes', cloud, '-o', planes, '--scales', measureOnly ? '30' : '16', '-q');
+const planesSeconds = (performance.now() - tPlanes) / 1000;
 
 const t0 = performance.now();
-const server = spawn(cli, ['view', planes, '--no-browser', '--export-dir', path.join(work, 'exports'), '-q'],
+const server = spawn(cli, ['view', cloudOnly ? cloud : planes, '--no-browser', '--export-dir', path.join(work, 'exports'), '-q'],
   { stdio: ['ignore', 'pipe', 'inherit'] });
 process.on('exit', () => server.kill('SIGTERM'));  // whatever happens below, the server stops
 const url = await new Promise((resolve, reject) => {
@@ -95,7 +120,7 @@ const browser = await chromium.launchPersistentContext(userDataDir, {
     '--disable-background-networking', '--disable-component-update', '--disable-sync',
     '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
 });
-const results = { points: pointCount };
+const results = { points: pointCount, planesSeconds: Number(planesSeconds.toFixed(1)) };
 try {
   const page = browser.pages()[0] || await browser.newPage();
   const errors = [];
@@ -113,10 +138,25 @@ try {
   const labels = async () => Int32Array.from(await page.evaluate(() => Array.from(window.scalespace.labels)));
   const shot = async (name) => { if (screenshots) await page.screenshot({ path: path.join(screenshots, name) }); };
 
+  if (cloudOnly) {
+    // Point size and colour changes: the cloud-only measurements.
+    const t1 = await page.evaluate(async () => {
+      const s = performance.now();
+      const select = document.getElementById('colorBy');
+      select.value = '__height';
+      select.dispatchEvent(new Event('change'));
+      await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+      return performance.now() - s;
+    });
+    results.recolorMs = Math.round(t1);
+    results.displayCount = manifest.cloud.display_count;
+    results.displayStep = manifest.cloud.display_step;
+  }
   // Persistence slider: a few key presses down from its start, then the labels against segment.
-  await page.focus('#persistence');
+  if (!cloudOnly) await page.focus('#persistence');
   const before = await page.evaluate(() => window.scalespace.timings.length);
-  for (let k = 0; k < 3; ++k) { await page.keyboard.press('ArrowLeft'); await idle(); }
+  for (let k = 0; k < 3 && !cloudOnly; ++k) { await page.keyboard.press('ArrowLeft'); await idle(); }
+  if (!cloudOnly) {
   const persistence = Number(await page.inputValue('#persistence'));
   await page.waitForFunction((p) => window.scalespace.labelsQuery && window.scalespace.labelsQuery.min_persistence === String(p) && window.scalespace.busy === 0, persistence);
   if (!measureOnly) {
@@ -140,6 +180,7 @@ try {
   await shot('viewer_scale.png');
   const timings = await page.evaluate((n) => window.scalespace.timings.slice(n), before);
   results.sliderMs = timings.map((x) => Math.round(x.ms));
+  }
 
   if (!measureOnly) {
     // Diagram: click the dot of the most persistent component; it becomes the selection.
@@ -198,6 +239,7 @@ try {
       'the exported CSV is byte for byte segment --similar\'s');
   }
   results.jsHeapMB = await page.evaluate(() => (performance.memory ? Math.round(performance.memory.usedJSHeapSize / 2 ** 20) : null));
+  Object.assign(results, chromiumMemory(userDataDir));
   check(errors.length === 0, `no page error ${errors.join('; ')}`);
   check(outside.length === 0, `no request left the local server ${outside.join(' ')}`);
 } finally {
