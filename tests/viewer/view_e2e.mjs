@@ -168,7 +168,7 @@ try {
 
   // Scale slider.
   await page.focus('#scale');
-  for (let k = 0; k < 3; ++k) { await page.keyboard.press('ArrowRight'); await idle(); }
+  for (let k = 0; k < 3; ++k) { await page.keyboard.press('ArrowLeft'); await idle(); }
   const level = Number(await page.inputValue('#scale'));
   await page.waitForFunction((l) => window.scalespace.labelsQuery && window.scalespace.labelsQuery.level === String(l) && window.scalespace.busy === 0, level);
   const t = manifest.planes.scales[level];
@@ -237,6 +237,14 @@ try {
     check(path.dirname(exported) === path.join(work, 'exports'), `export written to the export folder: ${exported}`);
     check(fs.readFileSync(exported).equals(fs.readFileSync(path.join(work, 'similar.csv'))),
       'the exported CSV is byte for byte segment --similar\'s');
+  }
+  if (!measureOnly) {
+    // Colour by an attribute: the colour bar names it with its range.
+    await page.selectOption('#colorBy', 'gt_face');
+    await page.waitForFunction(() => document.getElementById('barName').textContent.startsWith('gt_face'));
+    check(true, 'colour by the attribute gt_face, with its colour bar');
+    await page.selectOption('#upAxis', 'z');
+    await shot('viewer_attribute.png');
   }
   results.jsHeapMB = await page.evaluate(() => (performance.memory ? Math.round(performance.memory.usedJSHeapSize / 2 ** 20) : null));
   Object.assign(results, chromiumMemory(userDataDir));

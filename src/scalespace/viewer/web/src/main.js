@@ -195,8 +195,8 @@ function setSelection(ids) {
   for (const id of state.selection.slice(0, 200)) {
     const c = state.components[id];
     const row = body.insertRow();
-    for (const v of [c.id, c.birth_level, c.death_level, c.persistence, c.area.toPrecision(4),
-      `${c.nx.toFixed(3)} ${c.ny.toFixed(3)} ${c.nz.toFixed(3)} | ${c.offset.toPrecision(5)}`]) {
+    for (const v of [c.id, c.birth_level, c.death_level, c.persistence, c.area.toPrecision(3),
+      `${c.nx.toFixed(2)} ${c.ny.toFixed(2)} ${c.nz.toFixed(2)} | ${c.offset.toPrecision(4)}`]) {
       row.insertCell().textContent = v;
     }
   }
