@@ -10,7 +10,6 @@
 
 #include <chrono>
 #include <cstring>
-#include <regex>
 #include <thread>
 
 #include "cli/CliTestSupport.hpp"
@@ -42,11 +41,15 @@ class ViewProcess {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (std::chrono::steady_clock::now() < deadline && ::read(stdout_, &c, 1) == 1 && c != '\n')
       line += c;
-    std::smatch m;
-    if (std::regex_search(line, m,
-                          std::regex("http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]{32})"))) {
-      port = std::stoi(m[1]);
-      token = m[2];
+    // "scalespace view: http://127.0.0.1:PORT/?token=TOKEN" (no std::regex: GCC 12 warns on it
+    // under the sanitizers, and warnings are errors).
+    const std::string prefix = "http://127.0.0.1:", key = "/?token=";
+    const std::size_t at = line.find(prefix), mark = line.find(key);
+    if (at != std::string::npos && mark != std::string::npos && mark > at + prefix.size()) {
+      port = std::atoi(line.c_str() + at + prefix.size());
+      token = line.substr(mark + key.size());
+      if (token.size() != 32 || token.find_first_not_of("0123456789abcdef") != std::string::npos)
+        port = 0;
     }
   }
   ~ViewProcess() { stop(); }

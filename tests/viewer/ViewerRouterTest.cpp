@@ -205,6 +205,20 @@ TEST(ViewerLayers, LabelsAreTheLibrarysQueries) {
             std::vector<int>(8, -1));
 }
 
+TEST(ViewerLayers, ALongSelectionTravelsInTheBody) {
+  const auto router = smallRouter();
+  ViewerRequest r = request("/api/planes/labels", {{"components", "body"}}, "POST");
+  r.body = indexBody({2, 1});
+  EXPECT_EQ(decode<int>(router->route(r).body), labelsOfComponents(smallPlaneModel(), {2, 1}));
+  r.body = indexBody({3});  // no component 3
+  EXPECT_EQ(router->route(r).status, 400);
+  r.body = "abc";
+  EXPECT_EQ(router->route(r).status, 400);
+  EXPECT_EQ(router->route(request("/api/planes/labels", {{"components", "body"}})).status, 405);
+  EXPECT_EQ(router->route(request("/api/planes/labels", {{"components", "1"}}, "POST")).status,
+            405);
+}
+
 TEST(ViewerLayers, BrushAndSimilarAreTheLibrarysQueries) {
   const auto router = smallRouter();
   const PlaneModel model = smallPlaneModel();

@@ -65,8 +65,13 @@ std::vector<int> PlanesLayer::labels(const ViewerRequest& request, std::string* 
   const int components = int(model_.components.size());
   const auto persistence = intParam(request, "min_persistence", 0, 1 << 30);
   const auto level = intParam(request, "level", 0, std::max(0, model_.scaleCount() - 1));
-  const auto ids =
-      intListParam(request, "components", 0, std::max(0, components - 1), kMaxListedComponents);
+  // components=body: the ids are the body (uint32), for a selection too long for a URL.
+  const auto listed = request.params.find("components");
+  const auto ids = listed != request.params.end() && listed->second == "body"
+                       ? std::optional<std::vector<int>>(
+                             componentIdsFromBody(request.body, model_.components.size()))
+                       : intListParam(request, "components", 0, std::max(0, components - 1),
+                                      kMaxListedComponents);
   if (int(bool(persistence)) + int(bool(level)) + int(bool(ids)) != 1)
     throw RequestError(400, "give one of the parameters min_persistence, level, components");
   if (persistence) {
@@ -176,7 +181,10 @@ ViewerResponse PlanesLayer::handle(const std::string& endpoint,
     return binaryResponse(std::move(out));
   }
   if (endpoint == "labels") {
-    requireMethod(request, "GET");
+    // POST only for components=body; GET answers stay cacheable-looking plain queries.
+    const auto listed = request.params.find("components");
+    requireMethod(request,
+                  listed != request.params.end() && listed->second == "body" ? "POST" : "GET");
     return binaryResponse(sampledArray(sample_, labels(request, nullptr),
                                        [](std::string& out, int v) { appendInt32(out, v); }));
   }

@@ -72,22 +72,35 @@ std::optional<std::vector<int>> intListParam(const ViewerRequest& request, const
   return out;
 }
 
-std::vector<Index> indicesFromBody(const std::string& body, std::size_t pointCount) {
+namespace {
+std::vector<Index> uint32sFromBody(const std::string& body, std::size_t bound, const char* what,
+                                   const char* ofWhat) {
   if (body.size() % 4 != 0)
     throw RequestError(400, "body: " + std::to_string(body.size()) +
-                                " bytes is not a whole number of uint32 point indices");
+                                " bytes is not a whole number of uint32 " + what + "s");
   std::vector<Index> out(body.size() / 4);
   for (std::size_t k = 0; k < out.size(); ++k) {
     const auto* b = reinterpret_cast<const unsigned char*>(body.data() + 4 * k);
     const std::uint32_t v = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
                             std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
-    if (v >= pointCount)
-      throw RequestError(400, "body: point index " + std::to_string(v) +
-                                  " is out of range (the cloud has " + std::to_string(pointCount) +
-                                  " points)");
+    if (v >= bound)
+      throw RequestError(400, "body: " + std::string(what) + " " + std::to_string(v) +
+                                  " is out of range (" + std::to_string(bound) + " " + ofWhat +
+                                  ")");
     out[k] = Index(v);
   }
   return out;
+}
+}  // namespace
+
+std::vector<Index> indicesFromBody(const std::string& body, std::size_t pointCount) {
+  return uint32sFromBody(body, pointCount, "point index", "points");
+}
+
+std::vector<int> componentIdsFromBody(const std::string& body, std::size_t componentCount) {
+  const std::vector<Index> ids =
+      uint32sFromBody(body, componentCount, "component id", "components");
+  return std::vector<int>(ids.begin(), ids.end());
 }
 
 }  // namespace scalespace::viewer

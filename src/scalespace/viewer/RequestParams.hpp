@@ -20,5 +20,8 @@ std::optional<std::vector<int>> intListParam(const ViewerRequest& request, const
                                              int lo, int hi, std::size_t maxCount);
 /// The body as little-endian uint32 point indices, each < pointCount.
 std::vector<Index> indicesFromBody(const std::string& body, std::size_t pointCount);
+/// The body as little-endian uint32 component ids, each < componentCount (a selection too long
+/// for a URL).
+std::vector<int> componentIdsFromBody(const std::string& body, std::size_t componentCount);
 
 }  // namespace scalespace::viewer

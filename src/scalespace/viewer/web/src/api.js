@@ -47,3 +47,11 @@ export async function post(path, params, body) {
   }));
   return response.json();
 }
+
+// POST with a binary body, binary answer (labels of a selection too long for a URL).
+export async function postBytes(path, params, body) {
+  const response = await check(await fetch(url(path, params), {
+    method: 'POST', body, headers: { 'Content-Type': 'application/octet-stream' },
+  }));
+  return response.arrayBuffer();
+}

@@ -9,7 +9,7 @@ export class PersistenceDiagram {
     this.lo = Math.log(scales[0]);
     this.hi = Math.log(scales[scales.length - 1]);
     if (!(this.hi > this.lo)) this.hi = this.lo + 1;
-    this.maxPersistence = Math.max(1, ...components.map((c) => c.persistence));
+    this.maxPersistence = components.reduce((m, c) => Math.max(m, c.persistence), 1);
     this.minPersistence = 0;
     this.selected = new Set();
     canvas.addEventListener('click', (e) => {

@@ -3,7 +3,7 @@
 // only turns the answers (per-point labels, rankings) into colours, the diagram and the table.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { getBytes, getJson, post } from './api.js';
+import { getBytes, getJson, post, postBytes } from './api.js';
 import { drawColorBar, labelColors, scalarColors } from './colors.js';
 import { PersistenceDiagram } from './diagram.js';
 import { BrushStroke } from './brush.js';
@@ -149,12 +149,14 @@ function describe(query) {
     const t = state.manifest.planes.scales[query.level];
     return `segmentation at scale t = ${t.toPrecision(4)} (level ${query.level})`;
   }
+  if (query.components === 'body') return `${state.selection.length} selected components`;
   return `selected components: ${query.components || 'none'}`;
 }
 
-// Asks the server for the labels of `query` and shows them; `what` names the timing entry.
-function showLabels(query, what) {
-  pendingQuery = { query, what, start: performance.now() };
+// Asks the server for the labels of `query` and shows them; `what` names the timing entry;
+// `body` (uint32 component ids) goes with components=body.
+function showLabels(query, what, body = null) {
+  pendingQuery = { query, what, body, start: performance.now() };
   if (!running) drainQueries();
 }
 
@@ -163,11 +165,14 @@ async function drainQueries() {
   state.busy++;
   try {
     while (pendingQuery) {
-      const { query, what, start } = pendingQuery;
+      const { query, what, body, start } = pendingQuery;
       pendingQuery = null;
-      const labels = new Int32Array(await getBytes('/api/planes/labels', query));
+      const labels = new Int32Array(body
+        ? await postBytes('/api/planes/labels', query, body)
+        : await getBytes('/api/planes/labels', query));
       state.labels = labels;
       state.labelsQuery = query;
+      state.labelsBody = body;
       $('colorBy').value = '__labels';
       colorByLabels();
       colorAttribute().needsUpdate = true;
@@ -200,7 +205,9 @@ function setSelection(ids) {
       row.insertCell().textContent = v;
     }
   }
-  showLabels({ components: state.selection.join(',') }, 'selection');
+  // A long selection goes in the body: a URL holds a few thousand characters at most.
+  if (state.selection.length > 400) showLabels({ components: 'body' }, 'selection', Uint32Array.from(state.selection));
+  else showLabels({ components: state.selection.join(',') }, 'selection');
 }
 
 // --- brush: screen-space stroke -> the cloud's point indices -> rankByBrush on the server ------
@@ -270,7 +277,7 @@ async function onExport(format) {
   if (!state.labelsQuery) { status('export: nothing shown yet'); return; }
   state.busy++;
   try {
-    const result = await post('/api/planes/export', { ...state.labelsQuery, format }, new Uint8Array(0));
+    const result = await post('/api/planes/export', { ...state.labelsQuery, format }, state.labelsBody || new Uint8Array(0));
     state.lastExport = { ...result, query: state.labelsQuery, format };
     $('exported').textContent = `written: ${result.path} (${result.labelled} of ${result.point_count} points labelled)`;
   } catch (e) {
