@@ -247,6 +247,21 @@ try {
     await page.selectOption('#upAxis', 'z');
     await shot('viewer_attribute.png');
   }
+  if (measureOnly) {
+    // Orbiting: 20 mouse moves with the left button, each waited until two frames are drawn; the
+    // mean time per frame (headless Chromium's frames come at most every 16.7 ms).
+    const view = await page.locator('#view').boundingBox();
+    const x0 = view.x + view.width / 2, y0 = view.y + view.height / 2;
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    const start = performance.now();
+    for (let k = 1; k <= 20; ++k) {
+      await page.mouse.move(x0 + 8 * k, y0 + 2 * k);
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    }
+    await page.mouse.up();
+    results.orbitFrameMs = Math.round((performance.now() - start) / 40);
+  }
   results.jsHeapMB = await page.evaluate(() => (performance.memory ? Math.round(performance.memory.usedJSHeapSize / 2 ** 20) : null));
   Object.assign(results, chromiumMemory(userDataDir));
   check(errors.length === 0, `no page error ${errors.join('; ')}`);
