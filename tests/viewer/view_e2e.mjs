@@ -4,7 +4,8 @@
 // similarity search is run and the result exported; every point set the page shows is compared
 // with `scalespace segment` on the same input (same plane_id per point), the export with
 // segment's file byte for byte.
-//   node view_e2e.mjs CLI WORKDIR [--points N] [--screenshots DIR] [--measure]
+//   node view_e2e.mjs CLI WORKDIR [--points N] [--screenshots DIR] [--measure | --cloud-only]
+//                     [--point-budget N]
 // Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
 import { spawn, execFileSync } from 'node:child_process';
 import { createRequire } from 'node:module';
@@ -94,7 +95,9 @@ if (!cloudOnly) run('planes', cloud, '-o', planes, '--scales', measureOnly ? '30
 const planesSeconds = (performance.now() - tPlanes) / 1000;
 
 const t0 = performance.now();
-const server = spawn(cli, ['view', cloudOnly ? cloud : planes, '--no-browser', '--export-dir', path.join(work, 'exports'), '-q'],
+const budget = option('--point-budget', null);  // passed on to `view`
+const server = spawn(cli, ['view', cloudOnly ? cloud : planes, '--no-browser', '--export-dir', path.join(work, 'exports'), '-q',
+  ...(budget ? ['--point-budget', budget] : [])],
   { stdio: ['ignore', 'pipe', 'inherit'] });
 process.on('exit', () => server.kill('SIGTERM'));  // whatever happens below, the server stops
 const url = await new Promise((resolve, reject) => {
