@@ -14,7 +14,15 @@ packages=(
   clang-format
   python3 python3-numpy
   pybind11-dev python3-pybind11 python3-pytest
+  libcpp-httplib-dev  # `scalespace view`: the local HTTP server
 )
+# Optional: without them the project still builds and tests (the viewer page is not bundled, its
+# end-to-end test skips), so a failure to install them is a warning. Chromium: the viewer's
+# end-to-end test drives it headless (never a downloaded browser). Node.js and npm bundle the page
+# (scripts/setup_web.sh): Debian's, unless a Node.js with npm is installed already (NodeSource's
+# nodejs package brings its own npm).
+optional=(chromium)
+command -v npm >/dev/null || optional+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -22,8 +30,17 @@ for p in "${packages[@]}"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
-if ((${#missing[@]} == 0)); then
+missing_optional=()
+for p in "${optional[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing_optional+=("$p")
+done
+
+web() { "$(dirname "$0")/setup_web.sh"; }
+
+if ((${#missing[@]} == 0 && ${#missing_optional[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  web
   exit 0
 fi
 
@@ -35,7 +52,16 @@ if [[ $(id -u) -ne 0 ]]; then
 fi
 export DEBIAN_FRONTEND=noninteractive
 # Refresh the package lists only when a package cannot be found in them.
-if ! "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"; then
+if ((${#missing[@]} > 0)) &&
+  ! "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"; then
   "${sudo[@]}" apt-get update
   "${sudo[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
 fi
+if ((${#missing_optional[@]} > 0)) &&
+  ! "${sudo[@]}" apt-get install -y --no-install-recommends "${missing_optional[@]}" &&
+  ! { "${sudo[@]}" apt-get update &&
+    "${sudo[@]}" apt-get install -y --no-install-recommends "${missing_optional[@]}"; }; then
+  echo "setup: warning: could not install ${missing_optional[*]}: the viewer page or its" \
+    "end-to-end test will be skipped" >&2
+fi
+web

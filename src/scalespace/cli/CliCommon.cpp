@@ -170,7 +170,7 @@ PointCloud loadResultInput(const std::string& recorded, const std::string& overr
     throw FileError(recorded, "",
                     "the cloud the " + what + " in " + directory + " were computed on is not there",
                     "pass it with --input IN");
-  checkOutput(output, OutputKind::Cloud, {input.path, directory});
+  if (!output.empty()) checkOutput(output, OutputKind::Cloud, {input.path, directory});
   PointCloud cloud = loadCloud(input, quiet);
   if (cloud.size() != pointCount)
     throw FileError(input.path, "",

@@ -25,8 +25,9 @@ PointCloud loadCloud(const InputOptions& input, bool quiet);
 
 /// The cloud a saved result (`planes`, `cylinders`) was computed on: `override` when given, else
 /// `recorded` (the path the result names), checked to exist and to hold `pointCount` points, after
-/// checkOutput(output) (the output is neither of them). `what` names the result in messages
-/// ("planes", "cylinders"). Throws FileError naming the file and what to pass.
+/// checkOutput(output) (the output is neither of them; "" for a command without an output, such
+/// as `view`). `what` names the result in messages ("planes", "cylinders"). Throws FileError
+/// naming the file and what to pass.
 PointCloud loadResultInput(const std::string& recorded, const std::string& override,
                            const std::string& directory, const std::string& what,
                            std::size_t pointCount, const std::string& output, bool quiet);

@@ -13,6 +13,7 @@
 #include "scalespace/cli/PlanesCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/cli/ScalesCommands.hpp"
+#include "scalespace/cli/ViewCommands.hpp"
 #include "scalespace/core/AnalyticSurface.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
@@ -359,6 +360,7 @@ void addCloudCommands(CLI::App& app) {
   addFeatureCommands(app);
   addCylinderCommands(app);
   addParamCommands(app);
+  addViewCommand(app);
 }
 
 }  // namespace scalespace::cli

@@ -1,5 +1,6 @@
 #include "scalespace/cli/PlanesCommands.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -161,13 +162,6 @@ std::vector<Index> readIndexFile(const std::string& path) {
   return out;
 }
 
-// Points of component c at its representative level (where its plane and outline were computed).
-void labelComponent(const PlaneModel& model, int c, std::vector<int>& labels) {
-  const int level = model.components[std::size_t(c)].representativeLevel;
-  for (std::size_t i = 0; i < labels.size(); ++i)
-    if (labels[i] < 0 && model.membership.at(level, i) == c) labels[i] = c;
-}
-
 void addSegmentCommand(CLI::App& app) {
   struct Args {
     std::string directory, output, input, brush, within;
@@ -264,12 +258,11 @@ void addSegmentCommand(CLI::App& app) {
         if (!args->quiet)
           std::printf("%d,%.6g,%.6g,%d\n", m.component, m.score, m.overlap,
                       model.components[std::size_t(m.component)].persistence);
-      if (!matches.empty()) labelComponent(model, matches.front().component, labels);
+      if (!matches.empty()) labels = labelsOfComponents(model, {matches.front().component});
     } else {
       const auto found =
           findSimilar(model, args->similar, readIndexFile(args->within), args->similarity);
-      labels.assign(cloud.size(), -1);
-      for (int c : found) labelComponent(model, c, labels);
+      labels = labelsOfComponents(model, found);
       if (!args->quiet) std::fprintf(stderr, "%zu similar components\n", found.size());
     }
     if (args->coverage) {
@@ -277,21 +270,9 @@ void addSegmentCommand(CLI::App& app) {
       labels = extendCoverage(model, labels, cloud.positions(), cloud.normals(),
                               buildKnnGraph(cloud.positions()), args->coverageOptions);
     }
-    auto& id = cloud.addAttribute("plane_id", ScalarType::Int32);
-    auto& red = cloud.addAttribute("red", ScalarType::UInt8);
-    auto& green = cloud.addAttribute("green", ScalarType::UInt8);
-    auto& blue = cloud.addAttribute("blue", ScalarType::UInt8);
-    std::size_t labelled = 0;
-    const std::vector<Rgb> colors =
-        colorizeLabels(std::vector<double>(labels.begin(), labels.end()));
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-      const Rgb& c = colors[i];
-      id.values[i] = labels[i];
-      red.values[i] = c.r;
-      green.values[i] = c.g;
-      blue.values[i] = c.b;
-      labelled += labels[i] >= 0;
-    }
+    addPlaneLabelColumns(cloud, labels);
+    const std::size_t labelled =
+        std::size_t(std::count_if(labels.begin(), labels.end(), [](int l) { return l >= 0; }));
     writeCloud(cloud, args->output);
     if (!args->quiet) std::fprintf(stderr, "%zu of %zu points labelled\n", labelled, labels.size());
     reportDone("segment", start, args->quiet);

@@ -68,6 +68,23 @@ void writeComponentsCsv(const PlaneModel& model, const Vec3& origin, const std::
   });
 }
 
+void addPlaneLabelColumns(PointCloud& cloud, const std::vector<int>& labels) {
+  if (labels.size() != cloud.size())
+    throw Error("addPlaneLabelColumns: " + std::to_string(labels.size()) + " labels for " +
+                std::to_string(cloud.size()) + " points");
+  auto& id = cloud.addAttribute("plane_id", ScalarType::Int32);
+  auto& red = cloud.addAttribute("red", ScalarType::UInt8);
+  auto& green = cloud.addAttribute("green", ScalarType::UInt8);
+  auto& blue = cloud.addAttribute("blue", ScalarType::UInt8);
+  const std::vector<Rgb> colors = colorizeLabels(std::vector<double>(labels.begin(), labels.end()));
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    id.values[i] = labels[i];
+    red.values[i] = colors[i].r;
+    green.values[i] = colors[i].g;
+    blue.values[i] = colors[i].b;
+  }
+}
+
 void writeOutlinesObj(const std::vector<PlaneComponent>& components, const Vec3& origin,
                       const std::string& path) {
   writeFileAtomically(path, [&](std::ostream& out) {

@@ -4,7 +4,9 @@
 // membership.bin) that `scalespace segment` reloads. Every file is written atomically.
 // Plane offsets and outlines are written in absolute coordinates (positions + origin).
 #include <string>
+#include <vector>
 
+#include "scalespace/core/PointCloud.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
 
 namespace scalespace {
@@ -17,6 +19,11 @@ void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std:
 /// Header: id,birth_level,birth_scale,death_level,death_scale,persistence,nx,ny,nz,offset,rms,
 /// area,point_count.
 void writeComponentsCsv(const PlaneModel& model, const Vec3& origin, const std::string& path);
+
+/// Adds the columns `segment` writes for per-point component labels (-1 none): plane_id (int32)
+/// and red, green, blue (uint8, colorizeLabels: one colour per id, grey for -1). Replaces columns
+/// of those names.
+void addPlaneLabelColumns(PointCloud& cloud, const std::vector<int>& labels);
 
 /// Outline loops as OBJ polylines ("l" elements, closed), one group "g component_<id>" each.
 void writeOutlinesObj(const std::vector<PlaneComponent>& components, const Vec3& origin,

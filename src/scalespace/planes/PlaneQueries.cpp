@@ -61,6 +61,20 @@ std::vector<int> labelsAtScale(const PlaneModel& model, double t, int minPersist
                        minPersistence);
 }
 
+std::vector<int> labelsOfComponents(const PlaneModel& model, const std::vector<int>& ids) {
+  for (int c : ids)
+    if (c < 0 || std::size_t(c) >= model.components.size())
+      throw OptionError("labelsOfComponents: no component " + std::to_string(c) +
+                        " (the model has " + std::to_string(model.components.size()) + ")");
+  std::vector<int> labels(model.membership.pointCount, -1);
+  for (int c : ids) {
+    const int level = model.components[std::size_t(c)].representativeLevel;
+    for (std::size_t i = 0; i < labels.size(); ++i)
+      if (labels[i] < 0 && model.membership.at(level, i) == c) labels[i] = c;
+  }
+  return labels;
+}
+
 std::vector<BrushMatch> rankByBrush(const PlaneModel& model, const std::vector<Index>& query) {
   checkIndices(model, query, "brush");
   const std::vector<Index> unique = [&] {

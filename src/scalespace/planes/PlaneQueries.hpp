@@ -40,6 +40,12 @@ struct BrushMatch {
 /// ranked by decreasing score, then increasing id. Throws OptionError on an index out of range.
 std::vector<BrushMatch> rankByBrush(const PlaneModel& model, const std::vector<Index>& query);
 
+/// Per point, the first of `ids` (in the order given) whose points at its representative level
+/// (where its plane and outline were computed) hold the point, or -1: what `segment --brush` and
+/// `--similar` label, and what the viewer shows for a selection. Throws OptionError naming the id
+/// when one is not a component.
+std::vector<int> labelsOfComponents(const PlaneModel& model, const std::vector<int>& ids);
+
 /// Sec. 2.4.4 criteria. Defaults are the parameters of Fig. B.15 (5, 5, 100 %, 90 degrees).
 struct SimilarityOptions {
   int birthTolerance = 5;        // |l_b(C) - l_b(Q)| <= this (levels)

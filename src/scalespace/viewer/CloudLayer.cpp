@@ -1,0 +1,87 @@
+#include "scalespace/viewer/CloudLayer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "scalespace/viewer/BinaryArrays.hpp"
+#include "scalespace/viewer/RequestError.hpp"
+
+namespace scalespace::viewer {
+
+namespace {
+
+// min, max, 2nd and 98th percentiles of the finite values (all 0 when there are none).
+nlohmann::json columnRange(const AttributeColumn& column) {
+  std::vector<double> v;
+  v.reserve(column.values.size());
+  for (double x : column.values)
+    if (std::isfinite(x)) v.push_back(x);
+  if (v.empty()) return {{"min", 0}, {"max", 0}, {"p02", 0}, {"p98", 0}};
+  auto at = [&](double q) {
+    const auto k = std::size_t(q * double(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+    return v[k];
+  };
+  const double p02 = at(0.02), p98 = at(0.98);
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return {{"min", *lo}, {"max", *hi}, {"p02", p02}, {"p98", p98}};
+}
+
+}  // namespace
+
+CloudLayer::CloudLayer(std::shared_ptr<const PointCloud> cloud, DisplaySample sample)
+    : cloud_(std::move(cloud)), sample_(sample), attributes_(nlohmann::json::array()) {
+  for (const AttributeColumn& column : cloud_->attributes()) {
+    nlohmann::json a = columnRange(column);
+    a["name"] = column.name;
+    a["type"] = scalarTypeName(column.type);
+    attributes_.push_back(std::move(a));
+  }
+}
+
+nlohmann::json CloudLayer::manifest() const {
+  Vec3 lo, hi;
+  cloud_->bounds(lo, hi);
+  const Vec3& o = cloud_->origin();
+  return {{"point_count", sample_.pointCount},
+          {"display_count", sample_.count()},
+          {"display_step", sample_.step},
+          {"origin", {o.x(), o.y(), o.z()}},
+          {"bounds", {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}}},
+          {"has_normals", cloud_->hasNormals()},
+          {"attributes", attributes_}};
+}
+
+ViewerResponse CloudLayer::handle(const std::string& endpoint, const ViewerRequest& request) const {
+  auto vectors = [&](const std::vector<Vec3>& values) {
+    std::string out;
+    out.reserve(sample_.count() * 12);
+    for (std::size_t i = 0; i < sample_.pointCount; i += sample_.step)
+      for (int d = 0; d < 3; ++d) appendFloat32(out, float(values[i][d]));
+    return binaryResponse(std::move(out));
+  };
+  if (endpoint == "positions") {
+    requireMethod(request, "GET");
+    return vectors(cloud_->positions());
+  }
+  if (endpoint == "normals") {
+    requireMethod(request, "GET");
+    if (!cloud_->hasNormals()) throw RequestError(404, "the cloud has no normals");
+    return vectors(cloud_->normals());
+  }
+  if (endpoint == "attribute") {
+    requireMethod(request, "GET");
+    const auto it = request.params.find("name");
+    if (it == request.params.end()) throw RequestError(400, "parameter name: missing");
+    const AttributeColumn* column = cloud_->findAttribute(it->second);
+    if (!column)
+      throw RequestError(404, "parameter name: the cloud has no attribute '" + it->second + "'");
+    return binaryResponse(sampledArray(
+        sample_, column->values, [](std::string& out, double v) { appendFloat32(out, float(v)); }));
+  }
+  throw RequestError(404, "no endpoint " + request.path);
+}
+
+}  // namespace scalespace::viewer

@@ -1,0 +1,283 @@
+// End-to-end test of `scalespace view` in Debian's Chromium (headless, driven by playwright-core):
+// a generated `planes` result is opened, the persistence and scale sliders are moved with the
+// keyboard, a region is brushed with the mouse, a dot of the persistence diagram is clicked, a
+// similarity search is run and the result exported; every point set the page shows is compared
+// with `scalespace segment` on the same input (same plane_id per point), the export with
+// segment's file byte for byte.
+//   node view_e2e.mjs CLI WORKDIR [--points N] [--screenshots DIR] [--measure | --cloud-only]
+//                     [--point-budget N]
+// Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
+import { spawn, execFileSync } from 'node:child_process';
+import { createRequire } from 'node:module';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const webDir = path.join(here, '..', '..', 'src', 'scalespace', 'viewer', 'web');
+const SKIP = 77;
+const [cli, work, ...rest] = process.argv.slice(2);
+const option = (name, fallback) => {
+  const k = rest.indexOf(name);
+  return k >= 0 ? rest[k + 1] : fallback;
+};
+const pointCount = Number(option('--points', '20000'));
+const screenshots = option('--screenshots', null);
+const measureOnly = rest.includes('--measure') || rest.includes('--cloud-only');
+const cloudOnly = rest.includes('--cloud-only');  // view the generated cloud itself (no planes)
+const chromiumPath = process.env.SCALESPACE_CHROMIUM || '/usr/bin/chromium';
+
+let chromium;
+try {
+  ({ chromium } = createRequire(path.join(webDir, 'package.json'))('playwright-core'));
+} catch {
+  console.log(`SKIP: playwright-core is not installed in ${webDir}/node_modules (run scripts/setup_web.sh)`);
+  process.exit(SKIP);
+}
+if (!fs.existsSync(chromiumPath)) {
+  console.log(`SKIP: no Chromium at ${chromiumPath} (Debian package chromium; scripts/setup.sh installs it)`);
+  process.exit(SKIP);
+}
+if (!fs.existsSync(path.join(path.dirname(cli), 'viewer-page', 'app.js'))) {
+  console.log('SKIP: the viewer page was not bundled (no node_modules at build time: run scripts/setup_web.sh, then rebuild)');
+  process.exit(SKIP);
+}
+
+let failures = 0;
+function check(ok, what) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures++;
+}
+const run = (...args) => execFileSync(cli, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+
+// plane_id column of a CSV written by `segment -o X.csv` (header names the columns).
+function planeIds(file) {
+  const lines = fs.readFileSync(file, 'utf8').trim().split('\n');
+  const column = lines[0].split(',').indexOf('plane_id');
+  return Int32Array.from(lines.slice(1), (l) => Number(l.split(',')[column]));
+}
+function sameLabels(a, b) {
+  if (a.length !== b.length) return `lengths ${a.length} and ${b.length}`;
+  let differ = 0;
+  for (let i = 0; i < a.length; ++i) differ += a[i] !== b[i];
+  return differ === 0 ? '' : `${differ} points differ`;
+}
+
+// Resident memory (MB) of this run's Chromium processes: the renderer (the tab) and the GPU
+// process (SwiftShader's WebGL buffers live there), found under the browser process, which is the
+// one started with our --user-data-dir.
+function chromiumMemory(profile) {
+  const rows = execFileSync('ps', ['-eo', 'pid=,ppid=,rss=,args='], { encoding: 'utf8' }).trim().split('\n')
+    .map((l) => l.trim().match(/^(\d+)\s+(\d+)\s+(\d+)\s+(.*)$/)).filter(Boolean)
+    .map((m) => ({ pid: +m[1], ppid: +m[2], rss: +m[3], args: m[4] }));
+  const root = rows.find((r) => r.args.includes(`--user-data-dir=${profile}`) && !r.args.includes('--type='));
+  if (!root) return {};
+  const tree = new Set([root.pid]);
+  for (let grown = true; grown;) {
+    grown = false;
+    for (const r of rows) if (tree.has(r.ppid) && !tree.has(r.pid)) { tree.add(r.pid); grown = true; }
+  }
+  const mb = (f) => Math.round(rows.filter((r) => tree.has(r.pid) && f(r)).reduce((a, r) => a + r.rss, 0) / 1024);
+  return {
+    rendererRssMB: mb((r) => r.args.includes('--type=renderer')),
+    gpuRssMB: mb((r) => r.args.includes('--type=gpu-process')),
+    chromiumRssMB: mb(() => true),
+  };
+}
+
+fs.rmSync(work, { recursive: true, force: true });
+fs.mkdirSync(path.join(work, 'exports'), { recursive: true });
+const cloud = path.join(work, 'house.ply');
+const planes = path.join(work, 'house.planes');
+run('generate', 'house', '-n', String(pointCount), '--noise', '0.001', '--seed', '3', '-o', cloud, '-q');
+const tPlanes = performance.now();
+if (!cloudOnly) run('planes', cloud, '-o', planes, '--scales', measureOnly ? '30' : '16', '-q');
+const planesSeconds = (performance.now() - tPlanes) / 1000;
+
+const t0 = performance.now();
+const budget = option('--point-budget', null);  // passed on to `view`
+const server = spawn(cli, ['view', cloudOnly ? cloud : planes, '--no-browser', '--export-dir', path.join(work, 'exports'), '-q',
+  ...(budget ? ['--point-budget', budget] : [])],
+  { stdio: ['ignore', 'pipe', 'inherit'] });
+process.on('exit', () => server.kill('SIGTERM'));  // whatever happens below, the server stops
+const url = await new Promise((resolve, reject) => {
+  let out = '';
+  server.stdout.on('data', (d) => {
+    out += d;
+    const m = out.match(/scalespace view: (http:\/\/127\.0\.0\.1:\d+\/\?token=[0-9a-f]{32})/);
+    if (m) resolve(m[1]);
+  });
+  server.on('exit', (code) => reject(new Error(`scalespace view exited (${code}) before printing its URL`)));
+  const timer = setTimeout(() => reject(new Error('no URL from scalespace view within 60 s')), 60000);
+  server.stdout.on('data', () => { if (/token=[0-9a-f]{32}/.test(out)) clearTimeout(timer); });
+});
+const tUrl = performance.now() - t0;
+
+const userDataDir = fs.mkdtempSync(path.join(work, 'chromium-'));
+// A fresh profile each run (launchPersistentContext's folder is Chromium's --user-data-dir).
+const browser = await chromium.launchPersistentContext(userDataDir, {
+  executablePath: chromiumPath,
+  headless: true,
+  viewport: { width: 1400, height: 860 },
+  // A closed network: nothing that would try to reach the outside; software WebGL (no GPU here).
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync',
+    '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+});
+const results = { points: pointCount, planesSeconds: Number(planesSeconds.toFixed(1)) };
+try {
+  const page = browser.pages()[0] || await browser.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  const outside = [];
+  page.on('request', (r) => { if (!r.url().startsWith(url.slice(0, url.indexOf('/?')))) outside.push(r.url()); });
+  await page.goto(url);
+  await page.waitForFunction(() => window.scalespace && (window.scalespace.ready || window.scalespace.error), null, { timeout: 120000 });
+  results.urlMs = Math.round(tUrl);
+  results.firstFrameMs = Math.round(await page.evaluate(() => window.scalespace.firstFrameMs));
+  results.commandToFirstFrameMs = Math.round(performance.now() - t0 - (await page.evaluate(() => performance.now() - window.scalespace.firstFrameMs)));
+  check(!(await page.evaluate(() => window.scalespace.error)), 'the page loaded without an error');
+  const manifest = await page.evaluate(() => window.scalespace.manifest);
+  const idle = () => page.waitForFunction(() => window.scalespace.busy === 0, null, { timeout: 60000 });
+  const labels = async () => Int32Array.from(await page.evaluate(() => Array.from(window.scalespace.labels)));
+  const shot = async (name) => { if (screenshots) await page.screenshot({ path: path.join(screenshots, name) }); };
+
+  if (cloudOnly) {
+    // Point size and colour changes: the cloud-only measurements.
+    const t1 = await page.evaluate(async () => {
+      const s = performance.now();
+      const select = document.getElementById('colorBy');
+      select.value = '__height';
+      select.dispatchEvent(new Event('change'));
+      await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+      return performance.now() - s;
+    });
+    results.recolorMs = Math.round(t1);
+    results.displayCount = manifest.cloud.display_count;
+    results.displayStep = manifest.cloud.display_step;
+  }
+  // Persistence slider: a few key presses down from its start, then the labels against segment.
+  if (!cloudOnly) await page.focus('#persistence');
+  const before = await page.evaluate(() => window.scalespace.timings.length);
+  for (let k = 0; k < 3 && !cloudOnly; ++k) { await page.keyboard.press('ArrowLeft'); await idle(); }
+  if (!cloudOnly) {
+  const persistence = Number(await page.inputValue('#persistence'));
+  await page.waitForFunction((p) => window.scalespace.labelsQuery && window.scalespace.labelsQuery.min_persistence === String(p) && window.scalespace.busy === 0, persistence);
+  if (!measureOnly) {
+    run('segment', planes, '--min-persistence', String(persistence), '-o', path.join(work, 'pers.csv'), '-q');
+    const d = sameLabels(await labels(), planeIds(path.join(work, 'pers.csv')));
+    check(!d, `persistence slider at ${persistence}: same labels as segment --min-persistence ${persistence} ${d}`);
+  }
+  await shot('viewer_persistence.png');
+
+  // Scale slider.
+  await page.focus('#scale');
+  for (let k = 0; k < 3; ++k) { await page.keyboard.press('ArrowLeft'); await idle(); }
+  const level = Number(await page.inputValue('#scale'));
+  await page.waitForFunction((l) => window.scalespace.labelsQuery && window.scalespace.labelsQuery.level === String(l) && window.scalespace.busy === 0, level);
+  const t = manifest.planes.scales[level];
+  if (!measureOnly) {
+    run('segment', planes, '--scale', String(t), '-o', path.join(work, 'scale.csv'), '-q');
+    const d = sameLabels(await labels(), planeIds(path.join(work, 'scale.csv')));
+    check(!d, `scale slider at level ${level} (t = ${t}): same labels as segment --scale ${t} ${d}`);
+  }
+  await shot('viewer_scale.png');
+  const timings = await page.evaluate((n) => window.scalespace.timings.slice(n), before);
+  results.sliderMs = timings.map((x) => Math.round(x.ms));
+  }
+
+  if (!measureOnly) {
+    // Diagram: click the dot of the most persistent component; it becomes the selection.
+    await page.focus('#persistence');
+    await page.keyboard.press('Home');
+    await idle();
+    const comps = await page.evaluate(() => window.scalespace.components);
+    const top = comps.reduce((a, b) => (b.persistence > a.persistence ? b : a));
+    const box = await page.locator('#diagram').boundingBox();
+    const dot = await page.evaluate((c) => window.scalespace.diagram.position(c), top);
+    const canvasSize = await page.evaluate(() => [document.getElementById('diagram').width, document.getElementById('diagram').height]);
+    await page.mouse.click(box.x + dot[0] * box.width / canvasSize[0], box.y + dot[1] * box.height / canvasSize[1]);
+    await page.waitForFunction(() => window.scalespace.labelsQuery && 'components' in window.scalespace.labelsQuery && window.scalespace.busy === 0);
+    const picked = await page.evaluate(() => window.scalespace.selection);
+    check(picked.length === 1 && comps[picked[0]].persistence === top.persistence,
+      `diagram click selects a component of the largest persistence ${top.persistence} (got ${picked})`);
+
+    // Brush: a stroke across the middle of the view.
+    await page.click('#brush');
+    const view = await page.locator('#view').boundingBox();
+    const cx = view.x + view.width / 2, cy = view.y + view.height / 2;
+    await page.mouse.move(cx - 60, cy - 10);
+    await page.mouse.down();
+    for (let k = 0; k <= 12; ++k) await page.mouse.move(cx - 60 + 10 * k, cy - 10 + 2 * k);
+    await page.mouse.up();
+    await page.waitForFunction(() => window.scalespace.lastBrush && window.scalespace.busy === 0, null, { timeout: 60000 });
+    await page.click('#brush');
+    const brushed = await page.evaluate(() => Array.from(window.scalespace.lastBrush.indices));
+    const matches = await page.evaluate(() => window.scalespace.lastBrush.matches);
+    check(brushed.length > 0 && matches.length > 0, `brush: ${brushed.length} points, ${matches.length} components`);
+    fs.writeFileSync(path.join(work, 'brush.txt'), brushed.join('\n'));
+    const ranking = run('segment', planes, '--brush', path.join(work, 'brush.txt'), '-o', path.join(work, 'brush.csv'))
+      .trim().split('\n').slice(1).map((l) => Number(l.split(',')[0]));
+    check(JSON.stringify(ranking) === JSON.stringify(matches.map((m) => m.component)),
+      `brush ranking equals segment --brush's (${ranking.slice(0, 5)}...)`);
+    const db = sameLabels(await labels(), planeIds(path.join(work, 'brush.csv')));
+    check(!db, `brush: the best component's points equal segment --brush's ${db}`);
+    await shot('viewer_brush.png');
+
+    // Similarity search from the brushed component, in the whole cloud.
+    await page.click('#similar');
+    await page.waitForFunction(() => window.scalespace.lastSimilar && window.scalespace.busy === 0);
+    const similar = await page.evaluate(() => window.scalespace.lastSimilar);
+    fs.writeFileSync(path.join(work, 'all.txt'), Array.from({ length: pointCount }, (_, i) => i).join('\n'));
+    run('segment', planes, '--similar', String(similar.query), '--within', path.join(work, 'all.txt'), '-o', path.join(work, 'similar.csv'), '-q');
+    const ds = sameLabels(await labels(), planeIds(path.join(work, 'similar.csv')));
+    check(!ds, `similar to ${similar.query}: ${similar.components.length} components, same points as segment --similar ${ds}`);
+    await shot('viewer_similar.png');
+
+    // Export of what is shown (the similar components): byte for byte segment's file.
+    await page.click('#exportCsv');
+    await page.waitForFunction(() => window.scalespace.lastExport && window.scalespace.busy === 0);
+    const exported = await page.evaluate(() => window.scalespace.lastExport.path);
+    check(path.dirname(exported) === path.join(work, 'exports'), `export written to the export folder: ${exported}`);
+    check(fs.readFileSync(exported).equals(fs.readFileSync(path.join(work, 'similar.csv'))),
+      'the exported CSV is byte for byte segment --similar\'s');
+  }
+  if (!measureOnly) {
+    // Colour by an attribute: the colour bar names it with its range.
+    await page.selectOption('#colorBy', 'gt_face');
+    await page.waitForFunction(() => document.getElementById('barName').textContent.startsWith('gt_face'));
+    check(true, 'colour by the attribute gt_face, with its colour bar');
+    await page.selectOption('#upAxis', 'z');
+    await shot('viewer_attribute.png');
+  }
+  if (measureOnly) {
+    // Orbiting: 20 mouse moves with the left button, each waited until two frames are drawn; the
+    // mean time per frame (headless Chromium's frames come at most every 16.7 ms).
+    const view = await page.locator('#view').boundingBox();
+    const x0 = view.x + view.width / 2, y0 = view.y + view.height / 2;
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    const start = performance.now();
+    for (let k = 1; k <= 20; ++k) {
+      await page.mouse.move(x0 + 8 * k, y0 + 2 * k);
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    }
+    await page.mouse.up();
+    results.orbitFrameMs = Math.round((performance.now() - start) / 40);
+  }
+  results.jsHeapMB = await page.evaluate(() => (performance.memory ? Math.round(performance.memory.usedJSHeapSize / 2 ** 20) : null));
+  Object.assign(results, chromiumMemory(userDataDir));
+  check(errors.length === 0, `no page error ${errors.join('; ')}`);
+  check(outside.length === 0, `no request left the local server ${outside.join(' ')}`);
+} finally {
+  await browser.close();
+  server.kill('SIGTERM');
+  fs.rmSync(userDataDir, { recursive: true, force: true });
+}
+console.log(`measured: ${JSON.stringify(results)}`);
+if (failures) {
+  console.log(`${failures} check(s) failed`);
+  process.exit(1);
+}
+console.log('view end-to-end: all checks passed');
+process.exit(0);  // now: the server's pipe would keep the event loop (and ctest) waiting
