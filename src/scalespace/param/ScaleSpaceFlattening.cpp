@@ -204,8 +204,8 @@ FlatteningResult flattenScaleSpace(const std::vector<Vec3>& inputPositions,
     fitPoints(samples, FitQueries{current, scales}, walk, record, stepProgress);
 
     FlatteningStep step;
-    std::vector<double> sorted = scales;
-    step.tMedian = lowerMedian(std::move(sorted));
+    // t_j is increasing in t_min (Eq. 1.39, f <= 1): its median is that of t_min, mapped.
+    step.tMedian = result.medianTMin + f * (result.tMax - result.medianTMin);
     step.samples = members.size();
     double moved = 0;
     for (std::size_t k = 0; k < n; ++k) moved += (next[k] - current[k]).norm();
