@@ -12,15 +12,18 @@
 // - tops: raised tile tops found as regions of some scale (house: 24 tiles 2.5 cm proud).
 // - groups (gt_group; on Stairs every point is the ramp): the best IoU of any region of any scale
 //   with the group's points, and that scale.
-// - rms/t: per component, the RMS point-to-plane distance of its plane at its representative
-//   level over that level's scale t: the worst, and how many exceed 5 %; the largest component
-//   (points at its representative level) and its rms/t.
+// - rms/t: per component flagged planar (PlaneComponent::planar), the RMS point-to-plane distance
+//   of its plane at its representative level over that level's scale t: the worst, and how many
+//   exceed 5 % (the noise floor of the flag allows it below 40 sigma); the largest planar
+//   component (points at its representative level) and its rms/t. The comment line counts the
+//   flagged components and gives the noise the flag allowed for against the true sigma.
 // RANSAC (epsilon 2.5e-4 of the diagonal plus 3 noise sigmas, i.e. 4.5 mm on the noise-free house;
 // cluster epsilon 2 t_min; min points n/10000; CGAL's other defaults) has one level: its planes are
 // its regions, components and segmentation; its rms column is relative to epsilon. Usage:
 // bench_planes_scenes [--points N (300000)] [--scales M (50)] [--scene house|yard|stairs]
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
-//                            [--max-step F] [--max-rms F] (PlaneDetectionOptions, default 0)
+//                            [--max-step F] [--max-rms F] (PlaneDetectionOptions; default: the
+//                            library's) [--no-robust] (the plain APSS stack)
 // --diagnose also prints, per group and level, the region holding most of the group; per level
 // the tile tops found and where their points went; the faces of the largest component along its
 // life; the counted faces not found.
@@ -347,9 +350,9 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
 // Our pipeline with the defaults of `scalespace planes` (and the detection options given).
 void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, double noise,
              int scales, int minPersistence, bool diagnostics, double& tMinOut,
-             const PlaneDetectionOptions& options) {
+             const PlaneDetectionOptions& options, bool robust) {
   ScaleSpaceOptions stack;
-  stack.fit.robust = true;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
+  stack.fit.robust = robust;  // Sec. 2.3, Fig. 2.5: planes use the robust APSS
   stack.series.count = scales;
   const StackPlaneDetection result = detectPlanesInCloud(cloud, stack, options);
   const PlaneDetection& detection = result.detection;
@@ -361,14 +364,20 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
   for (int l = 0; l < detection.scaleCount(); ++l)
     for (const std::vector<Index>& r : detection.graph.levels[std::size_t(l)].regions)
       score(r, truth, model.scales[std::size_t(l)], regionBest);
+  // The rms columns are over the components a user is told are planes (PlaneComponent::planar);
+  // the flagged ones are counted apart.
   double worstRms = 0, largestRms = 0;
-  std::size_t overRms = 0, overRmsAboveNoise = 0, largest = 0;
+  std::size_t overRms = 0, overRmsAboveNoise = 0, largest = 0, flagged = 0;
   const double sigma = noise * cloud.boundingBoxDiagonal();
   for (const PlaneComponent& c : model.components) {
     const double t = model.scales[std::size_t(c.representativeLevel)];
     if (c.persistence >= minPersistence)
       score(componentPointsAt(detection.graph, c.id, c.representativeLevel), truth, t, compBest);
     const double rel = c.plane.valid ? c.plane.rms / t : 0.0;
+    if (!c.planar) {
+      ++flagged;
+      continue;
+    }
     worstRms = std::max(worstRms, rel);
     overRms += rel > kMaxRmsOverT;
     // Noise alone gives rms/t = sigma/t: above 5 % for t < 20 sigma, whatever the plane.
@@ -381,13 +390,14 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
            recall(compBest, truth, tMin), recall(segBest, truth, tMin), regionBest, worstRms,
            overRms, model.components.size(), largest, largestRms, result.totalSeconds);
   std::printf(
-      "#   t_min %.4g (3 t_min %.4g), t_max %.4g; components with rms/t > 5 %%: %zu, %zu of them "
-      "at t >= 20 sigma; time: stack %.2f s, knn %.2f s, segmentation %.2f s, filtering %.2f s "
+      "#   t_min %.4g (3 t_min %.4g), t_max %.4g; planar components with rms/t > 5 %%: %zu, %zu "
+      "of them at t >= 20 sigma; flagged non-planar: %zu; noise: estimated %.3g, true sigma %.3g; "
+      "time: stack %.2f s, knn %.2f s, segmentation %.2f s, filtering %.2f s "
       "(both during the stack; %.2f s after it), graph %.3f s, components %.2f s\n",
-      tMin, kWidthInTMin * tMin, model.scales.back(), overRms, overRmsAboveNoise,
-      result.stackSeconds, result.knnSeconds, detection.timings.segmentation,
-      detection.timings.filtering, result.segmentationWaitSeconds, detection.timings.graph,
-      detection.timings.components);
+      tMin, kWidthInTMin * tMin, model.scales.back(), overRms, overRmsAboveNoise, flagged,
+      detection.noiseRms, sigma, result.stackSeconds, result.knnSeconds,
+      detection.timings.segmentation, detection.timings.filtering, result.segmentationWaitSeconds,
+      detection.timings.graph, detection.timings.components);
   if (!diagnostics) return;
   diagnose(cloud, detection, model, truth);
   std::printf("# as regions of any scale:\n");
@@ -435,7 +445,7 @@ int main(int argc, char** argv) {
   int scales = 50, minPersistence = 5;
   double onlyNoise = -1;
   std::string onlyScene;
-  bool peers = true, diagnostics = false;
+  bool peers = true, diagnostics = false, robust = true;
   PlaneDetectionOptions detection;
   const std::vector<double> noiseLevels{0.0, 2.5e-4};
   for (int i = 1; i < argc; ++i) {
@@ -454,7 +464,9 @@ int main(int argc, char** argv) {
     } else if (a == "--max-step" && hasValue) {
       detection.growing.maxStep = std::atof(argv[++i]);
     } else if (a == "--max-rms" && hasValue) {
-      detection.maxRegionRms = std::atof(argv[++i]);
+      detection.planarity.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--no-robust") {
+      robust = false;
     } else if (a == "--no-ransac") {
       peers = false;
     } else if (a == "--diagnose") {
@@ -482,7 +494,7 @@ int main(int argc, char** argv) {
       const Truth truth = makeTruth(kind, options, cloud);
       double tMin = 0;
       runOurs(cloud, truth, sceneKindName(kind), noise, scales, minPersistence, diagnostics, tMin,
-              detection);
+              detection, robust);
       if (peers) runPeer(cloud, truth, sceneKindName(kind), noise, tMin, diagnostics);
     }
   }

@@ -59,3 +59,36 @@ TEST(RegionGraph, LabelQueriesOnAMembership) {
   EXPECT_THROW(nearestScaleIndex({}, 1), OptionError);
   EXPECT_THROW(nearestScaleIndex({0.1}, -1), OptionError);
 }
+
+// Regions of different kinds are never linked, whatever their Jaccard index: the chain splits.
+TEST(RegionGraph, KindsKeepChainsApart) {
+  std::vector<RegionLevel> levels(3);
+  for (int j = 0; j < 3; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
+  levels[0].regions = {{0, 1, 2, 3}};
+  levels[1].regions = {{0, 1, 2, 3, 4}};
+  levels[2].regions = {{0, 1, 2, 3, 4, 5}};
+  EXPECT_EQ(buildRegionGraph(levels, 6).components.size(), 1u);
+  const std::vector<std::vector<std::uint8_t>> kinds{{1}, {1}, {0}};
+  const RegionGraph g = buildRegionGraph(levels, 6, 0.5, &kinds);
+  ASSERT_EQ(g.components.size(), 2u);
+  EXPECT_EQ(g.components[0].deathLevel, 1);
+  EXPECT_EQ(g.components[1].birthLevel, 2);
+  const std::vector<std::vector<std::uint8_t>> wrongSize{{1}, {1}};
+  EXPECT_THROW(buildRegionGraph(levels, 6, 0.5, &wrongSize), OptionError);
+}
+
+// A preferred component wins over a more persistent one; among preferred ones (or with no
+// preference) the persistence decides.
+TEST(RegionGraph, PreferredComponentsWinThePersistenceLabels) {
+  PointMembership m;
+  m.pointCount = 3;
+  m.levelCount = 2;
+  m.ids = {0, 0, -1, /* level 1 */ 1, 2, 2};
+  const std::vector<int> persistence{1, 5, 3};
+  EXPECT_EQ(labelsByPersistence(m, persistence, 0), (std::vector<int>{1, 2, 2}));
+  const std::vector<std::uint8_t> preferred{1, 0, 1};
+  EXPECT_EQ(labelsByPersistence(m, persistence, 0, &preferred), (std::vector<int>{0, 2, 2}));
+  EXPECT_EQ(labelsByPersistence(m, persistence, 2, &preferred), (std::vector<int>{1, 2, 2}));
+  const std::vector<std::uint8_t> short_{1};
+  EXPECT_THROW(labelsByPersistence(m, persistence, 0, &short_), OptionError);
+}

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <set>
@@ -9,6 +10,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/planes/PlaneDetection.hpp"
+#include "scalespace/planes/PlaneQueries.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
 using namespace scalespace;
@@ -110,39 +112,61 @@ TEST(RegionGrowing, StepLimitSeparatesParallelFacesOffsetByLessThanTheGraphSpan)
 }
 
 // A flat patch and a cap of a sphere of radius 1 (sagitta ~0.1 over a width of 0.9): at t = 0.1
-// the filter with maxRms = 0.05 (RMS <= 0.005) keeps the patch and drops the cap; without it
-// both pass the alpha-shape test. The cap as a component is flagged non-planar.
-TEST(RegionFilter, PlanarityFilterDropsRegionsThatNoPlaneDescribes) {
+// the patch is planar (RMS 0 <= 5% of t), the cap is not (RMS ~0.03); a noise floor above the
+// cap's RMS makes it planar too. A chain from the patch into patch + cap splits there: the cap's
+// component is flagged, and the persistence labels prefer the planar one.
+TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   std::mt19937 rng(6);
   std::uniform_real_distribution<double> u(-0.45, 0.45);
   std::vector<Vec3> pts;
-  Segmentation seg;
-  seg.regions.resize(2);
+  std::vector<std::vector<Index>> regions(2);
   for (int i = 0; i < 3000; ++i) {
     const double x = u(rng), y = u(rng);
     const bool cap = i % 2;
     pts.emplace_back(cap ? x + 3 : x, y, cap ? std::sqrt(1 - x * x - y * y) : 0.0);
-    seg.regions[std::size_t(cap)].push_back(Index(i));
+    regions[std::size_t(cap)].push_back(Index(i));
   }
-  seg.labels.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) seg.labels[i] = int(i % 2);
-  EXPECT_EQ(filterRegions(pts, seg, 0.1).size(), 2u);
-  RegionFilterOptions planar;
-  planar.maxRms = 0.05;
-  const auto kept = filterRegions(pts, seg, 0.1, planar, {}, pts);
-  ASSERT_EQ(kept.size(), 1u);
-  EXPECT_EQ(kept[0], seg.regions[0]);
-  EXPECT_THROW(filterRegions(pts, seg, 0.1, planar), OptionError);  // needs the projections
-
   RegionLevel level;
   level.t = 0.1;
-  level.regions = seg.regions;
-  const RegionGraph graph = buildRegionGraph({level}, pts.size());
-  const std::vector<PlaneComponent> components = extractComponents(graph, pts);
-  ASSERT_EQ(components.size(), 2u);
-  EXPECT_TRUE(components[0].planar);
-  EXPECT_FALSE(components[1].planar);
-  EXPECT_DOUBLE_EQ(components[1].representativeScale, 0.1);
+  level.regions = regions;
+  EXPECT_DOUBLE_EQ(regionNoiseRms(pts, {RegionLevel{}, level}), 0.0);  // lower median: the patch
+  EXPECT_DOUBLE_EQ(regionNoiseRms(pts, {}), 0.0);
+  EXPECT_EQ(regionPlanarity(pts, {level}, 0.0), (std::vector<std::vector<std::uint8_t>>{{1, 0}}));
+  EXPECT_EQ(regionPlanarity(pts, {level}, 0.05), (std::vector<std::vector<std::uint8_t>>{{1, 1}}));
+  PlanarityOptions thesis;
+  thesis.maxRelativeRms = 0;
+  EXPECT_EQ(regionPlanarity(pts, {level}, 0.0, thesis),
+            (std::vector<std::vector<std::uint8_t>>{{1, 1}}));
+  PlanarityOptions bad;
+  bad.noiseFactor = -1;
+  EXPECT_THROW(regionPlanarity(pts, {level}, 0.0, bad), OptionError);
+
+  // Level 0: the patch; level 1: the patch and 900 cap points (J = 1500/2400 > 0.5).
+  std::vector<RegionLevel> levels(2);
+  levels[0].t = 0.1;
+  levels[0].regions = {regions[0]};
+  levels[1].t = 0.2;
+  std::vector<Index> merged = regions[0];
+  merged.insert(merged.end(), regions[1].begin(), regions[1].begin() + 900);
+  std::sort(merged.begin(), merged.end());
+  levels[1].regions = {merged};
+  PlaneDetectionOptions options;
+  options.outlines = false;
+  const PlaneDetection split = buildPlaneDetection(pts, levels, options, {});
+  ASSERT_EQ(split.components.size(), 2u);
+  EXPECT_EQ(split.nonPlanarRegions, 1u);
+  EXPECT_TRUE(split.components[0].planar);
+  EXPECT_EQ(split.components[0].deathLevel, 0);
+  EXPECT_FALSE(split.components[1].planar);
+  const PlaneModel model = makePlaneModel(split);
+  const std::vector<int> labels = labelsByPersistence(model, 0);
+  EXPECT_EQ(labels[0], 0);  // a patch point: the planar component, not the flagged chain
+  EXPECT_EQ(labels[1], 1);  // a cap point: only the flagged one holds it
+  options.planarity.maxRelativeRms = 0;  // the thesis: one chain, flagged by its plane's RMS
+  const PlaneDetection chained = buildPlaneDetection(pts, levels, options, {});
+  ASSERT_EQ(chained.components.size(), 1u);
+  EXPECT_FALSE(chained.components[0].planar);
+  EXPECT_EQ(chained.components[0].persistence, 1);
 }
 
 // The graph's distance to the k-th neighbour is knnRadii's (brute force), so the stack can take

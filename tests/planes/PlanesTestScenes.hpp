@@ -41,6 +41,7 @@ inline std::vector<ScaleFeatures> boxFeatures(const PointCloud& cloud, const Vec
         bend = std::max(bend, w);
       }
       f.normals.push_back(n.normalized());
+      f.projections.push_back(cloud.positions()[i]);  // the faces stay where they are
       f.kMax.push_back(float(bend / t));
       f.kMin.push_back(0.f);
       f.valid.push_back(1);
@@ -52,7 +53,8 @@ inline std::vector<ScaleFeatures> boxFeatures(const PointCloud& cloud, const Vec
 
 /// Stairs of `steps` steps of size d = 1/steps (SceneKind::Stairs): treads (+z) and risers (-y)
 /// turn towards the mean ramp normal (0,-1,1)/sqrt2 as t grows past half the step size, until at
-/// t >= d the whole staircase is one plane.
+/// t >= d the whole staircase is one plane; the projections move as far towards the mean ramp
+/// z = y + d/2, as a plain APSS would smooth the steps.
 inline std::vector<ScaleFeatures> stairsFeatures(const PointCloud& cloud, int steps,
                                                  const std::vector<double>& scales) {
   const double d = 1.0 / steps;
@@ -64,6 +66,9 @@ inline std::vector<ScaleFeatures> stairsFeatures(const PointCloud& cloud, int st
     const double s = std::clamp((t - 0.5 * d) / (0.5 * d), 0.0, 1.0);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       f.normals.push_back(((1 - s) * cloud.normals()[i] + s * ramp).normalized());
+      const Vec3 p = cloud.absolutePosition(i);
+      const Vec3 onRamp = p - (ramp.dot(p) - ramp.dot(Vec3(0, 0, 0.5 * d))) * ramp;
+      f.projections.push_back(cloud.positions()[i] + s * (onRamp - p));
       f.kMax.push_back(float(s < 1 ? s / t : 0.0));
       f.kMin.push_back(0.f);
       f.valid.push_back(1);

@@ -309,8 +309,10 @@ void addPlanesCommand(CLI::App& app) {
                   "largest step a region crosses between neighbours along its seed's normal, as a "
                   "fraction of t (0 = the angle alone, Sec. 2.3.1)")
       ->capture_default_str();
-  cmd->add_option("--max-rms", args->detection.maxRegionRms,
-                  "drop regions whose plane RMS exceeds this fraction of t (0 = no such filter)")
+  cmd->add_option("--max-rms", args->detection.planarity.maxRelativeRms,
+                  "a region whose points lie farther from their plane (RMS) than this fraction "
+                  "of t and twice the noise is not planar: never linked to a planar one, its "
+                  "component flagged (0 = link any regions, Sec. 2.3.2)")
       ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
@@ -358,11 +360,16 @@ void addPlanesCommand(CLI::App& app) {
     }
     std::size_t curved = 0;
     for (const PlaneComponent& c : model.components) curved += !c.planar;
-    if (curved)
-      printWarnings({std::to_string(curved) +
-                     " component(s) are not described by their plane (RMS > 5% of their "
-                     "representative scale and > 2x the typical RMS): components.json marks them "
-                     "\"planar\": false"});
+    if (curved && !args->quiet)
+      std::fprintf(stderr,
+                   "%zu of the components are not described by a plane (RMS > %g of their scale "
+                   "and > %g x the noise, %.3g): components.json marks them \"planar\": false; "
+                   "segment --min-persistence prefers the planar ones\n",
+                   curved,
+                   args->detection.planarity.maxRelativeRms > 0
+                       ? args->detection.planarity.maxRelativeRms
+                       : ComponentOptions{}.maxRelativeRms,
+                   args->detection.planarity.noiseFactor, result.detection.noiseRms);
     reportDone("planes", start, args->quiet);
   });
 }

@@ -35,7 +35,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FitOptions::mlsMaxSteps", "--mls-steps"},
     {"ScaleSpaceOptions::alpha", "--alpha"},
     {"RegionGrowingOptions::maxStep", "--max-step"},
-    {"RegionFilterOptions::maxRms", "--max-rms"},
+    {"PlanarityOptions::maxRelativeRms", "--max-rms"},
     {"RegionGrowingOptions::maxAngleDegrees", "--angle"},
     {"StackWriteOptions::encoding", "--encoding"},
     {"RenderOptions::up", "--up"},

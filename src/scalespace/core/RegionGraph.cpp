@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 
@@ -23,17 +24,22 @@ PointMembership pointMembership(const RegionGraph& graph) {
 }
 
 std::vector<int> labelsByPersistence(const PointMembership& membership,
-                                     const std::vector<int>& persistence, int minPersistence) {
+                                     const std::vector<int>& persistence, int minPersistence,
+                                     const std::vector<std::uint8_t>* preferred) {
+  if (preferred && preferred->size() != persistence.size())
+    throw OptionError("labelsByPersistence: one preference per component is needed");
+  const auto rank = [&](int c) {
+    return std::pair<int, int>(preferred ? int((*preferred)[std::size_t(c)] != 0) : 0,
+                               persistence[std::size_t(c)]);
+  };
   std::vector<int> labels(membership.pointCount, -1);
   for (int j = 0; j < membership.levelCount; ++j)
     for (std::size_t i = 0; i < membership.pointCount; ++i) {
       const int c = membership.at(j, i);
       if (c < 0 || persistence[std::size_t(c)] < minPersistence) continue;
       const int b = labels[i];
-      // Higher persistence, then lower id.
-      if (b < 0 || persistence[std::size_t(c)] > persistence[std::size_t(b)] ||
-          (persistence[std::size_t(c)] == persistence[std::size_t(b)] && c < b))
-        labels[i] = c;
+      // Preferred, then higher persistence, then lower id.
+      if (b < 0 || rank(c) > rank(b) || (rank(c) == rank(b) && c < b)) labels[i] = c;
     }
   return labels;
 }
@@ -98,9 +104,16 @@ std::vector<int> RegionGraph::componentLabels(int level) const {
 }
 
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
-                             double minJaccard) {
+                             double minJaccard,
+                             const std::vector<std::vector<std::uint8_t>>* kinds) {
   if (!(minJaccard >= 0.5 && minJaccard < 1))
     throw OptionError("the Jaccard threshold must be in [0.5, 1): below 0.5 links are ambiguous");
+  if (kinds) {
+    bool sized = kinds->size() == levels.size();
+    for (std::size_t j = 0; sized && j < levels.size(); ++j)
+      sized = (*kinds)[j].size() == levels[j].regions.size();
+    if (!sized) throw OptionError("region graph: the region kinds and the levels differ in size");
+  }
   RegionGraph graph;
   graph.pointCount = pointCount;
   graph.levels = std::move(levels);
@@ -125,6 +138,7 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
       for (Index i : here[r])
         if (nextLabels[i] >= 0) ++overlap[nextLabels[i]];
       for (const auto& [s, common] : overlap) {
+        if (kinds && (*kinds)[j][r] != (*kinds)[j + 1][std::size_t(s)]) continue;
         const std::size_t unionSize = here[r].size() + next[std::size_t(s)].size() - common;
         if (double(common) > minJaccard * double(unionSize)) graph.successor[j][r] = s;  // Eq. 2.1
       }

@@ -5,6 +5,7 @@
 // scale are disjoint, so a node has at most one such successor and one such predecessor: the
 // components are chains, each with a birth and a death level.
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "scalespace/core/Types.hpp"
@@ -56,9 +57,12 @@ struct PointMembership {
 PointMembership pointMembership(const RegionGraph& graph);
 
 /// Sec. 2.4.1: per point, the most persistent component (persistence[c], lower id on ties) with
-/// persistence >= minPersistence holding it at any level, or -1.
+/// persistence >= minPersistence holding it at any level, or -1. With `preferred` (per
+/// component), a preferred component beats any other whatever their persistence (the planes:
+/// planar components before the flagged ones, planes/RegionPlanarity.hpp).
 std::vector<int> labelsByPersistence(const PointMembership& membership,
-                                     const std::vector<int>& persistence, int minPersistence);
+                                     const std::vector<int>& persistence, int minPersistence,
+                                     const std::vector<std::uint8_t>* preferred = nullptr);
 
 /// Sec. 2.4.2: per point, the component holding it at `level` if its persistence is >=
 /// minPersistence, else -1. Throws OptionError for a level out of range.
@@ -73,8 +77,11 @@ int nearestScaleIndex(const std::vector<double>& scales, double t);
 /// Jaccard index |A n B| / |A u B| of two increasing index lists (Eq. 2.1).
 double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b);
 
-/// Links consecutive levels (J > minJaccard, 0.5 in Sec. 2.3.2) and extracts the chains.
+/// Links consecutive levels (J > minJaccard, 0.5 in Sec. 2.3.2) and extracts the chains. With
+/// `kinds` (kinds[j][r] per region), only regions of the same kind are linked: a chain never
+/// mixes them (planes/RegionPlanarity.hpp: planar and non-planar regions).
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
-                             double minJaccard = 0.5);
+                             double minJaccard = 0.5,
+                             const std::vector<std::vector<std::uint8_t>>* kinds = nullptr);
 
 }  // namespace scalespace

@@ -60,8 +60,9 @@ std::vector<PlaneComponent> extractComponents(const RegionGraph& graph,
   std::vector<double> rms;
   for (const PlaneComponent& c : out)
     if (c.plane.valid) rms.push_back(c.plane.rms);
-  double noise = 0;
-  if (!rms.empty()) {
+  double noise = options.noiseRms;
+  if (noise < 0 && rms.empty()) noise = 0;
+  if (noise < 0) {
     std::nth_element(rms.begin(), rms.begin() + (rms.size() - 1) / 2, rms.end());
     noise = rms[(rms.size() - 1) / 2];
   }

@@ -21,10 +21,10 @@ struct PlaneComponent {
   double representativeScale = 0.0;  // t of the representative level
   PlaneFit plane;                    // in the cloud's relative coordinates
   /// Whether the plane describes the component's points: plane.rms <= maxRelativeRms times the
-  /// representative scale, or <= noiseFactor times the lower median RMS of all components (the
-  /// sensor noise, which no scale can go below) (ComponentOptions). A chain of regions can drift
-  /// from a plane into a curved or folded set (each step keeping Jaccard > 0.5, Sec. 2.3.2); such a
-  /// component is kept, flagged, for the user to judge.
+  /// representative scale, or <= noiseFactor times the sensor noise, which no scale can go below
+  /// (ComponentOptions). A chain of regions can drift from a plane into a curved or folded set
+  /// (each step keeping Jaccard > 0.5, Sec. 2.3.2); the planarity split
+  /// (planes/RegionPlanarity.hpp) ends the chain there and starts a flagged one.
   bool planar = true;
   double area = 0.0;  // alpha shape (radius alphaFactor * t) at the representative level
   std::vector<std::vector<Vec3>> outlines;  // boundary loops of that alpha shape, in 3D
@@ -33,7 +33,9 @@ struct PlaneComponent {
 struct ComponentOptions {
   double alphaFactor = 2.0;      // same alpha-shape radius as the region filter: alphaFactor * t
   double maxRelativeRms = 0.05;  // PlaneComponent::planar: rms <= 5% of the representative scale
-  double noiseFactor = 2.0;      // ... or rms <= 2 x the typical (median) component rms
+  double noiseFactor = 2.0;      // ... or rms <= 2 x the sensor noise:
+  double noiseRms = -1;          // given (PlaneDetection::noiseRms), or < 0: the lower median
+                                 // RMS of all components
   bool outlines = true;
 };
 

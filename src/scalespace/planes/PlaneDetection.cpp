@@ -1,5 +1,6 @@
 #include "scalespace/planes/PlaneDetection.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -11,7 +12,6 @@ namespace {
 RegionFilterOptions filterOptionsOf(const PlaneDetectionOptions& options) {
   RegionFilterOptions filter;
   filter.alphaFactor = options.alphaFactor;
-  filter.maxRms = options.maxRegionRms;
   return filter;
 }
 
@@ -23,6 +23,7 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 void validatePlaneDetectionOptions(const PlaneDetectionOptions& options) {
   validateRegionGrowingOptions(options.growing);
   validateRegionFilterOptions(filterOptionsOf(options));
+  validate(options.planarity);
   if (!(options.minJaccard >= 0 && options.minJaccard < 1))
     throw OptionError("PlaneDetectionOptions::minJaccard must be in [0, 1)");
 }
@@ -36,8 +37,7 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
   start = std::chrono::steady_clock::now();
   RegionLevel level;
   level.t = scale.t;
-  level.regions =
-      filterRegions(positions, seg, scale.t, filterOptionsOf(options), {}, scale.projections);
+  level.regions = filterRegions(positions, seg, scale.t, filterOptionsOf(options));
   timings.filtering += secondsSince(start);
   return level;
 }
@@ -50,12 +50,21 @@ PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
   PlaneDetection result;
   result.timings = timings;
   auto start = std::chrono::steady_clock::now();
-  result.graph = buildRegionGraph(std::move(levels), positions.size(), options.minJaccard);
+  result.noiseRms = regionNoiseRms(positions, levels);
+  const auto planar = regionPlanarity(positions, levels, result.noiseRms, options.planarity);
+  for (const auto& level : planar)
+    result.nonPlanarRegions += std::size_t(std::count(level.begin(), level.end(), 0));
+  result.graph = buildRegionGraph(std::move(levels), positions.size(), options.minJaccard, &planar);
   result.timings.graph = secondsSince(start);
   start = std::chrono::steady_clock::now();
   ComponentOptions componentOptions;
   componentOptions.alphaFactor = options.alphaFactor;
   componentOptions.outlines = options.outlines;
+  componentOptions.maxRelativeRms = options.planarity.maxRelativeRms > 0
+                                        ? options.planarity.maxRelativeRms
+                                        : componentOptions.maxRelativeRms;
+  componentOptions.noiseFactor = options.planarity.noiseFactor;
+  componentOptions.noiseRms = result.noiseRms;
   result.components = extractComponents(result.graph, positions, componentOptions, progress);
   result.timings.components = secondsSince(start);
   return result;

@@ -8,15 +8,19 @@
 #include "scalespace/core/RegionGraph.hpp"
 #include "scalespace/planes/PlaneComponent.hpp"
 #include "scalespace/planes/RegionGrowing.hpp"
+#include "scalespace/planes/RegionPlanarity.hpp"
 #include "scalespace/planes/ScaleFeatures.hpp"
 
 namespace scalespace {
 
 struct PlaneDetectionOptions {
-  RegionGrowingOptions growing;  // theta = 5 degrees
-  double alphaFactor = 2.0;      // alpha-shape radius and minimum extent: 2t
-  double maxRegionRms = 0.0;     // RegionFilterOptions::maxRms (0: the thesis' filter)
-  double minJaccard = 0.5;       // Sec. 2.3.2
+  /// theta = 5 degrees (Sec. 2.3.1) and a step limit of 0.05 t (a departure, docs/THESIS_NOTES.md,
+  /// region growing offset; maxStep 0 is the thesis' criterion). The scale features must then
+  /// carry the projections.
+  RegionGrowingOptions growing{5.0, 0.05};
+  double alphaFactor = 2.0;    // alpha-shape radius and minimum extent: 2t
+  PlanarityOptions planarity;  // RMS <= 5% of t or 2 x noise (maxRelativeRms 0: the thesis)
+  double minJaccard = 0.5;     // Sec. 2.3.2
   bool outlines = true;
 };
 
@@ -26,14 +30,18 @@ struct PlaneDetectionTimings {
 
 struct PlaneDetection {
   RegionGraph graph;
+  /// The sensor noise the planarity test and the components' `planar` flags allow for
+  /// (regionNoiseRms), and how many regions are not planar (kept, linked to no planar one).
+  double noiseRms = 0.0;
+  std::size_t nonPlanarRegions = 0;
   std::vector<PlaneComponent> components;  // same ids as graph.components
   PlaneDetectionTimings timings;
   int scaleCount() const { return int(graph.levels.size()); }
 };
 
-/// OptionError naming the field unless every option is in its range (angle in (0, 180), maxStep,
-/// maxRegionRms finite and >= 0, alphaFactor > 0, minJaccard in [0, 1)); the entry points check
-/// it first, a caller can check it before reading its input.
+/// OptionError naming the field unless every option is in its range (angle in (0, 180), maxStep
+/// and the planarity bounds finite and >= 0, alphaFactor > 0, minJaccard in [0, 1)); the entry
+/// points check it first, a caller can check it before reading its input.
 void validatePlaneDetectionOptions(const PlaneDetectionOptions& options);
 
 /// Sec. 2.3.1 for one scale: region growing then the alpha-shape filter; adds the time spent to
@@ -42,7 +50,8 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
                          const ScaleFeatures& scale, const PlaneDetectionOptions& options,
                          PlaneDetectionTimings& timings);
 
-/// Sec. 2.3.2-2.3.3 on the filtered levels: graph, components, planes and outlines.
+/// Sec. 2.3.2-2.3.3 on the filtered levels: the regions' planarity (it needs the noise, read at
+/// the finest level), graph, components, planes and outlines.
 PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
                                    std::vector<RegionLevel> levels,
                                    const PlaneDetectionOptions& options,

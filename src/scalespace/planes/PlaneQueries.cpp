@@ -47,7 +47,9 @@ std::vector<int> persistenceOf(const PlaneModel& model) {
 }  // namespace
 
 std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence) {
-  return labelsByPersistence(model.membership, persistenceOf(model), minPersistence);
+  std::vector<std::uint8_t> planar;
+  for (const PlaneComponent& c : model.components) planar.push_back(c.planar);
+  return labelsByPersistence(model.membership, persistenceOf(model), minPersistence, &planar);
 }
 
 int nearestLevel(const PlaneModel& model, double t) {

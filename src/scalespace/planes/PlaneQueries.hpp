@@ -19,7 +19,8 @@ struct PlaneModel {
 PlaneModel makePlaneModel(const PlaneDetection& detection);
 
 /// Sec. 2.4.1: per point, the most persistent component with pers >= minPersistence holding it
-/// at any level (lower id on ties), or -1.
+/// at any level (lower id on ties), or -1; a planar component beats a flagged one (a departure:
+/// docs/THESIS_NOTES.md, planarity split; with every component planar it is Sec. 2.4.1's rule).
 std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence);
 
 /// Level whose scale is nearest to t on a log scale (the scales are log-spaced, Eq. 1.40).

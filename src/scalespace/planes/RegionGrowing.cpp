@@ -68,8 +68,6 @@ void validateRegionGrowingOptions(const RegionGrowingOptions& options) {
 void validateRegionFilterOptions(const RegionFilterOptions& options) {
   if (!(options.alphaFactor > 0) || !std::isfinite(options.alphaFactor))
     throw OptionError("RegionFilterOptions::alphaFactor must be positive");
-  if (!(options.maxRms >= 0) || !std::isfinite(options.maxRms))
-    throw OptionError("RegionFilterOptions::maxRms must be finite and >= 0");
 }
 
 Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
@@ -102,13 +100,9 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
 std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions,
                                               const Segmentation& segmentation, double t,
                                               const RegionFilterOptions& options,
-                                              const ProgressCallback& progress,
-                                              const std::vector<Vec3>& projections) {
+                                              const ProgressCallback& progress) {
   if (!(t > 0)) throw OptionError("region filter: the scale t must be positive");
   validateRegionFilterOptions(options);
-  if (options.maxRms > 0 && projections.size() != positions.size())
-    throw OptionError("RegionFilterOptions::maxRms needs the projections of the scale");
-  const double maxRms = options.maxRms * t;
   const double radius = options.alphaFactor * t;
   const auto& regions = segmentation.regions;
   std::vector<std::uint8_t> keep(regions.size(), 0);
@@ -118,8 +112,6 @@ std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions
       // A region whose point count cannot reach the area is skipped without an alpha shape:
       // fewer than 3 points have zero area.
       if (regions[r].size() < 3) continue;
-      // A region that no plane describes at its scale is no planar structure of that scale.
-      if (maxRms > 0 && !(fitPlane(projections, regions[r]).rms <= maxRms)) continue;
       const PlaneFit plane = fitPlane(positions, regions[r]);
       keep[r] = alphaShapeAreaAtLeast(projectOnPlane(plane, positions, regions[r]), radius * radius,
                                       radius * radius);

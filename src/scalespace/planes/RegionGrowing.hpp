@@ -34,17 +34,12 @@ struct RegionFilterOptions {
   /// The alpha-shape radius and the minimum extent are alphaFactor * t (Sec. 2.3.1: 2t); CGAL's
   /// alpha is the squared radius.
   double alphaFactor = 2.0;
-  /// Regions whose projections (at t) lie farther from their least-squares plane than maxRms t
-  /// (root mean square) are dropped: no plane describes them at that scale (a departure from
-  /// Sec. 2.3.1: docs/THESIS_NOTES.md, planarity filter). 0: the thesis' filter.
-  double maxRms = 0.0;
 };
 
-/// OptionError naming the field unless alphaFactor > 0 and maxRms finite, >= 0.
+/// OptionError naming the field unless alphaFactor > 0 (finite).
 void validateRegionFilterOptions(const RegionFilterOptions& options);
 
 /// Keeps the regions (their increasing point lists) with sqrt(alpha-shape area) >= alphaFactor * t
-/// (and, with maxRms, the projections' plane RMS <= maxRms t)
 /// (the docs/THESIS_NOTES.md reading of "a < 2t"), in their input order. Regions run in parallel; a
 /// large region is usually accepted from the alpha shape of a patch around its middle
 /// (alphaShapeAreaAtLeast), so the area itself is not computed (the components compute theirs at
@@ -52,7 +47,6 @@ void validateRegionFilterOptions(const RegionFilterOptions& options);
 std::vector<std::vector<Index>> filterRegions(const std::vector<Vec3>& positions,
                                               const Segmentation& segmentation, double t,
                                               const RegionFilterOptions& options = {},
-                                              const ProgressCallback& progress = {},
-                                              const std::vector<Vec3>& projections = {});
+                                              const ProgressCallback& progress = {});
 
 }  // namespace scalespace

@@ -16,7 +16,7 @@ struct ScaleFeatures {
   std::vector<float> kMax, kMin;    // principal curvatures (Eq. 1.38)
   std::vector<std::uint8_t> valid;  // 0 where the fit failed: such points join no region
   /// Per input point, its projection at t (same frame as the cloud's positions); may be empty
-  /// unless RegionGrowingOptions::maxStep or RegionFilterOptions::maxRms is set.
+  /// unless RegionGrowingOptions::maxStep is set.
   std::vector<Vec3> projections;
 };
 

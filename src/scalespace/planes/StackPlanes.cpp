@@ -99,7 +99,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
       std::size_t(stack.series.K) * knn.size() == knn.neighbors.size())
     stack.series.knownMedianKnnRadius = lowerMedian(knn.kthDistance);
   // What scaleFeaturesFromLayer reads: the projections only when a criterion needs them.
-  const bool projections = options.growing.maxStep > 0 || options.maxRegionRms > 0;
+  const bool projections = options.growing.maxStep > 0;
   stack.layerContents = projections ? LayerContents::NormalCurvaturesAndProjection
                                     : LayerContents::NormalAndCurvatures;
   try {

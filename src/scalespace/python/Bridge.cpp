@@ -41,7 +41,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FitOptions::mlsMaxSteps", "mls_steps"},
     {"ScaleSpaceOptions::alpha", "alpha"},
     {"RegionGrowingOptions::maxStep", "max_step"},
-    {"RegionFilterOptions::maxRms", "max_rms"},
+    {"PlanarityOptions::maxRelativeRms", "max_rms"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},
     {"RenderOptions::up", "up"},

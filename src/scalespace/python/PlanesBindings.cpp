@@ -177,7 +177,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   stackOptions.alpha = alpha;
   PlaneDetectionOptions options;
   options.growing.maxStep = maxStep;
-  options.maxRegionRms = maxRms;
+  options.planarity.maxRelativeRms = maxRms;
   options.growing.maxAngleDegrees = angle;
   validateScaleSpaceOptions(stackOptions);
   validatePlaneDetectionOptions(options);
@@ -270,14 +270,17 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
                std::to_string(p.pointCount()) + " points>";
       });
   m.def("planes", &planesPy, "points"_a, "normals"_a = py::none(), py::kw_only(), "scales"_a = 50,
-        "alpha"_a = 0.1, "angle"_a = 5.0, "max_step"_a = 0.0, "max_rms"_a = 0.0, "robust"_a = true,
+        "alpha"_a = 0.1, "angle"_a = 5.0, "max_step"_a = PlaneDetectionOptions{}.growing.maxStep,
+        "max_rms"_a = PlaneDetectionOptions{}.planarity.maxRelativeRms, "robust"_a = true,
         "stack"_a = py::none(), "output"_a = py::none(), "input"_a = "", "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Multi-scale planes by persistence (Chapter 2), as `scalespace planes`.
 
 scales: M log-spaced scales; alpha: the stack's Poisson-disk factor; angle: region growing theta
-(degrees); max_step, max_rms: departures from Sec. 2.3.1, off (0) by default; robust: the
-robust APSS of Sec. 2.3. stack: a stack folder computed from these points instead of computing
+(degrees); max_step: the largest step (fraction of t) a region crosses along its seed's normal
+(0.05; 0: the angle alone, Sec. 2.3.1); max_rms: regions whose plane RMS exceeds this fraction of
+t and twice the noise are not planar, never linked to planar ones and their components flagged
+(0.05; 0: the graph of Sec. 2.3.2); robust: the robust APSS of Sec. 2.3. stack: a stack folder computed from these points instead of computing
 one. output: also write the result folder (input: the cloud file to record in it).)doc");
   m.def(
       "read_planes",
