@@ -405,6 +405,8 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
   std::printf("# as components of persistence >= %d at their representative level:\n",
               minPersistence);
   printMissedFaces(truth, compBest, tMin);
+  std::printf("# as labels of segment --min-persistence %d:\n", minPersistence);
+  printMissedFaces(truth, segBest, tMin);
   std::fflush(stdout);
 }
 

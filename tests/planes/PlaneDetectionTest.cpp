@@ -111,6 +111,33 @@ TEST(RegionGrowing, StepLimitSeparatesParallelFacesOffsetByLessThanTheGraphSpan)
   EXPECT_THROW(growRegions(knn, f, options), OptionError);  // the limit needs the projections
 }
 
+// A gently curved sheet (a cylinder of radius 28.7: normals within +-2 degrees): every normal is
+// within theta = 5 degrees of any seed's, and a k-NN edge of length d rises by up to d sin(4
+// degrees) along the seed's normal. A step limit far below that rise (0.001 t) must not cut the
+// sheet: the rise of a face tilted within theta is no step.
+TEST(RegionGrowing, StepLimitAllowsTheRiseOfAFaceTiltedWithinTheta) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double radius = 1 / std::sin(2 * M_PI / 180);
+  std::vector<Vec3> pts;
+  ScaleFeatures f;
+  f.t = 0.1;
+  for (int i = 0; i < 3000; ++i) {
+    const double x = u(rng), y = u(rng) / 2;
+    const double z = radius - std::sqrt(radius * radius - x * x);
+    pts.emplace_back(x, y, z);
+    f.normals.push_back(Vec3(-x, 0, radius - z).normalized());
+    f.kMax.push_back(float(1 / radius));
+    f.kMin.push_back(0.f);
+    f.valid.push_back(1);
+  }
+  f.projections = pts;
+  const KnnGraph knn = buildKnnGraph(pts, 10);
+  RegionGrowingOptions options;
+  options.maxStep = 0.001;
+  EXPECT_EQ(growRegions(knn, f, options).regions.size(), 1u);
+}
+
 // A flat patch and a cap of a sphere of radius 1 (sagitta ~0.1 over a width of 0.9): at t = 0.1
 // the patch is planar (RMS 0 <= 5% of t), the cap is not (RMS ~0.03); a noise floor above the
 // cap's RMS makes it planar too. A chain from the patch into patch + cap splits there: the cap's

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
@@ -147,4 +148,42 @@ TEST(StackPlanes, CancellingWhileSegmentingThrowsCancelled) {
     const ProgressCallback cancel = [stopAt](double f, std::string_view) { return f < stopAt; };
     EXPECT_THROW(detectPlanesInCloud(cloud, robustStack(10), {}, cancel), Cancelled) << stopAt;
   }
+}
+
+// The planarity split end to end, on the Tri scene (a ground carrying a prism) with noise: a
+// component is flagged exactly when its regions are not planar, so every component flagged
+// planar has a plane RMS within max(5% of its representative scale, 2 x the noise), and no chain
+// mixes planar and non-planar regions.
+TEST(StackPlanes, ComponentsFlaggedPlanarAreDescribedByTheirPlane) {
+  SceneOptions scene;
+  scene.pointCount = 4000;
+  scene.noise = 5e-4;
+  const PointCloud cloud = generateScene(SceneKind::Tri, scene);
+  ScaleSpaceOptions stack;
+  stack.series.count = 10;
+  stack.fit.robust = true;
+  const PlaneDetectionOptions options;
+  const PlaneDetection detection = detectPlanesInCloud(cloud, stack, options).detection;
+  const RegionGraph& graph = detection.graph;
+  const auto planar =
+      regionPlanarity(cloud.positions(), graph.levels, detection.noiseRms, options.planarity);
+  EXPECT_GT(detection.noiseRms, 0.0);
+  std::size_t flagged = 0;
+  for (const PlaneComponent& c : detection.components) {
+    const GraphComponent& g = graph.components[std::size_t(c.id)];
+    for (int level = g.birthLevel; level <= g.deathLevel; ++level)
+      EXPECT_EQ(bool(planar[std::size_t(level)]
+                           [std::size_t(g.regionAt[std::size_t(level - g.birthLevel)])]),
+                c.planar);
+    if (c.planar) {
+      EXPECT_LE(c.plane.rms,
+                std::max(0.05 * c.representativeScale, 2 * detection.noiseRms) + 1e-12);
+    }
+    flagged += !c.planar;
+  }
+  std::size_t nonPlanar = 0;
+  for (const auto& level : planar)
+    nonPlanar += std::size_t(std::count(level.begin(), level.end(), 0));
+  EXPECT_EQ(nonPlanar, detection.nonPlanarRegions);
+  EXPECT_LE(flagged, nonPlanar);
 }

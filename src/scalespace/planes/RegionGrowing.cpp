@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -31,9 +32,10 @@ struct SeedNormalCriterion {
 
 /// The same, and a step may not cross more than maxStep along the seed's normal: the projection
 /// of the point joining and that of the region point it is reached from lie in planes (with the
-/// seed's orientation) at most maxStep apart. Parallel faces offset by a few centimetres (a tile
-/// on a roof, a tread above the ground) have the same normal, so the angle alone joins them
-/// through any graph edge that spans the step (docs/THESIS_NOTES.md, region growing offset).
+/// seed's orientation) at most max(maxStep, |edge| sin(theta)) apart. Parallel faces offset by a
+/// few centimetres (a tile on a roof, a tread above the ground) have the same normal, so the angle
+/// alone joins them through any graph edge that spans the step (docs/THESIS_NOTES.md, region
+/// growing offset).
 struct SeedNormalAndStepCriterion {
   struct Slot {
     double normal[3];
@@ -41,7 +43,7 @@ struct SeedNormalAndStepCriterion {
   };
   const std::vector<Vec3>& normals;
   const std::vector<Vec3>& projections;
-  double cosTheta, maxStep;
+  double cosTheta, sinTheta, maxStep;
   Slot payload(Index point) const {
     const Vec3 &n = normals[point], &p = projections[point];
     return {{n.x(), n.y(), n.z()}, {p.x(), p.y(), p.z()}};
@@ -50,10 +52,15 @@ struct SeedNormalAndStepCriterion {
     const double* n = seed.normal;
     const double* m = candidate.normal;
     if (!(m[0] * n[0] + m[1] * n[1] + m[2] * n[2] >= cosTheta)) return false;
-    const double step = (candidate.position[0] - from.position[0]) * n[0] +
-                        (candidate.position[1] - from.position[1]) * n[1] +
-                        (candidate.position[2] - from.position[2]) * n[2];
-    return std::abs(step) <= maxStep;
+    const double d[3] = {candidate.position[0] - from.position[0],
+                         candidate.position[1] - from.position[1],
+                         candidate.position[2] - from.position[2]};
+    const double step = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    // A face tilted by theta against the seed's normal, which the angle test accepts, rises by
+    // up to |d| sin(theta) over the edge: at the finest scales the edges to the 10th neighbour
+    // are about t long, so 0.087 t of rise is no step.
+    const double tilt = sinTheta * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    return std::abs(step) <= std::max(maxStep, tilt);
   }
 };
 }  // namespace
@@ -81,6 +88,7 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
     throw OptionError(
         "RegionGrowingOptions::maxStep needs the projections of the scale (ScaleFeatures)");
   const double cosTheta = std::cos(options.maxAngleDegrees * M_PI / 180.0);
+  const double sinTheta = std::sin(options.maxAngleDegrees * M_PI / 180.0);
   // Seeds by decreasing planarity (k1^2 + k2^2)^-1 = increasing k1^2 + k2^2, ties by increasing
   // point index, so the result does not depend on anything else. A point with a non-finite
   // normal or curvature seeds nothing.
@@ -90,9 +98,10 @@ Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
     return double(scale.kMax[i]) * scale.kMax[i] + double(scale.kMin[i]) * scale.kMin[i];
   });
   if (options.maxStep > 0)
-    return growRegionsFromSeeds(graph, std::move(seeds), scale.valid,
-                                SeedNormalAndStepCriterion{scale.normals, scale.projections,
-                                                           cosTheta, options.maxStep * scale.t});
+    return growRegionsFromSeeds(
+        graph, std::move(seeds), scale.valid,
+        SeedNormalAndStepCriterion{scale.normals, scale.projections, cosTheta, sinTheta,
+                                   options.maxStep * scale.t});
   return growRegionsFromSeeds(graph, std::move(seeds), scale.valid,
                               SeedNormalCriterion{scale.normals, cosTheta});
 }

@@ -24,8 +24,10 @@ void validateRegionGrowingOptions(const RegionGrowingOptions& options);
 
 /// Seeds by decreasing planarity 1/(k1^2 + k2^2), i.e. increasing k1^2 + k2^2 (stable, index
 /// tie-break); a region grows through the graph over unassigned valid points whose normal is
-/// within theta of the seed's normal (and, with maxStep, whose projection is at most maxStep t
-/// from the plane through the neighbour it is reached from). Invalid points stay -1.
+/// within theta of the seed's normal (and, with maxStep, whose projection is at most
+/// max(maxStep t, |edge| sin theta) from the plane through the neighbour it is reached from,
+/// |edge| the distance between the two projections: the rise that a face tilted by theta makes
+/// over the edge is no step). Invalid points stay -1.
 /// Deterministic.
 Segmentation growRegions(const KnnGraph& graph, const ScaleFeatures& scale,
                          const RegionGrowingOptions& options = {});
