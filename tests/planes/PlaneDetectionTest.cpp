@@ -156,8 +156,6 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   RegionLevel level;
   level.t = 0.1;
   level.regions = regions;
-  EXPECT_DOUBLE_EQ(regionNoiseRms(pts, {RegionLevel{}, level}), 0.0);  // lower median: the patch
-  EXPECT_DOUBLE_EQ(regionNoiseRms(pts, {}), 0.0);
   EXPECT_EQ(regionPlanarity(pts, {level}, 0.0), (std::vector<std::vector<std::uint8_t>>{{1, 0}}));
   EXPECT_EQ(regionPlanarity(pts, {level}, 0.05), (std::vector<std::vector<std::uint8_t>>{{1, 1}}));
   PlanarityOptions thesis;
@@ -179,7 +177,7 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   levels[1].regions = {merged};
   PlaneDetectionOptions options;
   options.outlines = false;
-  const PlaneDetection split = buildPlaneDetection(pts, levels, options, {});
+  const PlaneDetection split = buildPlaneDetection(pts, levels, 0.0, options, {});
   ASSERT_EQ(split.components.size(), 2u);
   EXPECT_EQ(split.nonPlanarRegions, 1u);
   EXPECT_TRUE(split.components[0].planar);
@@ -190,10 +188,27 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   EXPECT_EQ(labels[0], 0);  // a patch point: the planar component, not the flagged chain
   EXPECT_EQ(labels[1], 1);  // a cap point: only the flagged one holds it
   options.planarity.maxRelativeRms = 0;  // the thesis: one chain, flagged by its plane's RMS
-  const PlaneDetection chained = buildPlaneDetection(pts, levels, options, {});
+  const PlaneDetection chained = buildPlaneDetection(pts, levels, 0.0, options, {});
   ASSERT_EQ(chained.components.size(), 1u);
   EXPECT_FALSE(chained.components[0].planar);
   EXPECT_EQ(chained.components[0].persistence, 1);
+}
+
+// The noise read from every point's 10 neighbours is the sigma of Gaussian noise added to a
+// plane (within 15%), and 0 on the clean plane; an empty graph reads 0.
+TEST(RegionPlanarity, PointNoiseIsTheSigmaOfANoisyPlane) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> gauss(0, 0.002);
+  std::vector<Vec3> clean, noisy;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = u(rng), y = u(rng);
+    clean.emplace_back(x, y, 0.0);
+    noisy.emplace_back(x, y, gauss(rng));
+  }
+  EXPECT_NEAR(pointNoiseRms(clean, buildKnnGraph(clean, 10)), 0.0, 1e-12);
+  EXPECT_NEAR(pointNoiseRms(noisy, buildKnnGraph(noisy, 10)), 0.002, 0.0003);
+  EXPECT_DOUBLE_EQ(pointNoiseRms({}, KnnGraph{}), 0.0);
 }
 
 // The graph's distance to the k-th neighbour is knnRadii's (brute force), so the stack can take

@@ -43,14 +43,14 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
 }
 
 PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
-                                   std::vector<RegionLevel> levels,
+                                   std::vector<RegionLevel> levels, double noiseRms,
                                    const PlaneDetectionOptions& options,
                                    PlaneDetectionTimings timings,
                                    const ProgressCallback& progress) {
   PlaneDetection result;
   result.timings = timings;
   auto start = std::chrono::steady_clock::now();
-  result.noiseRms = regionNoiseRms(positions, levels);
+  result.noiseRms = noiseRms;
   const auto planar = regionPlanarity(positions, levels, result.noiseRms, options.planarity);
   for (const auto& level : planar)
     result.nonPlanarRegions += std::size_t(std::count(level.begin(), level.end(), 0));
@@ -85,7 +85,8 @@ PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& 
       throw Cancelled();
     levels.push_back(segmentScale(positions, knn, scales[j], options, timings));
   }
-  return buildPlaneDetection(positions, std::move(levels), options, timings, progress);
+  return buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn), options,
+                             timings, progress);
 }
 
 }  // namespace scalespace

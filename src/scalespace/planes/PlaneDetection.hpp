@@ -31,7 +31,7 @@ struct PlaneDetectionTimings {
 struct PlaneDetection {
   RegionGraph graph;
   /// The sensor noise the planarity test and the components' `planar` flags allow for
-  /// (regionNoiseRms), and how many regions are not planar (kept, linked to no planar one).
+  /// (pointNoiseRms), and how many regions are not planar (kept, linked to no planar one).
   double noiseRms = 0.0;
   std::size_t nonPlanarRegions = 0;
   std::vector<PlaneComponent> components;  // same ids as graph.components
@@ -50,10 +50,10 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
                          const ScaleFeatures& scale, const PlaneDetectionOptions& options,
                          PlaneDetectionTimings& timings);
 
-/// Sec. 2.3.2-2.3.3 on the filtered levels: the regions' planarity (it needs the noise, read at
-/// the finest level), graph, components, planes and outlines.
+/// Sec. 2.3.2-2.3.3 on the filtered levels: the regions' planarity (allowing for `noiseRms`, the
+/// cloud's pointNoiseRms), graph, components, planes and outlines.
 PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
-                                   std::vector<RegionLevel> levels,
+                                   std::vector<RegionLevel> levels, double noiseRms,
                                    const PlaneDetectionOptions& options,
                                    PlaneDetectionTimings timings,
                                    const ProgressCallback& progress = {});

@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -29,15 +30,28 @@ std::vector<double> regionRms(const std::vector<Vec3>& positions, const RegionLe
 }
 }  // namespace
 
-double regionNoiseRms(const std::vector<Vec3>& positions, const std::vector<RegionLevel>& levels) {
-  for (const RegionLevel& level : levels) {
-    if (level.regions.empty()) continue;
-    std::vector<double> rms = regionRms(positions, level);
-    const auto middle = rms.begin() + std::ptrdiff_t((rms.size() - 1) / 2);
-    std::nth_element(rms.begin(), middle, rms.end());
-    return std::isfinite(*middle) ? *middle : 0.0;
-  }
-  return 0.0;
+double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn) {
+  const std::size_t n = knn.size();
+  if (n == 0 || positions.size() != n) return 0.0;
+  std::vector<double> rms(n, 0.0);
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+    const std::size_t begin = knn.offsets[i], end = knn.offsets[i + 1];
+    const double m = double(end - begin + 1);
+    if (m < 4) return;
+    Vec3 mean = positions[i];
+    for (std::size_t e = begin; e < end; ++e) mean += positions[knn.neighbors[e]];
+    mean /= m;
+    Mat3 cov = (positions[i] - mean) * (positions[i] - mean).transpose();
+    for (std::size_t e = begin; e < end; ++e) {
+      const Vec3 d = positions[knn.neighbors[e]] - mean;
+      cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat3> eigen(cov / m, Eigen::EigenvaluesOnly);
+    rms[i] = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) * m / (m - 3));
+  });
+  const auto middle = rms.begin() + std::ptrdiff_t((n - 1) / 2);
+  std::nth_element(rms.begin(), middle, rms.end());
+  return *middle;
 }
 
 std::vector<std::vector<std::uint8_t>> regionPlanarity(const std::vector<Vec3>& positions,

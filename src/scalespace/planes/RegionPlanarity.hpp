@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/RegionGraph.hpp"
 
 namespace scalespace {
@@ -19,17 +20,18 @@ struct PlanarityOptions {
   /// thesis' graph).
   double maxRelativeRms = 0.05;
   /// Sensor noise puts a flat region's RMS at sigma whatever its scale, so 5% of a scale below
-  /// 20 sigma cannot hold: the floor is noiseFactor times the noise (regionNoiseRms).
+  /// 20 sigma cannot hold: the floor is noiseFactor times the noise (pointNoiseRms).
   double noiseFactor = 2.0;
 };
 
 /// OptionError naming the field unless maxRelativeRms and noiseFactor are finite and >= 0.
 void validate(const PlanarityOptions& options);
 
-/// The sensor noise as the regions see it: the lower median plane RMS of the regions of the
-/// finest level that has any (at the finest scales regions are small flat patches whose RMS is
-/// the noise), or 0 when no level has a region.
-double regionNoiseRms(const std::vector<Vec3>& positions, const std::vector<RegionLevel>& levels);
+/// The sensor noise: the median over the points of the RMS distance of the point and its graph
+/// neighbours to their least-squares plane (sqrt of the covariance's smallest eigenvalue, times
+/// sqrt(m / (m - 3)) for the m points, the plane's three degrees of freedom), or 0 for an empty
+/// graph. On flat parts it is the noise's sigma; curvature and edges touch few points.
+double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn);
 
 /// Per level and region, 1 when the region is planar (PlanarityOptions), else 0: the kinds that
 /// buildRegionGraph keeps apart. Parallel over regions; independent of the thread count.

@@ -124,7 +124,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
     timings.filtering += slot.timings.filtering;
     levels.push_back(std::move(slot.level));
   }
-  out.detection = buildPlaneDetection(positions, std::move(levels), options, timings, progress);
+  out.detection = buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn),
+                                      options, timings, progress);
   out.totalSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return out;
@@ -146,7 +147,8 @@ PlaneDetection detectPlanesFromStack(const PointCloud& cloud, const ScaleStackRe
         positions, knn, scaleFeaturesFromLayer(stack.readScale(j), stack.info().scales[j]), options,
         timings));
   }
-  return buildPlaneDetection(positions, std::move(levels), options, timings, progress);
+  return buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn), options,
+                             timings, progress);
 }
 
 }  // namespace scalespace
