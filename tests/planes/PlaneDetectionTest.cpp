@@ -184,6 +184,7 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   EXPECT_EQ(split.components[0].deathLevel, 0);
   EXPECT_FALSE(split.components[1].planar);
   const PlaneModel model = makePlaneModel(split);
+  EXPECT_TRUE(model.planaritySplit);
   const std::vector<int> labels = labelsByPersistence(model, 0);
   EXPECT_EQ(labels[0], 0);  // a patch point: the planar component, not the flagged chain
   EXPECT_EQ(labels[1], 1);  // a cap point: only the flagged one holds it
@@ -191,6 +192,8 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   const PlaneDetection chained = buildPlaneDetection(pts, levels, 0.0, options, {});
   ASSERT_EQ(chained.components.size(), 1u);
   EXPECT_FALSE(chained.components[0].planar);
+  EXPECT_FALSE(makePlaneModel(chained).planaritySplit);  // Sec. 2.4.1's labels, no preference
+  EXPECT_THROW(buildPlaneDetection(pts, levels, -1.0, options, {}), OptionError);
   EXPECT_EQ(chained.components[0].persistence, 1);
 }
 

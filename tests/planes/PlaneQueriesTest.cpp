@@ -216,6 +216,8 @@ TEST(PlaneExport, ModelRoundTripAndFiles) {
   EXPECT_EQ(input, "in.ply");
   EXPECT_EQ(back.scales, s.model.scales);
   EXPECT_EQ(back.membership.ids, s.model.membership.ids);
+  EXPECT_EQ(back.planaritySplit, s.model.planaritySplit);
+  EXPECT_TRUE(back.planaritySplit);  // the default options split chains by planarity
   ASSERT_EQ(back.components.size(), s.model.components.size());
   for (std::size_t c = 0; c < back.components.size(); ++c) {
     const auto& a = s.model.components[c];

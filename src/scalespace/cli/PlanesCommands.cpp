@@ -179,8 +179,10 @@ void addSegmentCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--output", args->output, "output cloud (.ply ...)")->required();
-  auto* pers = cmd->add_option("--min-persistence", args->minPersistence,
-                               "components with persistence >= P (most persistent per point)");
+  auto* pers = cmd->add_option(
+      "--min-persistence", args->minPersistence,
+      "components with persistence >= P (per point the most persistent, a planar one "
+      "before a flagged one)");
   auto* scale =
       cmd->add_option("--scale", args->scale, "segmentation at the computed scale nearest to T");
   auto* brush = cmd->add_option(

@@ -55,8 +55,9 @@ std::vector<PlaneComponent> extractComponents(const RegionGraph& graph,
   tracker.finish();
   // Sensor noise puts the RMS of a flat component at sigma whatever its scale, so 5% of a scale
   // below 20 sigma cannot hold (the table scan: 84% of its components, nearly all at t < 2 cm).
-  // The typical (lower median) component RMS is that noise: most components are small, fine
-  // ones. A plane describes its points when its RMS is within the larger of the two bounds.
+  // The noise is given (PlaneDetection::noiseRms, read from the points' neighbourhoods) or, as
+  // a fallback, the typical (lower median) component RMS: most components are small, fine ones.
+  // A plane describes its points when its RMS is within the larger of the two bounds.
   std::vector<double> rms;
   for (const PlaneComponent& c : out)
     if (c.plane.valid) rms.push_back(c.plane.rms);

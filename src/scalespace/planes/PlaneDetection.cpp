@@ -50,7 +50,10 @@ PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
   PlaneDetection result;
   result.timings = timings;
   auto start = std::chrono::steady_clock::now();
+  if (!(noiseRms >= 0) || !std::isfinite(noiseRms))
+    throw OptionError("plane detection: the noise RMS must be finite and >= 0");
   result.noiseRms = noiseRms;
+  result.planaritySplit = options.planarity.maxRelativeRms > 0;
   const auto planar = regionPlanarity(positions, levels, result.noiseRms, options.planarity);
   for (const auto& level : planar)
     result.nonPlanarRegions += std::size_t(std::count(level.begin(), level.end(), 0));

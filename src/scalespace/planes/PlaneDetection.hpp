@@ -34,6 +34,7 @@ struct PlaneDetection {
   /// (pointNoiseRms), and how many regions are not planar (kept, linked to no planar one).
   double noiseRms = 0.0;
   std::size_t nonPlanarRegions = 0;
+  bool planaritySplit = false;  // planarity.maxRelativeRms > 0: chains split, labels prefer planar
   std::vector<PlaneComponent> components;  // same ids as graph.components
   PlaneDetectionTimings timings;
   int scaleCount() const { return int(graph.levels.size()); }
@@ -59,6 +60,8 @@ PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
                                    const ProgressCallback& progress = {});
 
 /// Runs Sec. 2.3 on precomputed scale features (increasing t) and the k-NN graph of `positions`.
+/// With the default step limit (growing.maxStep > 0) the features must carry their projections
+/// (OptionError otherwise; growing.maxStep = 0 is the thesis' angle-only criterion).
 PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& knn,
                             const std::vector<ScaleFeatures>& scales,
                             const PlaneDetectionOptions& options = {},

@@ -30,6 +30,7 @@ void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std:
   root["point_count"] = model.membership.pointCount;
   root["scales"] = model.scales;
   root["persistence_definition"] = "death_level - birth_level";
+  root["planarity_split"] = model.planaritySplit;
   nlohmann::json list = nlohmann::json::array();
   for (const PlaneComponent& c : model.components) {
     nlohmann::json j;
@@ -251,6 +252,7 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
   std::string where;  // the component being read, for the message
   try {
     model.scales = root.at("scales").get<std::vector<double>>();
+    model.planaritySplit = root.value("planarity_split", false);  // absent before the split
     if (input) *input = root.at("input").get<std::string>();
     for (const auto& j : root.at("components")) {
       where = "component " + std::to_string(model.components.size());

@@ -15,6 +15,7 @@ PlaneModel makePlaneModel(const PlaneDetection& detection) {
   for (const auto& level : g.levels) model.scales.push_back(level.t);
   model.components = detection.components;
   model.membership = pointMembership(g);
+  model.planaritySplit = detection.planaritySplit;
   return model;
 }
 
@@ -47,6 +48,8 @@ std::vector<int> persistenceOf(const PlaneModel& model) {
 }  // namespace
 
 std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence) {
+  if (!model.planaritySplit)
+    return labelsByPersistence(model.membership, persistenceOf(model), minPersistence);
   std::vector<std::uint8_t> planar;
   for (const PlaneComponent& c : model.components) planar.push_back(c.planar);
   return labelsByPersistence(model.membership, persistenceOf(model), minPersistence, &planar);

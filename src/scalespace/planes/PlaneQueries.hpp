@@ -13,14 +13,18 @@ struct PlaneModel {
   std::vector<double> scales;  // t_j, increasing
   std::vector<PlaneComponent> components;
   PointMembership membership;
+  /// Whether the chains were split by planarity (PlaneDetection::planaritySplit): then the
+  /// persistence labels prefer planar components. False for the thesis' graph and for results
+  /// written before the split existed (components.json "planarity_split").
+  bool planaritySplit = false;
   int scaleCount() const { return int(scales.size()); }
 };
 
 PlaneModel makePlaneModel(const PlaneDetection& detection);
 
 /// Sec. 2.4.1: per point, the most persistent component with pers >= minPersistence holding it
-/// at any level (lower id on ties), or -1; a planar component beats a flagged one (a departure:
-/// docs/THESIS_NOTES.md, planarity split; with every component planar it is Sec. 2.4.1's rule).
+/// at any level (lower id on ties), or -1. With the planarity split (model.planaritySplit) a
+/// planar component beats a flagged one (a departure: docs/THESIS_NOTES.md, planarity split).
 std::vector<int> labelsByPersistence(const PlaneModel& model, int minPersistence);
 
 /// Level whose scale is nearest to t on a log scale (the scales are log-spaced, Eq. 1.40).

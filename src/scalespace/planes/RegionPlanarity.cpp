@@ -33,7 +33,7 @@ std::vector<double> regionRms(const std::vector<Vec3>& positions, const RegionLe
 double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn) {
   const std::size_t n = knn.size();
   if (n == 0 || positions.size() != n) return 0.0;
-  std::vector<double> rms(n, 0.0);
+  std::vector<double> rms(n, std::numeric_limits<double>::quiet_NaN());
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     const std::size_t begin = knn.offsets[i], end = knn.offsets[i + 1];
     const double m = double(end - begin + 1);
@@ -49,7 +49,11 @@ double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn) {
     const Eigen::SelfAdjointEigenSolver<Mat3> eigen(cov / m, Eigen::EigenvaluesOnly);
     rms[i] = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) * m / (m - 3));
   });
-  const auto middle = rms.begin() + std::ptrdiff_t((n - 1) / 2);
+  // Points with too few neighbours for a plane read nothing (NaN), rather than 0.
+  rms.erase(std::remove_if(rms.begin(), rms.end(), [](double r) { return !std::isfinite(r); }),
+            rms.end());
+  if (rms.empty()) return 0.0;
+  const auto middle = rms.begin() + std::ptrdiff_t((rms.size() - 1) / 2);
   std::nth_element(rms.begin(), middle, rms.end());
   return *middle;
 }

@@ -243,7 +243,8 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
           "t"_a, "The level whose scale is nearest to t (log scale).")
       .def("labels_by_persistence", &Planes::byPersistence, "min_persistence"_a,
            "`segment --min-persistence P`: per point the most persistent component with "
-           "persistence >= P.")
+           "persistence >= P (a planar one before a flagged one when the chains were split "
+           "by planarity).")
       .def("labels_at_scale", &Planes::atScale, "t"_a, "min_persistence"_a = 0,
            "`segment --scale T`: the components at the computed scale nearest to t.")
       .def("rank_by_brush", &Planes::brush, "indices"_a,
@@ -280,8 +281,9 @@ scales: M log-spaced scales; alpha: the stack's Poisson-disk factor; angle: regi
 (degrees); max_step: the largest step (fraction of t) a region crosses along its seed's normal
 (0.05; 0: the angle alone, Sec. 2.3.1); max_rms: regions whose plane RMS exceeds this fraction of
 t and twice the noise are not planar, never linked to planar ones and their components flagged
-(0.05; 0: the graph of Sec. 2.3.2); robust: the robust APSS of Sec. 2.3. stack: a stack folder computed from these points instead of computing
-one. output: also write the result folder (input: the cloud file to record in it).)doc");
+(0.05; 0: the graph of Sec. 2.3.2); robust: the robust APSS of Sec. 2.3. stack: a stack folder
+computed from these points instead of computing one. output: also write the result folder
+(input: the cloud file to record in it).)doc");
   m.def(
       "read_planes",
       [](const std::string& directory) {
