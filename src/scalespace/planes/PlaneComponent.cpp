@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "scalespace/scales/ScaleSeries.hpp"
+
 namespace scalespace {
 
 const std::vector<Index>& componentPointsAt(const RegionGraph& graph, int id, int level) {
@@ -62,11 +64,7 @@ std::vector<PlaneComponent> extractComponents(const RegionGraph& graph,
   for (const PlaneComponent& c : out)
     if (c.plane.valid) rms.push_back(c.plane.rms);
   double noise = options.noiseRms;
-  if (noise < 0 && rms.empty()) noise = 0;
-  if (noise < 0) {
-    std::nth_element(rms.begin(), rms.begin() + (rms.size() - 1) / 2, rms.end());
-    noise = rms[(rms.size() - 1) / 2];
-  }
+  if (noise < 0) noise = rms.empty() ? 0.0 : lowerMedian(std::move(rms));
   for (PlaneComponent& c : out)
     c.planar =
         c.plane.valid && c.plane.rms <= std::max(options.maxRelativeRms * c.representativeScale,

@@ -1,14 +1,15 @@
 #include "scalespace/planes/RegionPlanarity.hpp"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/planes/AlphaShapeArea.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
 
 namespace scalespace {
 
@@ -34,28 +35,20 @@ double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn) {
   const std::size_t n = knn.size();
   if (n == 0 || positions.size() != n) return 0.0;
   std::vector<double> rms(n, std::numeric_limits<double>::quiet_NaN());
-  tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-    const std::size_t begin = knn.offsets[i], end = knn.offsets[i + 1];
-    const double m = double(end - begin + 1);
-    if (m < 4) return;
-    Vec3 mean = positions[i];
-    for (std::size_t e = begin; e < end; ++e) mean += positions[knn.neighbors[e]];
-    mean /= m;
-    Mat3 cov = (positions[i] - mean) * (positions[i] - mean).transpose();
-    for (std::size_t e = begin; e < end; ++e) {
-      const Vec3 d = positions[knn.neighbors[e]] - mean;
-      cov += d * d.transpose();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const auto& range) {
+    std::vector<Index> patch;  // the point and its neighbours, reused along the range
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      patch.assign(1, Index(i));
+      patch.insert(patch.end(), knn.neighbors.begin() + std::ptrdiff_t(knn.offsets[i]),
+                   knn.neighbors.begin() + std::ptrdiff_t(knn.offsets[i + 1]));
+      const double m = double(patch.size());
+      if (m < 4) continue;  // too few for a plane: reads nothing rather than 0
+      rms[i] = fitPlane(positions, patch).rms * std::sqrt(m / (m - 3));
     }
-    const Eigen::SelfAdjointEigenSolver<Mat3> eigen(cov / m, Eigen::EigenvaluesOnly);
-    rms[i] = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) * m / (m - 3));
   });
-  // Points with too few neighbours for a plane read nothing (NaN), rather than 0.
   rms.erase(std::remove_if(rms.begin(), rms.end(), [](double r) { return !std::isfinite(r); }),
             rms.end());
-  if (rms.empty()) return 0.0;
-  const auto middle = rms.begin() + std::ptrdiff_t((rms.size() - 1) / 2);
-  std::nth_element(rms.begin(), middle, rms.end());
-  return *middle;
+  return rms.empty() ? 0.0 : lowerMedian(std::move(rms));
 }
 
 std::vector<std::vector<std::uint8_t>> regionPlanarity(const std::vector<Vec3>& positions,
