@@ -44,18 +44,23 @@ def main():
         print(f"retain_freed_memory(): {ss.retain_freed_memory()}")
     print(f"{args.points} points, curvature scale_k={args.scale_k}, W3, {args.runs} runs each")
 
-    walls, libs = [], []
+    walls, libs, ins, outs = [], [], [], []
     for _ in range(args.runs):
         start = time.perf_counter()
         columns, summary = ss.curvature(points, normals, scale_k=args.scale_k, summary=True)
         walls.append(time.perf_counter() - start)
         libs.append(summary["library_seconds"])
+        ins.append(summary["input_seconds"])
+        outs.append(summary["output_seconds"])
         del columns
     overheads = [w - c for w, c in zip(walls, libs)]
-    k = overheads.index(statistics.median(overheads))
+    k = overheads.index(statistics.median_low(overheads))
     print(f"curvature(): wall {walls[k]:.3f} s, the library call {libs[k]:.3f} s, "
           f"overhead {1e3 * overheads[k]:.1f} ms = {100 * overheads[k] / libs[k]:.2f}% "
           f"(median run; all overheads ms: {', '.join(f'{1e3 * o:.1f}' for o in overheads)})")
+    print(f"  of which: points and normals checked and copied in {1e3 * ins[k]:.1f} ms, "
+          f"columns out and the copies freed {1e3 * outs[k]:.1f} ms, "
+          f"the rest (call, worker thread, summary) {1e3 * (overheads[k] - ins[k] - outs[k]):.1f} ms")
 
     # Points that are not float64 C-contiguous are converted once: the cost of that copy.
     fortran = np.asfortranarray(points)

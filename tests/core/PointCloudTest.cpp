@@ -1,4 +1,8 @@
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <limits>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/PointCloud.hpp"
@@ -77,4 +81,34 @@ TEST(PointCloud, SetAttributesChecksSizesAndNames) {
                Error);
   cloud.setAttributes({AttributeColumn{"a", ScalarType::UInt8, {1, 2}}});
   EXPECT_EQ(cloud.findAttribute("a")->values[1], 2);
+}
+
+TEST(PointCloud, LargeInputsCopyInBlocksWithTheSameOriginForAnyThreadCount) {
+  // Enough points for several parallel blocks; the extreme coordinates sit in the last block and
+  // a non-finite point (which bounds skip) in the first, so a block-wise bound that lost either
+  // would move the origin.
+  const std::size_t n = 200000;
+  std::vector<Vec3> abs(n), normals(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    abs[i] = Vec3(5e5 + double(i % 1000), 4e6 + double(i / 1000), 10.0 + double(i % 7));
+    normals[i] = Vec3(double(i % 3), 1.0, -double(i % 5)).normalized();
+  }
+  abs[n - 1] = Vec3(5e5 + 7777.25, 4e6 - 3333.5, -99.0);
+  PointCloud reference;
+  {
+    tbb::task_arena one(1);
+    one.execute([&] { reference.setAbsolutePositions(abs); });
+  }
+  abs[0] = Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0);
+  PointCloud cloud;
+  cloud.setAbsolutePositions(abs);
+  cloud.setNormals(normals.data(), normals.size());
+  EXPECT_EQ(cloud.origin(), Vec3(503889.0, 3998433.0, -42.0));  // rounded bounding-box centre
+  EXPECT_EQ(cloud.origin(), reference.origin());
+  for (std::size_t i = 1; i < n; i += 997) {
+    EXPECT_EQ(cloud.absolutePosition(i), abs[i]);
+    EXPECT_EQ(cloud.normals()[i], normals[i]);
+  }
+  EXPECT_EQ(cloud.absolutePosition(n - 1), abs[n - 1]);
+  EXPECT_THROW(cloud.setNormals(normals.data(), n - 1), Error);
 }

@@ -355,6 +355,23 @@ def test_bad_arrays_raise_with_the_message(points, error, message):
     assert message in str(e.value)
 
 
+def test_large_arrays_are_checked_and_copied_exactly(tmp_path):
+    # 300k georeferenced points: checked and copied in parallel blocks, which must name the first
+    # bad row, keep every coordinate bit for bit, and time themselves in the summary.
+    rng = np.random.default_rng(3)
+    points = np.array([652000.0, 5412000.0, 300.0]) + rng.uniform(0, 100, size=(300_000, 3))
+    ss.write(str(tmp_path / "big.ply"), points)
+    np.testing.assert_array_equal(ss.read(str(tmp_path / "big.ply")).points, points)
+    bad = points.copy()
+    bad[290_000, 2] = np.nan
+    bad[170_001, 0] = np.inf
+    with pytest.raises(ValueError, match=r"points: row 170001: point 170002 has a NaN"):
+        ss.curvature(bad, scale_k=10)
+    _, summary = ss.curvature(points[:20_000], scale_k=10, summary=True)
+    assert 0 <= summary["input_seconds"] < summary["library_seconds"]
+    assert 0 <= summary["output_seconds"] < summary["library_seconds"]
+
+
 def test_bad_values_and_options_raise_with_the_library_message(tmp_path):
     p = sphere_points(500)
     q = p.copy()

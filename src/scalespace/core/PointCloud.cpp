@@ -1,7 +1,12 @@
 #include "scalespace/core/PointCloud.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scalespace/core/Error.hpp"
 
@@ -55,26 +60,59 @@ void PointCloud::setAbsolutePositions(const std::vector<Vec3>& absolute) {
   setAbsolutePositions(absolute.data(), absolute.size());
 }
 
-void PointCloud::setAbsolutePositions(const Vec3* absolute, std::size_t count) {
-  Vec3 lo = Vec3::Constant(0), hi = Vec3::Constant(0);
-  bool first = true;
-  for (std::size_t i = 0; i < count; ++i) {
-    const Vec3& p = absolute[i];
-    if (!p.allFinite()) continue;  // readers reject non-finite points; be defensive here
-    if (first) {
-      lo = hi = p;
-      first = false;
-    } else {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+namespace {
+
+// Large inputs (a NumPy array of 1M points, a reader's buffer) are bounded and copied in parallel
+// blocks: the copy is memory-bound and its page faults are paid per thread. Min and max are exact
+// in any order, so the origin does not depend on the thread count.
+constexpr std::size_t kCopyGrain = std::size_t(1) << 15;
+
+struct Bounds {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  void add(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
   }
+  void add(const Bounds& o) {
+    lo = lo.cwiseMin(o.lo);
+    hi = hi.cwiseMax(o.hi);
+  }
+  bool empty() const { return !(lo.array() <= hi.array()).all(); }
+};
+
+Bounds finiteBounds(const Vec3* points, std::size_t count) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, count, kCopyGrain), Bounds(),
+      [&](const tbb::blocked_range<std::size_t>& r, Bounds b) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          if (points[i].allFinite()) b.add(points[i]);  // readers reject the others; be defensive
+        return b;
+      },
+      [](Bounds a, const Bounds& b) {
+        a.add(b);
+        return a;
+      });
+}
+
+void copyShifted(const Vec3* from, std::size_t count, const Vec3& shift, std::vector<Vec3>& to) {
+  to.resize(count);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kCopyGrain),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) to[i] = from[i] - shift;
+                    });
+}
+
+}  // namespace
+
+void PointCloud::setAbsolutePositions(const Vec3* absolute, std::size_t count) {
+  const Bounds b = finiteBounds(absolute, count);
+  const Vec3 lo = b.empty() ? Vec3::Zero() : b.lo, hi = b.empty() ? Vec3::Zero() : b.hi;
   // An integer origin keeps p - origin exact (both are multiples of ulp(p) and |p - o| <= |p|
   // whenever the cloud does not straddle far from its centre); small clouds keep origin 0.
   const Vec3 centre = 0.5 * lo + 0.5 * hi;  // lo + hi would overflow near DBL_MAX
   origin_ = centre.cwiseAbs().maxCoeff() < 1e3 ? Vec3::Zero() : Vec3(centre.array().round());
-  positions_.resize(count);
-  for (std::size_t i = 0; i < count; ++i) positions_[i] = absolute[i] - origin_;
+  copyShifted(absolute, count, origin_, positions_);
   resizeColumns();
 }
 
@@ -89,6 +127,13 @@ void PointCloud::setNormals(std::vector<Vec3> normals) {
     throw Error("PointCloud::setNormals: " + std::to_string(normals.size()) + " normals for " +
                 std::to_string(positions_.size()) + " points");
   normals_ = std::move(normals);
+}
+
+void PointCloud::setNormals(const Vec3* normals, std::size_t count) {
+  if (count != positions_.size())
+    throw Error("PointCloud::setNormals: " + std::to_string(count) + " normals for " +
+                std::to_string(positions_.size()) + " points");
+  copyShifted(normals, count, Vec3::Zero(), normals_);
 }
 
 PointCloud::PointCloud(const PointCloud& other)

@@ -103,6 +103,8 @@ class PointCloud {
   std::vector<Vec3>& normals() { return normals_; }
   /// Sets normals (size must equal size()); pass an empty vector to remove them.
   void setNormals(std::vector<Vec3> normals);
+  /// Same from `count` (= size()) packed normals, e.g. a NumPy array's buffer.
+  void setNormals(const Vec3* normals, std::size_t count);
 
   AttributeColumns attributes() const { return AttributeColumns(attributes_); }
   /// Replaces every column (each of size() values, names unique; Error otherwise).

@@ -1,7 +1,10 @@
 #include "scalespace/python/Bridge.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
@@ -165,13 +168,21 @@ Points asPoints(const py::handle& object, const char* name) {
   if (p.size == 0)
     throwValue(std::string(name) + ": the array holds no points (nothing to analyse)");
   // The readers' policy (io/CloudBuilder.hpp) and wording, with the row for the place in the file.
-  for (std::size_t i = 0; i < p.size; ++i)
-    if (!io_detail::isUsablePosition(p.data[i]))
-      throwValue(FileError(name, "row " + std::to_string(i),
-                           "point " + std::to_string(i + 1) +
-                               " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
-                           "remove such rows, e.g. points[np.isfinite(points).all(axis=1)]")
-                     .what());
+  // The first unusable row, found in parallel blocks (a 1M-point check is a few ms alone).
+  const std::size_t i = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, p.size, std::size_t(1) << 15), p.size,
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t first) {
+        for (std::size_t j = r.begin(); j < std::min(r.end(), first); ++j)
+          if (!io_detail::isUsablePosition(p.data[j])) return j;
+        return first;
+      },
+      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+  if (i < p.size)
+    throwValue(FileError(name, "row " + std::to_string(i),
+                         "point " + std::to_string(i + 1) +
+                             " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
+                         "remove such rows, e.g. points[np.isfinite(points).all(axis=1)]")
+                   .what());
   return p;
 }
 
@@ -188,7 +199,7 @@ PointCloud makeCloud(const Points& points, const py::handle& normals) {
   cloud.setAbsolutePositions(points.data, points.size);
   if (!normals.is_none()) {
     const Points n = asVectors(normals, points.size, "normals");
-    cloud.setNormals(std::vector<Vec3>(n.data, n.data + n.size));
+    cloud.setNormals(n.data, n.size);
   }
   return cloud;
 }

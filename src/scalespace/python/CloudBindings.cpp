@@ -16,6 +16,10 @@
 namespace scalespace::python {
 namespace {
 
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 py::dict readCloudPy(const std::string& path, bool dropInvalid, std::size_t sample,
                      std::uint64_t seed) {
   ReadOptions options;
@@ -103,7 +107,11 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
   options.scale = scale.value_or(0);
   options.scaleK = scaleK.value_or(0);
   validateCurvatureOptions(options);
+  // The cost of the binding itself is timed apart (summary's input/output_seconds): checking and
+  // copying the arrays in, handing the columns out and freeing the copies.
+  const auto inputStart = std::chrono::steady_clock::now();
   PointCloud cloud = makeCloud(asPoints(points), normals);
+  const double inputSeconds = secondsSince(inputStart);
   if (std::size_t(options.scaleK) >= cloud.size())
     throw OptionError("scale_k " + std::to_string(options.scaleK) +
                       " must be smaller than the number of points (" +
@@ -115,12 +123,12 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
     if (estimated) estimateAndOrient(cloud, k, "mst", std::nullopt, call.progress());
     const auto start = std::chrono::steady_clock::now();
     CurvatureSummary s = computeCurvatureColumns(cloud, options, call.progress());
-    librarySeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    librarySeconds = secondsSince(start);
     return s;
   });
   warn(summary.warnings);
   // The columns, moved out of the cloud (no copy), under the names `scalespace curvature` writes.
+  const auto outputStart = std::chrono::steady_clock::now();
   py::dict out;
   for (const std::string& name : curvatureColumnNames()) {
     AttributeColumn* column = cloud.findAttribute(name);
@@ -128,6 +136,8 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
     const bool integer = isIntegerType(column->type);
     out[py::str(name)] = columnToArray(std::move(*column), integer);
   }
+  cloud = PointCloud();  // the copies of the inputs, freed here to be timed
+  const double outputSeconds = secondsSince(outputStart);
   if (!withSummary) return std::move(out);
   // What `scalespace curvature` writes in its JSON summary.
   py::dict s;
@@ -137,6 +147,8 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
   s["median_scale"] = summary.medianScale;
   s["seconds"] = summary.seconds;
   s["library_seconds"] = librarySeconds;
+  s["input_seconds"] = inputSeconds;
+  s["output_seconds"] = outputSeconds;
   s["normals_estimated"] = estimated;
   s["warnings"] = summary.warnings;
   return py::make_tuple(out, s);
@@ -277,7 +289,9 @@ curv_mean curv_max curv_min dir_max_x .. dir_min_z gls_tau gls_kappa gls_fitness
 (float64), neighbors (int32), fit_valid (uint8; 0: invalid fit, zeros elsewhere).
 Most fits invalid: a RuntimeWarning says why. summary=True returns (columns, summary): the
 figures of the CLI's JSON summary (points, invalid_fits, mean_neighbors, median_scale, seconds:
-the fits' time, library_seconds: the whole library call's, normals_estimated, warnings).)doc");
+the fits' time, library_seconds: the whole library call's, input_seconds and output_seconds: the
+binding's own time to check and copy the arrays in and to hand the columns out, normals_estimated,
+warnings).)doc");
   m.def("render", &renderPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "colors"_a = py::none(), "labels"_a = py::none(), "values"_a = py::none(), "view"_a = "iso",
         "up"_a = "z", "width"_a = 1024, "height"_a = 768, "point_radius"_a = -1, "shading"_a = true,
