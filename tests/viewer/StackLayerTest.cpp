@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 
@@ -112,8 +113,9 @@ TEST_P(StackViewer, ValuesAreTheReadersAtEveryScaleForEveryQuantity) {
           differ += std::memcmp(&values[k], &expected, 4) != 0;
         }
         EXPECT_EQ(differ, 0u) << name << " at scale " << j;
-        if (name == "curv_max" || name == "fit_valid")  // not a trivial answer: the fits are valid
+        if (name == "curv_max" || name == "fit_valid") {  // not trivial: the fits are valid
           EXPECT_GT(*std::max_element(values.begin(), values.end()), 0.1f) << name;
+        }
       }
     }
   }
