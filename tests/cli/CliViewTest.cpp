@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "cli/CliTestSupport.hpp"
@@ -144,6 +145,57 @@ TEST_F(CliView, ServesAPlainCloud) {
   EXPECT_EQ(positions.second.size(), 2000u * 12);
   EXPECT_EQ(view.get("/api/planes/labels?level=0&token=" + view.token).first, 404);
   EXPECT_EQ(view.stop(), 0);
+}
+
+TEST_F(CliView, ServesAStackWithTheValuesOfExport) {
+  ASSERT_EQ(run("generate sphere -n 2000 -o " + path("s.ply") + " -q").code, 0);
+  ASSERT_EQ(run("scales " + path("s.ply") + " -o " + path("s.stack") + " --scales 4 -q").code, 0);
+  ViewProcess view({path("s.stack"), "--no-browser", "-q"});
+  ASSERT_GT(view.port, 0) << "no URL printed";
+  const auto manifest = view.get("/api/manifest?token=" + view.token);
+  ASSERT_EQ(manifest.first, 200);
+  EXPECT_NE(manifest.second.find("\"kind\":\"stack\""), std::string::npos) << manifest.second;
+  EXPECT_EQ(view.get("/api/cloud/positions?token=" + view.token).second.size(), 2000u * 12);
+  const auto values = view.get("/api/stack/values?quantity=curv_mean&scale=1&token=" + view.token);
+  ASSERT_EQ(values.first, 200);
+  ASSERT_EQ(values.second.size(), 2000u * 4);
+  ASSERT_EQ(run("export " + path("s.stack") + " --scale 1 -o " + path("s1.ply") + " -q").code, 0);
+  const PointCloud exported = readCloud(path("s1.ply"));
+  const AttributeColumn* h = exported.findAttribute("curv_mean");
+  ASSERT_NE(h, nullptr);
+  for (std::size_t i = 0; i < 2000; ++i) {
+    float v;
+    std::memcpy(&v, values.second.data() + 4 * i, 4);
+    ASSERT_EQ(v, float(h->values[i])) << "point " << i;
+  }
+  EXPECT_EQ(view.get("/api/stack/values?quantity=curv_mean&scale=4&token=" + view.token).first,
+            400);
+  EXPECT_EQ(view.get("/api/stack/series?point=2000&token=" + view.token).first, 400);
+  EXPECT_EQ(view.stop(), 0);
+}
+
+TEST_F(CliView, DrawsLinesOverACloudAndAlone) {
+  ASSERT_EQ(run("generate torus -n 3000 -o " + path("t.ply") + " -q").code, 0);
+  const Result lines = run("lines " + path("t.ply") + " -o " + path("l.ply") + " --scales 1 -q");
+  ASSERT_EQ(lines.code, 0) << lines.err;
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{path("t.ply"), "--lines", path("l.ply")},
+        std::vector<std::string>{path("l.ply")}}) {
+    std::vector<std::string> all = args;
+    all.insert(all.end(), {"--no-browser", "-q"});
+    ViewProcess view(all);
+    ASSERT_GT(view.port, 0) << "no URL printed";
+    const auto manifest =
+        nlohmann::json::parse(view.get("/api/manifest?token=" + view.token).second);
+    const std::size_t segments = manifest.at("lines").at("segment_count");
+    EXPECT_GT(segments, 0u);
+    EXPECT_EQ(view.get("/api/lines/segments?token=" + view.token).second.size(), 8 * segments);
+    EXPECT_EQ(view.stop(), 0);
+  }
+  const Result notLines =
+      run("view " + path("t.ply") + " --lines " + path("t.ply") + " --no-browser");
+  EXPECT_NE(notLines.code, 0);
+  EXPECT_NE(notLines.err.find("edge element"), std::string::npos) << notLines.err;
 }
 
 TEST_F(CliView, DecimatesBeyondThePointBudget) {

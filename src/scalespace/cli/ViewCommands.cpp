@@ -8,17 +8,21 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <thread>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/io/Polylines.hpp"
 #include "scalespace/planes/PlaneExport.hpp"
 #include "scalespace/scales/ScaleStackReader.hpp"
 #include "scalespace/viewer/CloudLayer.hpp"
+#include "scalespace/viewer/LinesLayer.hpp"
 #include "scalespace/viewer/PageAssets.hpp"
 #include "scalespace/viewer/PlanesLayer.hpp"
+#include "scalespace/viewer/StackLayer.hpp"
 #include "scalespace/viewer/ViewerServer.hpp"
 #include "scalespace/viewer/ViewerToken.hpp"
 
@@ -31,7 +35,7 @@ namespace fs = std::filesystem;
 namespace {
 
 struct ViewArgs {
-  std::string path, input, exportDir = ".";
+  std::string path, input, lines, exportDir = ".";
   int port = 0;
   std::size_t pointBudget = 4000000;
   bool noBrowser = false, quiet = false;
@@ -63,15 +67,52 @@ void openBrowser(const std::string& url, bool quiet) {
   std::thread([pid] { waitpid(pid, nullptr, 0); }).detach();  // no zombie left behind
 }
 
-std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayers(const ViewArgs& args,
-                                                             nlohmann::json& source) {
+// True when `path` is a PLY file whose header declares an edge element (a polyline file, as
+// `scalespace lines` writes): only the header's text is looked at, readPolylines parses the file.
+bool isPolylinePly(const std::string& path) {
+  const std::string extension = fs::path(path).extension().string();
+  if (extension != ".ply" && extension != ".PLY") return false;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int k = 0; k < 1000 && std::getline(in, line); ++k) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return false;
+    if (line.rfind("element edge ", 0) == 0) return true;
+  }
+  return false;
+}
+
+// A scale stack: its input positions (or the --input cloud, checked to be the stack's input, with
+// its own attributes) as the cloud, the stack's quantities over them.
+void loadStack(const ViewArgs& args, nlohmann::json& source,
+               std::vector<std::unique_ptr<viewer::ViewerLayer>>& layers) {
+  auto reader = std::make_shared<const ScaleStackReader>(args.path);
+  std::shared_ptr<PointCloud> cloud;
+  if (!args.input.empty()) {
+    InputOptions input;
+    input.path = args.input;
+    cloud = std::make_shared<PointCloud>(loadCloud(input, args.quiet));
+    reader->checkInput(*cloud, args.input);
+  } else {
+    cloud = std::make_shared<PointCloud>();
+    cloud->setAbsolutePositions(reader->inputPositions());
+  }
+  const viewer::DisplaySample sample = viewer::displaySampleFor(cloud->size(), args.pointBudget);
+  source = {{"path", args.path}, {"kind", "stack"}};
+  if (!args.input.empty()) source["input"] = args.input;
+  layers.push_back(std::make_unique<viewer::CloudLayer>(cloud, sample));
+  layers.push_back(std::make_unique<viewer::StackLayer>(reader, sample));
+}
+
+std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const ViewArgs& args,
+                                                                         nlohmann::json& source) {
   std::vector<std::unique_ptr<viewer::ViewerLayer>> layers;
   std::error_code ec;
   if (fs::is_directory(args.path, ec)) {
-    if (isScaleStack(args.path))
-      throw OptionError(args.path +
-                        " is a scale stack: `view` opens clouds and `planes` results "
-                        "so far (stacks: issue 23, not done yet)");
+    if (isScaleStack(args.path)) {
+      loadStack(args, source, layers);
+      return layers;
+    }
     if (!isPlaneResult(args.path))
       throw FileError(args.path, "", "is a folder but not a `scalespace planes` result",
                       "pass a cloud file or the output folder of `scalespace planes`");
@@ -93,6 +134,18 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayers(const ViewArgs& arg
         std::make_unique<viewer::PlanesLayer>(std::move(model), cloud, sample, options));
     return layers;
   }
+  if (!args.input.empty())
+    throw OptionError("--input goes with a `planes` result or a scale stack, not with a file");
+  if (isPolylinePly(args.path)) {
+    // Lines alone: their vertices are the cloud (coloured by the same attributes).
+    PolylineSet lines = readPolylines(args.path);
+    auto cloud = std::make_shared<PointCloud>(lines.vertices);
+    source = {{"path", args.path}, {"kind", "lines"}};
+    layers.push_back(std::make_unique<viewer::CloudLayer>(
+        cloud, viewer::displaySampleFor(cloud->size(), args.pointBudget)));
+    layers.push_back(std::make_unique<viewer::LinesLayer>(std::move(lines), cloud->origin()));
+    return layers;
+  }
   InputOptions input;
   input.path = args.path;
   auto cloud = std::make_shared<PointCloud>(loadCloud(input, args.quiet));
@@ -102,13 +155,38 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayers(const ViewArgs& arg
   return layers;
 }
 
+// The layers of PATH, and the polylines of --lines over them (positions relative to the cloud's
+// origin, so that lines and points line up).
+std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayers(const ViewArgs& args,
+                                                             nlohmann::json& source) {
+  auto layers = loadLayersWithoutLines(args, source);
+  if (args.lines.empty()) return layers;
+  for (const auto& layer : layers)
+    if (layer->name() == "lines")
+      throw OptionError("--lines: " + args.path + " is a polyline file already");
+  if (!isPolylinePly(args.lines))
+    throw FileError(args.lines, "", "is not a PLY file with an edge element",
+                    "pass the .ply written by `scalespace lines` (its .obj has no attributes)");
+  PolylineSet lines = readPolylines(args.lines);
+  const auto origin = layers.front()->manifest().at("origin");
+  source["lines"] = args.lines;
+  layers.push_back(std::make_unique<viewer::LinesLayer>(
+      std::move(lines),
+      Vec3(origin[0].get<double>(), origin[1].get<double>(), origin[2].get<double>())));
+  return layers;
+}
+
 }  // namespace
 
 void addViewCommand(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "view", "explore a cloud or a `planes` result in the browser (local server, Sec. 2.4)");
-  cmd->add_option("path", args->path, "a cloud (.ply .las ...) or a `scalespace planes` folder")
+      "view",
+      "explore a cloud, a `planes` result, a scale stack or polylines in the browser (local "
+      "server, Sec. 2.4)");
+  cmd->add_option("path", args->path,
+                  "a cloud (.ply .las ...), a `scalespace planes` folder, a scale stack "
+                  "(`scalespace scales`) or a polyline .ply (`scalespace lines`)")
       ->required();
   cmd->add_option("--port", args->port, "port on 127.0.0.1 (0 = any free port)")
       ->capture_default_str()
@@ -124,7 +202,12 @@ void addViewCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--input", args->input,
-                  "the cloud the planes were computed on (default: the one recorded in PATH)");
+                  "the cloud the planes or the stack were computed on (default: the one recorded "
+                  "in PATH; for a stack, its stored input positions; given, its attributes can "
+                  "colour the points)");
+  cmd->add_option("--lines", args->lines,
+                  "polylines (.ply with an edge element, `scalespace lines`) drawn over PATH")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr (the URL still goes to stdout)");
   cmd->callback([args] {
     const auto start = std::chrono::steady_clock::now();

@@ -1,12 +1,16 @@
 // The page of `scalespace view`: draws what the server computes. Every query of Sec. 2.4
 // (persistence threshold, scale, brush, similarity) runs in the library on the server; the page
 // only turns the answers (per-point labels, rankings) into colours, the diagram and the table.
+// A scale stack's quantities (one scale for every point, one point for every scale) and a `lines`
+// result's polylines come from the server the same way.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { getBytes, getJson, post, postBytes } from './api.js';
 import { drawColorBar, labelColors, scalarColors } from './colors.js';
 import { PersistenceDiagram } from './diagram.js';
 import { BrushStroke } from './brush.js';
+import { colorLines, loadLines } from './lines.js';
+import { SeriesPlot } from './series.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -15,6 +19,8 @@ const state = {
   manifest: null, step: 1, count: 0, positions: null, labels: null, labelsQuery: null,
   components: [], selection: [], lastBrush: null, lastSimilar: null, lastExport: null,
   timings: [], firstFrameMs: null, busy: 0, error: null,
+  stackQuery: null, stackValues: null, stackRange: null, series: null,
+  linesSegments: 0, linesColorBy: null,
 };
 window.scalespace = state;
 
@@ -38,6 +44,8 @@ controls.screenSpacePanning = true;
 const upGroup = new THREE.Group();
 scene.add(upGroup);
 let points = null;
+let lines = null;   // THREE.LineSegments of the lines layer
+let marker = null;  // the clicked point (stack series)
 let frameWaiters = [];
 let frameRequested = false;
 
@@ -148,14 +156,160 @@ function colorByLabels() {
   showColorBar(null);
 }
 
+// --- stack: one quantity at one scale for every point, latest request wins --------------------
+// The robust range of a scale's values: 2nd and 98th percentiles of (at most 65,536 evenly
+// spread) finite values.
+function robustRange(values) {
+  const k = Math.max(1, Math.ceil(values.length / 65536));
+  const v = [];
+  for (let i = 0; i < values.length; i += k) if (Number.isFinite(values[i])) v.push(values[i]);
+  if (v.length === 0) return [0, 0];
+  const sorted = Float64Array.from(v).sort();
+  const at = (q) => sorted[Math.floor(q * (sorted.length - 1))];
+  let lo = at(0.02), hi = at(0.98);
+  if (!(hi > lo)) { lo = sorted[0]; hi = sorted[sorted.length - 1]; }
+  return [lo, hi];
+}
+
+function stackQuery() {
+  return { quantity: $('stackQuantity').value, scale: $('stackScale').value };
+}
+
+async function colorByStack() {
+  const query = stackQuery();
+  const values = new Float32Array(await getBytes('/api/stack/values', query));
+  const fixed = $('stackRange').value === 'fixed' && state.stackRange && state.stackRange.quantity === query.quantity;
+  const [lo, hi] = fixed ? state.stackRange.range : robustRange(values);
+  if (!fixed) state.stackRange = { quantity: query.quantity, range: [lo, hi] };
+  state.stackValues = values;
+  state.stackQuery = query;
+  scalarColors(values, lo, hi, colorAttribute().array);
+  const t = state.manifest.stack.scales[Number(query.scale)];
+  showColorBar(`${query.quantity} at t = ${t.toPrecision(3)}${fixed ? ' (fixed range)' : ''}`, lo, hi);
+}
+
+let pendingStack = null;
+let stackRunning = false;
+
+// Colours by the stack at the selectors' quantity and scale; `what` names the timing entry.
+function showStack(what) {
+  pendingStack = { what, start: performance.now() };
+  if (!stackRunning) drainStack();
+}
+
+async function drainStack() {
+  stackRunning = true;
+  state.busy++;
+  try {
+    while (pendingStack) {
+      const { what, start } = pendingStack;
+      pendingStack = null;
+      $('colorBy').value = '__stack';
+      await colorByStack();
+      colorAttribute().needsUpdate = true;
+      await nextFrame();
+      state.timings.push({ what, ms: performance.now() - start });
+      if (state.series) plotSeries();
+    }
+  } catch (e) {
+    fail(e);
+  } finally {
+    stackRunning = false;
+    state.busy--;
+  }
+}
+
+// --- stack: a clicked point's series over the scales -------------------------------------------
+const raycaster = new THREE.Raycaster();
+let seriesPlot = null;
+
+// The display index of the point under the page position (x, y), the nearest to the eye among
+// those within 6 pixels of the ray; null when none.
+function pickPoint(clientX, clientY) {
+  const rect = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2((clientX - rect.left) / rect.width * 2 - 1, -(clientY - rect.top) / rect.height * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const distance = camera.position.distanceTo(controls.target);
+  raycaster.params.Points.threshold = 6 * 2 * distance * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) / rect.height;
+  points.updateMatrixWorld();
+  const hits = raycaster.intersectObject(points, false);
+  return hits.length ? hits[0].index : null;
+}
+
+// Page position of displayed point k (for the end-to-end test's clicks).
+function screenPosition(k) {
+  points.updateMatrixWorld();
+  const p = state.positions;
+  const v = new THREE.Vector3(p[3 * k], p[3 * k + 1], p[3 * k + 2]).applyMatrix4(points.matrixWorld).project(camera);
+  const rect = renderer.domElement.getBoundingClientRect();
+  return [rect.left + (v.x + 1) / 2 * rect.width, rect.top + (1 - v.y) / 2 * rect.height];
+}
+state.screenPosition = screenPosition;
+
+function plotSeries() {
+  const name = $('stackQuantity').value;
+  seriesPlot.values = state.series.values[name];
+  seriesPlot.name = name;
+  seriesPlot.current = Number($('stackScale').value);
+  seriesPlot.draw();
+}
+
+async function showSeries(k) {
+  const point = k * state.step;  // the cloud's own index
+  state.busy++;
+  try {
+    const names = state.manifest.stack.quantities.map((q) => q.name);
+    const m = state.manifest.stack.scale_count;
+    const raw = new Float32Array(await getBytes('/api/stack/series', { point, quantities: names.join(',') }));
+    const values = {};
+    names.forEach((n, q) => { values[n] = raw.subarray(q * m, (q + 1) * m); });
+    state.series = { point, length: m, values };
+    const p = state.positions;
+    marker.geometry.getAttribute('position').array.set([p[3 * k], p[3 * k + 1], p[3 * k + 2]]);
+    marker.geometry.getAttribute('position').needsUpdate = true;
+    marker.visible = true;
+    requestRender();
+    $('seriesTitle').textContent = `point ${point.toLocaleString()}: ${m} scales`;
+    plotSeries();
+  } catch (e) {
+    fail(e);
+  } finally {
+    state.busy--;
+  }
+}
+
+// A click (not a drag) on the view picks a point when a stack is shown.
+let pressed = null;
+function onPointerDown(e) { pressed = e.button === 0 ? [e.clientX, e.clientY] : null; }
+function onPointerUp(e) {
+  if (!pressed || !state.manifest || !state.manifest.stack || brush.enabled) return;
+  const moved = Math.hypot(e.clientX - pressed[0], e.clientY - pressed[1]);
+  pressed = null;
+  if (moved > 4) return;
+  const k = pickPoint(e.clientX, e.clientY);
+  if (k === null) { status('no point under the click'); return; }
+  showSeries(k);
+}
+
 async function applyColoring() {
   const mode = $('colorBy').value;
+  if (mode === '__stack') { showStack('colour by'); return; }
   if (mode === '__labels') colorByLabels();
   else if (mode === '__normals') await colorByNormals();
   else if (mode === '__height') colorByHeight();
   else await colorByAttribute(mode);
   colorAttribute().needsUpdate = true;
   await nextFrame();
+}
+
+// The first frame's colouring (the stack's goes through colorByStack directly: no timing entry).
+async function firstColoring() {
+  if ($('colorBy').value === '__stack') {
+    colorAttribute().needsUpdate = true;
+    await nextFrame();
+  } else {
+    await applyColoring();
+  }
 }
 
 // --- planes: labels from the server, latest request wins -------------------------------------
@@ -359,10 +513,65 @@ function fillColorChoices() {
   const select = $('colorBy');
   const add = (value, text) => { const o = document.createElement('option'); o.value = value; o.textContent = text; select.append(o); };
   if (state.manifest.planes) add('__labels', 'plane components');
+  if (state.manifest.stack) add('__stack', 'stack quantity (scale slider)');
   if (state.manifest.cloud.has_normals) add('__normals', 'normals (as RGB)');
   add('__height', 'height');
   for (const a of state.manifest.cloud.attributes) add(a.name, a.name);
   select.addEventListener('change', () => applyColoring().catch(fail));
+}
+
+// --- lines and stack panels ----------------------------------------------------------------------
+async function colorLinesBy(name) {
+  const range = await colorLines(lines, state.manifest.lines, name);
+  state.linesColorBy = name;
+  $('linesBar').classList.toggle('hidden', !range);
+  $('linesBarName').textContent = range ? name : `${name} (one colour per id)`;
+  $('linesBarMin').textContent = range ? range[0].toPrecision(4) : '';
+  $('linesBarMax').textContent = range ? range[1].toPrecision(4) : '';
+  requestRender();
+}
+
+function setupLines() {
+  const m = state.manifest.lines;
+  $('linesPanel').classList.remove('hidden');
+  $('showLines').classList.remove('hidden');
+  $('showLinesLabel').classList.remove('hidden');
+  $('linesInfo').textContent = `${m.line_count.toLocaleString()} lines, ${state.linesSegments.toLocaleString()} segments, ${m.vertex_count.toLocaleString()} vertices`;
+  const select = $('linesColorBy');
+  for (const a of m.attributes) { const o = document.createElement('option'); o.value = a.name; o.textContent = a.name; select.append(o); }
+  const names = m.attributes.map((a) => a.name);
+  select.value = names.includes('scale') ? 'scale' : names[0];
+  select.addEventListener('change', () => colorLinesBy(select.value).catch(fail));
+  drawColorBar($('linesBar'));
+}
+
+function setupStack() {
+  const s = state.manifest.stack;
+  $('stackPanel').classList.remove('hidden');
+  const quantity = $('stackQuantity');
+  for (const q of s.quantities) { const o = document.createElement('option'); o.value = q.name; o.textContent = q.name; o.title = q.description; quantity.append(o); }
+  quantity.value = 'curv_mean';
+  const scale = $('stackScale');
+  scale.max = String(Math.max(0, s.scale_count - 1));
+  scale.value = String(Math.floor(s.scale_count / 2));
+  const showScale = () => { $('stackScaleValue').textContent = `t = ${s.scales[Number(scale.value)].toPrecision(3)}`; };
+  showScale();
+  scale.addEventListener('input', () => { showScale(); showStack('stack scale slider'); });
+  quantity.addEventListener('change', () => showStack('stack quantity'));
+  $('stackRange').addEventListener('change', () => showStack('stack range'));
+  seriesPlot = new SeriesPlot($('series'));
+  seriesPlot.scales = s.scales;
+  state.seriesPlot = seriesPlot;
+  const mg = new THREE.BufferGeometry();
+  mg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3), 3));
+  // A child of the points: state.positions are already in their (centred) frame.
+  marker = new THREE.Points(mg, new THREE.PointsMaterial({ size: 12, color: 0xffcc33, sizeAttenuation: false, depthTest: false }));
+  marker.renderOrder = 1;
+  marker.visible = false;
+  marker.frustumCulled = false;
+  points.add(marker);
+  renderer.domElement.addEventListener('pointerdown', onPointerDown);
+  renderer.domElement.addEventListener('pointerup', onPointerUp);
 }
 
 async function start() {
@@ -383,12 +592,30 @@ async function start() {
   geometry.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
   const material = new THREE.PointsMaterial({ size: Number($('pointSize').value), vertexColors: true, sizeAttenuation: false });
   points = new THREE.Points(geometry, material);
+  state.pointsObject = points;
   upGroup.add(points);
   upGroup.rotation.copy(UP.z);
+  if (state.manifest.lines) {
+    status('loading lines…');
+    const loaded = await loadLines(state.manifest.lines);
+    lines = loaded.lines;
+    lines.geometry.translate(-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -(lo[2] + hi[2]) / 2);
+    upGroup.add(lines);
+    state.linesSegments = lines.geometry.getIndex().count / 2;
+    state.linesObject = lines;
+    setupLines();
+    await colorLinesBy($('linesColorBy').value);
+    if (state.manifest.source.kind === 'lines') $('showPoints').checked = false;
+    points.visible = $('showPoints').checked;
+  }
+  if (state.manifest.stack) setupStack();
   fillColorChoices();
   resize();
   resetView();
-  if (state.manifest.planes) {
+  if (state.manifest.stack) {
+    $('colorBy').value = '__stack';
+    await colorByStack();
+  } else if (state.manifest.planes) {
     const query = { min_persistence: String(Math.round(state.manifest.planes.max_persistence / 2)) };
     const labels = new Int32Array(await getBytes('/api/planes/labels', query));
     state.labels = labels;
@@ -397,7 +624,7 @@ async function start() {
   } else {
     $('colorBy').value = cloud.attributes.length ? cloud.attributes[0].name : cloud.has_normals ? '__normals' : '__height';
   }
-  await applyColoring();
+  await firstColoring();
   state.firstFrameMs = performance.now();
   state.firstFrameSincePageStart = performance.now() - t0;
   progress(1);
@@ -418,6 +645,8 @@ $('upAxis').addEventListener('change', () => {
   resetView();
 });
 $('resetView').addEventListener('click', resetView);
+$('showPoints').addEventListener('change', () => { if (points) { points.visible = $('showPoints').checked; requestRender(); } });
+$('showLines').addEventListener('change', () => { if (lines) { lines.visible = $('showLines').checked; requestRender(); } });
 window.addEventListener('resize', resize);
 drawColorBar($('colorbar'));
 start().catch((e) => { fail(e); $('loading').textContent = `error: ${state.error}`; });
