@@ -5,7 +5,7 @@
 //   bench_features [--points N (100000)] [--data DIR (/tmp/real/cgal/data/meshes)]
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
-//                  [--vote-radius X] [--all-salient]
+//                  [--vote-radius X] [--all-salient] [--noise-curvature X]
 //                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
@@ -763,6 +763,8 @@ int main(int argc, char** argv) {
       ourOptions.minSalientCurvature = std::atof(argv[++i]);
     } else if (a == "--all-salient") {
       ourOptions.ridgeOnly = false;
+    } else if (a == "--noise-curvature" && hasValue) {
+      ourOptions.noiseSalientFactor = std::atof(argv[++i]);
     } else if (a == "--min-scales" && hasValue) {
       ourOptions.minVotingScales = std::atoi(argv[++i]);
     } else if (a == "--vote-radius" && hasValue) {

@@ -327,6 +327,10 @@ def test_render_lines_features(data):
         ss.render(cloud.points, lines=lines, line_color_by="no_such")
     features = ss.features(cloud.points)
     assert features["curve_id"].shape == (12000,) and len(features["curves"]) > 0
+    assert features["salient_curvature_floor"] == max(
+        0.6, 8 * features["noise_rms"] / features["spacing"])
+    with pytest.raises(ss.OptionError, match="noise_curvature must be finite and >= 0"):
+        ss.features(cloud.points, noise_curvature=-1)
 
 
 def test_any_layout_gives_the_same_result_and_inputs_stay_untouched():

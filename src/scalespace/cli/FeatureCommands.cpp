@@ -219,6 +219,9 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--min-curvature", args->features.minSalientCurvature,
                   "salient vertices also have |k1| t >= this (0 = the thesis' rule alone)")
       ->capture_default_str();
+  cmd->add_option("--noise-curvature", args->features.noiseSalientFactor,
+                  "and |k1| t >= this x sigma / e, sigma the noise read from the points (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--min-scales", args->features.minVotingScales,
                   "points join curves only when this many scales voted for them (1 = the thesis)")
       ->capture_default_str();
@@ -319,6 +322,8 @@ void addFeaturesCommand(CLI::App& app) {
                                  {"samples", cloud.size()},
                                  {"spacing", result.spacing},
                                  {"max_vote", result.maxVote},
+                                 {"noise_rms", result.noiseRms},
+                                 {"salient_curvature_floor", result.salientCurvatureFloor},
                                  {"feature_points", labelled},
                                  {"parameters",
                                   {{"scale_count", options.scaleCount},
@@ -326,6 +331,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"salient_percentile", options.salientPercentile},
                                    {"vote_threshold", options.voteThreshold},
                                    {"min_salient_curvature", options.minSalientCurvature},
+                                   {"noise_salient_factor", options.noiseSalientFactor},
                                    {"min_voting_scales", options.minVotingScales},
                                    {"ridge_only", options.ridgeOnly},
                                    {"min_curve_extent", options.minCurveExtent},

@@ -56,6 +56,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
     {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
     {"FeatureCurveOptions::minVotingScales", "--min-scales"},
+    {"FeatureCurveOptions::noiseSalientFactor", "--noise-curvature"},
     {"CylinderOptions::scaleCount", "--scales"},
     {"CylinderOptions::tMin", "--tmin"},
     {"CylinderOptions::tMax", "--tmax"},

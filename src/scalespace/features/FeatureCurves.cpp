@@ -12,6 +12,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/scales/PointNoise.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
@@ -121,6 +122,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::salientThreshold must be in [0, 1]");
   require(std::isfinite(o.minSalientCurvature) && o.minSalientCurvature >= 0,
           "FeatureCurveOptions::minSalientCurvature must be finite and >= 0");
+  require(std::isfinite(o.noiseSalientFactor) && o.noiseSalientFactor >= 0,
+          "FeatureCurveOptions::noiseSalientFactor must be finite and >= 0");
   require(std::isfinite(o.voteRadiusFactor) && o.voteRadiusFactor > 0,
           "FeatureCurveOptions::voteRadiusFactor must be finite and > 0");
   require(std::isfinite(o.voteThreshold) && o.voteThreshold >= 0 && o.voteThreshold < 1,
@@ -200,6 +203,15 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                        : meanKthNeighborDistance(cloud.positions(), options.spacingNeighbors);
   const double e = result.spacing;
   require(e > 0, "detectFeatureCurves: every point is at the same position (spacing 0)");
+  if (options.noiseSalientFactor > 0) {
+    // The noise of the points the lines are traced on (the cloud; a mesh's area samples).
+    const bool targetsAreCloud = &targets == &cloud.positions();
+    result.noiseRms = targetsAreCloud
+                          ? pointNoiseRms(cloud.positions(), targetGraph)
+                          : pointNoiseRms(cloud.positions(), buildKnnGraph(cloud.positions(), 10));
+  }
+  result.salientCurvatureFloor =
+      std::max(options.minSalientCurvature, options.noiseSalientFactor * result.noiseRms / e);
 
   // 1-2. Lines per scale and their salient vertices (Sec. 3.4.1).
   std::vector<Vec3> salient;
@@ -222,7 +234,7 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     summary.salientBound = quantile(lines.seedKappa1, options.salientPercentile);
     summary.lines = lines.lines.size();
     const double bound = std::max((1 - options.salientThreshold) * summary.salientBound,
-                                  options.minSalientCurvature / lineOptions.scale);
+                                  result.salientCurvatureFloor / lineOptions.scale);
     std::vector<const CurvatureLineVertex*> candidates;
     for (const CurvatureLine& line : lines.lines)
       for (const CurvatureLineVertex& v : line.vertices) {

@@ -1,13 +1,13 @@
 #pragma once
 // Area and outline of the regularized 2D alpha shape of planar points (the region filter of
-// Sec. 2.3.1 and the component outlines), plus the least-squares plane used to flatten them.
+// Sec. 2.3.1 and the component outlines); the least-squares plane that flattens them is in
+// fit/PointSetPlane.hpp.
 #include <vector>
 
 #include "scalespace/core/Types.hpp"
+#include "scalespace/fit/PointSetPlane.hpp"
 
 namespace scalespace {
-
-using Vec2 = Eigen::Vector2d;
 
 struct AlphaShape {
   double area = 0.0;  // total area of the regular (interior) faces
@@ -31,24 +31,5 @@ bool alphaShapeAreaAtLeast(const std::vector<Vec2>& points, double alpha, double
 /// circular segment of radius sqrt(alpha) on that edge (AlphaShapeArea.cpp gives the proof).
 /// Nearly tight for dense points when cell << sqrt(alpha); 0 for fewer than 3 subset points.
 double alphaShapeAreaLowerBound(const std::vector<Vec2>& points, double alpha, double cell);
-
-struct PlaneFit {
-  Vec3 normal = Vec3::UnitZ();  // unit; the plane is {x : normal . x = offset}
-  double offset = 0.0;
-  double rms = 0.0;  // root mean square of the point-to-plane distances
-  Vec3 centroid = Vec3::Zero();
-  Vec3 axisU = Vec3::UnitX(), axisV = Vec3::UnitY();  // in-plane orthonormal basis
-  bool valid = false;                                 // false for fewer than 3 points
-};
-
-/// Total least squares plane through positions[indices] (smallest eigenvector of the covariance).
-PlaneFit fitPlane(const std::vector<Vec3>& positions, const std::vector<Index>& indices);
-
-/// Coordinates of positions[indices] in the plane's (axisU, axisV) basis around its centroid.
-std::vector<Vec2> projectOnPlane(const PlaneFit& plane, const std::vector<Vec3>& positions,
-                                 const std::vector<Index>& indices);
-
-/// Back to 3D: centroid + x axisU + y axisV.
-Vec3 liftFromPlane(const PlaneFit& plane, const Vec2& p);
 
 }  // namespace scalespace

@@ -11,6 +11,7 @@
 
 #include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/RegionGraph.hpp"
+#include "scalespace/scales/PointNoise.hpp"
 
 namespace scalespace {
 
@@ -26,12 +27,6 @@ struct PlanarityOptions {
 
 /// OptionError naming the field unless maxRelativeRms and noiseFactor are finite and >= 0.
 void validate(const PlanarityOptions& options);
-
-/// The sensor noise: the median over the points of the RMS distance of the point and its graph
-/// neighbours to their least-squares plane (sqrt of the covariance's smallest eigenvalue, times
-/// sqrt(m / (m - 3)) for the m points, the plane's three degrees of freedom), or 0 for an empty
-/// graph. On flat parts it is the noise's sigma; curvature and edges touch few points.
-double pointNoiseRms(const std::vector<Vec3>& positions, const KnnGraph& knn);
 
 /// Per level and region, 1 when the region is planar (PlanarityOptions), else 0: the kinds that
 /// buildRegionGraph keeps apart. Parallel over regions; independent of the thread count.

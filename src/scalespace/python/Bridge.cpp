@@ -60,6 +60,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::voteThreshold", "vote_threshold"},
     {"FeatureCurveOptions::minCurveExtent", "min_extent"},
     {"FeatureCurveOptions::minSalientCurvature", "min_curvature"},
+    {"FeatureCurveOptions::noiseSalientFactor", "noise_curvature"},
     {"FeatureCurveOptions::minVotingScales", "min_scales"},
     {"CylinderOptions::scaleCount", "scale_count"},
     {"CylinderOptions::scales", "scales"},
