@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <random>
 
 #include "scalespace/core/AnalyticSurface.hpp"
 #include "scalespace/core/Error.hpp"
@@ -30,6 +31,36 @@ CurvatureLineOptions atScale(double t) {
   CurvatureLineOptions options;
   options.scale = t;
   return options;
+}
+
+/// The longest edge of `set` over delta, the closing edges of closed lines included.
+double longestEdgeInSteps(const CurvatureLineSet& set, const CurvatureLineOptions& options) {
+  double longest = 0;
+  for (const auto& line : set.lines) {
+    const auto& v = line.vertices;
+    for (std::size_t i = 1; i < v.size(); ++i)
+      longest = std::max(longest, (v[i].position - v[i - 1].position).norm());
+    if (line.closed) longest = std::max(longest, (v.front().position - v.back().position).norm());
+  }
+  return longest / (options.gamma * options.scale);
+}
+
+/// A thin wedge: two 1 x 1 sheets meeting at the edge x = z = 0 along y, opening `degrees`,
+/// normals outwards. Near the edge both sheets lie within t of a point.
+PointCloud wedge(double degrees, std::size_t count) {
+  const double half = degrees / 2 * M_PI / 180;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u01(0, 1);
+  std::vector<Vec3> positions, normals;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = u01(rng), y = u01(rng), side = i % 2 ? 1 : -1;
+    positions.emplace_back(x, y, side * x * std::tan(half));
+    normals.emplace_back(-std::sin(half), 0, side * std::cos(half));
+  }
+  PointCloud cloud;
+  cloud.setRelativePositions(positions, Vec3::Zero());
+  cloud.setNormals(normals);
+  return cloud;
 }
 
 std::size_t vertexCount(const CurvatureLineSet& set) {
@@ -114,6 +145,57 @@ TEST(CurvatureLines, OnATorusTheLinesAreItsParallelsAndClose) {
   }
   EXPECT_LT(worst, 2.0);
   EXPECT_GT(closed, 0u) << "a parallel is a closed curve";
+}
+
+TEST(CurvatureLines, AClosedLineClosesOnlyWhereItsEndsMeet) {
+  // On a torus at coarse scales the traced parallels drift across the tube (Euler steps), so a
+  // line can wind more than once around and run into its own earlier turn: a self collision, not
+  // a closed loop. Flagged closed, its closing edge would cut across the torus (28-134 delta in
+  // `scalespace lines` on generated tori before this was fixed).
+  const PointCloud cloud = surface(SurfaceShape::Torus, 150000);
+  std::size_t closed = 0, selfCollisions = 0;
+  for (const double t : {0.05, 0.06, 0.07}) {
+    const CurvatureLineOptions options = atScale(t);
+    const CurvatureLineSet set = traceCurvatureLines(cloud, options);
+    const double delta = options.gamma * t;
+    for (const auto& line : set.lines) {
+      if (!line.closed) continue;
+      ++closed;
+      EXPECT_TRUE(line.stopBackward == LineStop::Loop || line.stopForward == LineStop::Loop);
+      EXPECT_LE((line.vertices.front().position - line.vertices.back().position).norm(),
+                (1 + 2 * options.collisionFraction) * delta)
+          << "t = " << t;
+    }
+    EXPECT_LE(longestEdgeInSteps(set, options), 2.0) << "t = " << t;
+    selfCollisions += set.stops[std::size_t(LineStop::SelfCollision)];
+  }
+  EXPECT_GT(closed, 0u);
+  EXPECT_GT(selfCollisions, 0u) << "the case this test is about did not occur";
+}
+
+TEST(CurvatureLines, AWayStopsWhereTheProjectionLeavesItsSheet) {
+  // Near the edge of a thin wedge (5 degrees) the other sheet is within t: the MLS projection of
+  // a step can land on it or between the sheets, far from q + delta v; the way stops there
+  // instead of drawing an edge of 2.5-3 delta across the wedge.
+  const PointCloud cloud = wedge(5, 60000);
+  std::size_t jumps = 0;
+  for (const double t : {0.0127, 0.0232, 0.0775}) {
+    const CurvatureLineOptions options = atScale(t);
+    const CurvatureLineSet set = traceCurvatureLines(cloud, options);
+    EXPECT_LE(longestEdgeInSteps(set, options), 2.0) << "t = " << t;
+    jumps += set.stops[std::size_t(LineStop::Jump)];
+  }
+  EXPECT_GT(jumps, 0u);
+  // On a smooth sheet the projection moves a step by about kappa2 delta^2 / 2: the default bound
+  // never trips on a torus; a bound below that stops ways there.
+  const PointCloud torus = surface(SurfaceShape::Torus, 30000);
+  CurvatureLineOptions options = atScale(0.12);
+  const CurvatureLineSet smooth = traceCurvatureLines(torus, options);
+  EXPECT_EQ(smooth.stops[std::size_t(LineStop::Jump)], 0u);
+  options.maxProjectionShift = 1e-4;
+  const CurvatureLineSet tight = traceCurvatureLines(torus, options);
+  EXPECT_GT(tight.stops[std::size_t(LineStop::Jump)], 0u);
+  EXPECT_LT(vertexCount(tight), vertexCount(smooth));
 }
 
 TEST(CurvatureLines, UmbilicSurfacesHaveNoLines) {
@@ -207,6 +289,7 @@ TEST(CurvatureLines, InvalidOptionsAndInputsAreRefused) {
   refused([](auto& o) { o.fit.mls = false; }, "fit.mls");
   refused([](auto& o) { o.maxSteps = 0; }, "CurvatureLineOptions::maxSteps");
   refused([](auto& o) { o.maxTurnDegrees = 0; }, "CurvatureLineOptions::maxTurnDegrees");
+  refused([](auto& o) { o.maxProjectionShift = 0; }, "CurvatureLineOptions::maxProjectionShift");
   PointCloud noNormals;
   noNormals.setRelativePositions(cloud.positions(), Vec3::Zero());
   EXPECT_THROW(traceCurvatureLines(noNormals, atScale(0.1)), OptionError);

@@ -34,6 +34,10 @@ const char* lineStopName(LineStop stop) {
       return "collision";
     case LineStop::Loop:
       return "loop";
+    case LineStop::Jump:
+      return "jump";
+    case LineStop::SelfCollision:
+      return "self_collision";
     case LineStop::MaxSteps:
       return "max_steps";
   }
@@ -167,6 +171,8 @@ void validateCurvatureLineOptions(const CurvatureLineOptions& o) {
           "CurvatureLineOptions::borderOffset must be finite and >= 0");
   require(std::isfinite(o.maxTurnDegrees) && o.maxTurnDegrees > 0 && o.maxTurnDegrees <= 180,
           "CurvatureLineOptions::maxTurnDegrees must be in (0, 180]");
+  require(std::isfinite(o.maxProjectionShift) && o.maxProjectionShift > 0,
+          "CurvatureLineOptions::maxProjectionShift must be finite and > 0");
   require(std::isfinite(o.collisionFraction) && o.collisionFraction >= 0,
           "CurvatureLineOptions::collisionFraction must be finite and >= 0");
   require(o.maxSteps >= 1 && o.maxSteps <= 1000000,
@@ -200,6 +206,8 @@ class LineTracer {
         t_(options.scale),
         delta_(options.gamma * options.scale),
         collision_(options.collisionFraction * delta_),
+        closing_(delta_ + 2 * collision_),
+        maxShift_(options.maxProjectionShift * delta_),
         cosTurn_(std::cos(options.maxTurnDegrees * M_PI / 180)),
         placed_(std::max(collision_, 1e-9 * options.scale)) {
     fitOptions_.fit = options.fit;
@@ -221,9 +229,9 @@ class LineTracer {
     }
     // Lines in the order their seeds started them.
     for (Line& line : lines_) {
-      ++result_.stops[std::size_t(ways_[line.ways[0]].stop)];
-      ++result_.stops[std::size_t(ways_[line.ways[1]].stop)];
       CurvatureLine out = assemble(line);
+      ++result_.stops[std::size_t(out.stopBackward)];
+      ++result_.stops[std::size_t(out.stopForward)];
       if (out.vertices.size() >= 2) result_.lines.push_back(std::move(out));
     }
   }
@@ -324,7 +332,7 @@ class LineTracer {
         const Way& w = ways_[active[a]];
         const int stepIndex = int(w.vertices.size()) + 1;
         const LineStop stop =
-            stepOutcome(fits[a], last(w).position, heading(w), candidate[a], found);
+            stepOutcome(fits[a], last(w).position, heading(w), queries[a], candidate[a], found);
         outcome[a] = stop == LineStop::MaxSteps ? 0 : std::uint8_t(1 + int(stop));
         if (outcome[a] || collision_ <= 0) continue;
         const Vec3& p = candidate[a].position;
@@ -379,10 +387,15 @@ class LineTracer {
   }
 
   /// What one step gives: MaxSteps (meaning "go on") and the new vertex, or why the way stops.
+  /// `predicted` is q_n + delta v, the point the fit projected.
   LineStop stepOutcome(const LocalFit& f, const Vec3& from, const Vec3& previous,
-                       CurvatureLineVertex& vertex, std::vector<Neighbor>& found) const {
+                       const Vec3& predicted, CurvatureLineVertex& vertex,
+                       std::vector<Neighbor>& found) const {
     if (!f.valid) return LineStop::InvalidFit;
     if ((f.projection - from).norm() < 0.1 * delta_) return LineStop::Stalled;
+    // Projected off the sheet of q_n (across a crease, or onto another sheet within t): the
+    // vertex would be far from the line, and the edge to it would cut across the shape.
+    if ((f.projection - predicted).norm() > maxShift_) return LineStop::Jump;
     if (atBorder(f.projection, f.normal, found)) return LineStop::Border;
     const MinimalDirection m = minimalDirection(f);
     if (nearUmbilic(m, t_, options_)) return LineStop::Umbilic;
@@ -393,14 +406,16 @@ class LineTracer {
   }
 
   /// The backward way reversed (its tangents turned to the line's direction), the seed, the
-  /// forward way.
+  /// forward way. A way that met its own line closes it only when the line's two ends meet
+  /// (within closing_); one that met it elsewhere (a spiral meeting its previous turn, a way
+  /// curling onto itself) stopped on a self collision and leaves the line open: closing it would
+  /// join two far-apart vertices with one long edge across the shape.
   CurvatureLine assemble(const Line& l) const {
     const Way &back = ways_[l.ways[0]], &forward = ways_[l.ways[1]];
     CurvatureLine line;
     line.seed = l.seed;
     line.stopBackward = back.stop;
     line.stopForward = forward.stop;
-    line.closed = back.stop == LineStop::Loop || forward.stop == LineStop::Loop;
     line.vertices.reserve(back.vertices.size() + 1 + forward.vertices.size());
     for (auto it = back.vertices.rbegin(); it != back.vertices.rend(); ++it) {
       line.vertices.push_back(*it);
@@ -408,13 +423,21 @@ class LineTracer {
     }
     line.vertices.push_back(l.start);
     line.vertices.insert(line.vertices.end(), forward.vertices.begin(), forward.vertices.end());
+    const bool loop = back.stop == LineStop::Loop || forward.stop == LineStop::Loop;
+    line.closed =
+        loop && line.vertices.size() > 2 &&
+        (line.vertices.front().position - line.vertices.back().position).norm() <= closing_;
+    if (loop && !line.closed) {
+      if (line.stopBackward == LineStop::Loop) line.stopBackward = LineStop::SelfCollision;
+      if (line.stopForward == LineStop::Loop) line.stopForward = LineStop::SelfCollision;
+    }
     return line;
   }
 
   const CurvatureLineOptions& options_;
   const SurfaceSamples& samples_;
   CurvatureLineSet& result_;
-  const double t_, delta_, collision_, cosTurn_;
+  const double t_, delta_, collision_, closing_, maxShift_, cosTurn_;
   FitPointsOptions fitOptions_;
   const std::vector<double> scales_{options_.scale};
   std::vector<Line> lines_;

@@ -10,8 +10,11 @@
 //   continues the previous step (v . v_prev >= 0).
 // - A line is traced both ways from its seed; each way stops at the first of: an invalid fit (too
 //   few neighbours, degenerate), a near-umbilic point (StopReason::Umbilic), a turn sharper than
-//   maxTurnDegrees in one step, a step that does not move (the projection pulled it back), coming
-//   within collisionFraction * delta of a vertex of another line, closing on itself, or maxSteps.
+//   maxTurnDegrees in one step, a step that does not move (the projection pulled it back), a
+//   projection that lands more than maxProjectionShift * delta from q_n + delta v (it left the
+//   sheet: jumped across a crease or to a nearby sheet), coming within collisionFraction * delta
+//   of a vertex of another line, meeting its own line (closing it when the line's two ends meet,
+//   else a self collision), or maxSteps.
 // - Coarse scales fit on the Poisson-disk level of the pyramid for that scale (Sec. 1.5.2): the
 //   samples lie >= 2 alpha t apart, so a fit reads a bounded number of them whatever t.
 // - Lines are what a sequential tracer gives (Kalogerakis 2009: seeds in a seeded random order,
@@ -56,6 +59,11 @@ struct CurvatureLineOptions {
   double borderOffset = 0.2;
   /// Stop a way when one step turns by more than this (the field jumped: crossing an umbilic).
   double maxTurnDegrees = 45;
+  /// Stop a way when the MLS projection moves the predicted point q_n + delta v by more than
+  /// maxProjectionShift * delta: it did not follow the sheet of q_n (jumped across a crease or to
+  /// another sheet within t). On a smooth sheet it moves it by about kappa delta^2 / 2, < 0.4 delta
+  /// within the turn limit. With 1, no step is longer than 2 delta.
+  double maxProjectionShift = 1;
   /// Stop a way within collisionFraction * delta of another line's vertex (lines of one scale
   /// stay apart; a seed next to an existing line makes no line).
   double collisionFraction = 0.5;
@@ -73,13 +81,15 @@ struct CurvatureLineOptions {
 
 /// Why one way of a line ended.
 enum class LineStop : std::uint8_t {
-  InvalidFit,  // too few neighbours or a degenerate fit
-  Umbilic,     // |kappa1| ~ |kappa2|: no minimal direction
-  Turn,        // turned more than maxTurnDegrees in one step
-  Stalled,     // the projection undid the step (moved < delta / 10)
-  Border,      // reached the border of the data (borderOffset)
-  Collision,   // reached another line
-  Loop,        // closed on itself
+  InvalidFit,     // too few neighbours or a degenerate fit
+  Umbilic,        // |kappa1| ~ |kappa2|: no minimal direction
+  Turn,           // turned more than maxTurnDegrees in one step
+  Stalled,        // the projection undid the step (moved < delta / 10)
+  Border,         // reached the border of the data (borderOffset)
+  Collision,      // reached another line
+  Loop,           // met its own line where the line's two ends meet: the line is closed
+  Jump,           // the projection landed more than maxProjectionShift * delta from the step
+  SelfCollision,  // met its own line away from its other end (e.g. a spiral): the line is open
   MaxSteps
 };
 const char* lineStopName(LineStop stop);
@@ -97,7 +107,9 @@ struct CurvatureLine {
   std::vector<CurvatureLineVertex> vertices;  // in order along the line
   Index seed = 0;                             // input point the line started from
   LineStop stopBackward = LineStop::MaxSteps, stopForward = LineStop::MaxSteps;
-  bool closed = false;  // the last vertex joins the first
+  // The last vertex joins the first: a way met its own line and the two ends are within
+  // (1 + 2 collisionFraction) delta (2 delta by default), so the closing edge is no longer.
+  bool closed = false;
   double length() const;
 };
 
