@@ -5,7 +5,8 @@
 //   bench_features [--points N (100000)] [--data DIR (/tmp/real/cgal/data/meshes)]
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
-//                  [--vote-radius X] [--all-salient] [--noise-curvature X]
+//                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
+//                  [--per-curve]
 //                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
@@ -462,6 +463,8 @@ struct Scores {
   double curveDice = 0, curveHausdorff = NAN, curveRecall = 0, seconds = 0;
 };
 
+bool printPerCurve = false;  // --per-curve
+
 // Per curve: each ground-truth curve against the detected curve holding most of its points.
 void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
   const std::vector<std::vector<Index>> truth = groups(m.gt, m.edges.curves),
@@ -480,6 +483,18 @@ void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedC
   for (std::size_t g = 0; g < truth.size(); ++g) {
     if (truth[g].empty()) continue;
     ++counted;
+    if (printPerCurve) {  // why a curve is missed: unlabelled, or cut into pieces
+      std::size_t labelled = 0, pieces = 0;
+      for (const auto& [pair, k] : overlap)
+        if (pair.first == int(g)) {
+          labelled += k;
+          pieces += double(k) >= 0.05 * double(truth[g].size());
+        }
+      std::printf(
+          "#   curve %zu: %zu points, %.0f%% labelled, best match %.0f%%, %zu pieces >= 5%%\n", g,
+          truth[g].size(), 100.0 * double(labelled) / double(truth[g].size()),
+          100.0 * double(common[g]) / double(truth[g].size()), pieces);
+    }
     if (match[g] < 0) continue;
     const std::vector<Index>& d = found[std::size_t(match[g])];
     diceSum += dice(common[g], truth[g].size(), d.size());
@@ -769,6 +784,10 @@ int main(int argc, char** argv) {
       ourOptions.minVotingScales = std::atoi(argv[++i]);
     } else if (a == "--vote-radius" && hasValue) {
       ourOptions.voteRadiusFactor = std::atof(argv[++i]);
+    } else if (a == "--join-gap" && hasValue) {
+      ourOptions.joinGap = std::atof(argv[++i]);
+    } else if (a == "--per-curve") {
+      printPerCurve = true;
     } else if (a == "--no-peers") {
       peers = false;
     } else {

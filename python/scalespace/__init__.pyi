@@ -103,7 +103,7 @@ def read_mesh(path: str) -> Tuple[np.ndarray, np.ndarray]: ...
 def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
              spacing: float = ..., vote_threshold: float = ..., min_scales: int = ...,
              min_curvature: float = ..., noise_curvature: float = ...,
-             salient_threshold: float = ..., min_extent: float = ...,
+             salient_threshold: float = ..., min_extent: float = ..., join_gap: float = ...,
              all_salient: bool = ..., beta: float = ..., gamma: float = ...,
              with_lines: bool = ..., triangles: Optional[ArrayLike] = ...,
              mesh_samples: int = ..., threads: Optional[int] = ...,

@@ -156,6 +156,7 @@ TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
     (footprint ? footprintCurves : convexCurves).insert(l.curves.begin(), l.curves.end());
   }
   EXPECT_EQ(footprintCurves.size(), 1u) << "the footprint is one closed concave curve";
+  EXPECT_EQ(convexCurves.size(), 1u) << "the top and the vertical edges meet at the corners";
   for (const int c : footprintCurves) {
     EXPECT_EQ(r.curves[std::size_t(c)].convexity, -1);
     EXPECT_EQ(convexCurves.count(c), 0u);
@@ -215,6 +216,28 @@ TEST(FeatureCurves, TheSalientFloorFollowsTheNoiseReadFromThePoints) {
     const EdgeLabels l = labelsAlong(s.positions, r, edge, 0.5 * e, footprint ? -1 : +1);
     EXPECT_GT(l.fraction, 0.8) << (footprint ? "footprint " : "convex ") << edge.a.transpose();
   }
+}
+
+// Lines stop short of the corners where creases meet, so the region growing alone cuts the box's
+// edges into pieces; joinGap joins the pieces of one sign, never a convex piece to a concave one.
+TEST(FeatureCurves, PiecesOfOneSignMeetingAtCornersAreOneCurve) {
+  RectangleSampler s;
+  addBox(s, 8000, false);
+  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
+        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+  const PointCloud cloud = s.cloud();
+  FeatureCurveOptions pieces;
+  pieces.joinGap = 0;
+  const FeatureCurveResult apart = detectFeatureCurves(cloud, pieces);
+  const FeatureCurveResult joined = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  EXPECT_GT(apart.curves.size(), joined.curves.size());  // measured: 4 pieces
+  EXPECT_EQ(joined.curves.size(), 2u) << "one convex curve (top and verticals), one footprint";
+  // The same points are labelled with the same signs; only the curve ids differ.
+  EXPECT_EQ(apart.convexity, joined.convexity);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    EXPECT_EQ(apart.curveId[i] >= 0, joined.curveId[i] >= 0);
+  for (const FeatureCurve& c : joined.curves)
+    for (const Index p : c.points) ASSERT_EQ(joined.convexity[p], c.convexity);
 }
 
 TEST(FeatureCurves, SameResultForAnyThreadCount) {

@@ -228,6 +228,10 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_flag("--all-salient{false}", args->features.ridgeOnly,
                 "vote with every salient vertex, not only the most curved across nearby lines "
                 "(the thesis)");
+  cmd->add_option("--join-gap", args->features.joinGap,
+                  "curves of one sign within this x e of each other are one curve (0 keeps the "
+                  "pieces)")
+      ->capture_default_str();
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e (0 keeps all)")
       ->capture_default_str();
@@ -335,6 +339,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"min_voting_scales", options.minVotingScales},
                                    {"ridge_only", options.ridgeOnly},
                                    {"min_curve_extent", options.minCurveExtent},
+                                   {"join_gap", options.joinGap},
                                    {"threads", args->threads}}},
                                  {"scales", scales},
                                  {"curves", curves},

@@ -54,6 +54,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::salientThreshold", "--salient"},
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
+    {"FeatureCurveOptions::joinGap", "--join-gap"},
     {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
     {"FeatureCurveOptions::minVotingScales", "--min-scales"},
     {"FeatureCurveOptions::noiseSalientFactor", "--noise-curvature"},

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/SpatialOrder.hpp"
 
 namespace scalespace {
@@ -28,34 +29,6 @@ struct Edge {
     return b < o.b;
   }
   bool operator==(const Edge& o) const { return a == o.a && b == o.b; }
-};
-
-// Union-find with path halving and union by size (Kruskal).
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : parent_(n), size_(n, 1) {
-    for (std::size_t i = 0; i < n; ++i) parent_[i] = Index(i);
-  }
-  Index find(Index x) {
-    while (parent_[x] != x) {
-      parent_[x] = parent_[parent_[x]];
-      x = parent_[x];
-    }
-    return x;
-  }
-  bool unite(Index a, Index b) {
-    a = find(a);
-    b = find(b);
-    if (a == b) return false;
-    if (size_[a] < size_[b] || (size_[a] == size_[b] && a > b)) std::swap(a, b);
-    parent_[b] = a;
-    size_[a] += size_[b];
-    return true;
-  }
-
- private:
-  std::vector<Index> parent_;
-  std::vector<Index> size_;
 };
 
 void checkCancel(const ProgressCallback& progress, double fraction, const char* stage) {

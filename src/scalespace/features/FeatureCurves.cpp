@@ -1,6 +1,7 @@
 #include "scalespace/features/FeatureCurves.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <limits>
 #include <string>
 
+#include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
@@ -101,6 +103,51 @@ std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLine
   return keep;
 }
 
+// Curves of the same sign whose points come within `gap` of each other, as groups of curve indices
+// (each group increasing, groups ordered by their first curve).
+std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& positions,
+                                                      const std::vector<std::vector<Index>>& curves,
+                                                      const std::vector<std::int8_t>& sign,
+                                                      double gap) {
+  std::vector<Vec3> points;
+  std::vector<Index> owner;
+  for (std::size_t c = 0; c < curves.size(); ++c)
+    for (const Index p : curves[c]) {
+      points.push_back(positions[p]);
+      owner.push_back(Index(c));
+    }
+  DisjointSets sets(curves.size());
+  if (!points.empty()) {
+    const auto index = makeSpatialIndex(points);
+    tbb::enumerable_thread_specific<std::vector<std::pair<Index, Index>>> found;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& r) {
+      std::vector<Neighbor> near;
+      auto& pairs = found.local();
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        index->radiusSearch(points[i], gap, near);
+        for (const Neighbor& nb : near) {
+          const Index a = owner[i], b = owner[nb.index];
+          if (a < b && sign[a] == sign[b]) pairs.emplace_back(a, b);
+        }
+      }
+    });
+    // Connected components do not depend on the order of the unions (nor on the thread count).
+    for (const auto& pairs : found)
+      for (const auto& [a, b] : pairs) sets.unite(a, b);
+  }
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<int> groupOfRoot(curves.size(), -1);
+  for (std::size_t c = 0; c < curves.size(); ++c) {
+    int& g = groupOfRoot[sets.find(Index(c))];
+    if (g < 0) {
+      g = int(groups.size());
+      groups.emplace_back();
+    }
+    groups[std::size_t(g)].push_back(c);
+  }
+  return groups;
+}
+
 }  // namespace
 
 void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
@@ -122,6 +169,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::salientThreshold must be in [0, 1]");
   require(std::isfinite(o.minSalientCurvature) && o.minSalientCurvature >= 0,
           "FeatureCurveOptions::minSalientCurvature must be finite and >= 0");
+  require(std::isfinite(o.joinGap) && o.joinGap >= 0,
+          "FeatureCurveOptions::joinGap must be finite and >= 0");
   require(std::isfinite(o.noiseSalientFactor) && o.noiseSalientFactor >= 0,
           "FeatureCurveOptions::noiseSalientFactor must be finite and >= 0");
   require(std::isfinite(o.voteRadiusFactor) && o.voteRadiusFactor > 0,
@@ -312,6 +361,28 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     if ((hi - lo).norm() < options.minCurveExtent * e) continue;
     renumber[c] = int(kept.size());
     kept.push_back(std::move(seg.regions[c]));
+  }
+  // 5. (not in the thesis) Lines stop short of corners (near-umbilic points, sharp turns), so where
+  // creases meet the votes leave a gap and the regions cut a connected set of creases into
+  // pieces; pieces of the same sign within joinGap * e of each other are one curve.
+  std::vector<std::int8_t> keptSign(kept.size());
+  for (std::size_t c = 0; c < kept.size(); ++c) keptSign[c] = result.convexity[kept[c].front()];
+  const std::vector<std::vector<std::size_t>> joined =
+      options.joinGap > 0 ? curvesWithinGap(targets, kept, keptSign, options.joinGap * e)
+                          : std::vector<std::vector<std::size_t>>();
+  if (!joined.empty()) {
+    std::vector<int> joinedOf(kept.size());
+    std::vector<std::vector<Index>> merged(joined.size());
+    for (std::size_t g = 0; g < joined.size(); ++g) {
+      for (const std::size_t c : joined[g]) {
+        joinedOf[c] = int(g);
+        merged[g].insert(merged[g].end(), kept[c].begin(), kept[c].end());
+      }
+      std::sort(merged[g].begin(), merged[g].end());
+    }
+    for (int& r : renumber)
+      if (r >= 0) r = joinedOf[std::size_t(r)];
+    kept = std::move(merged);
   }
   result.curveId = std::move(seg.labels);
   for (std::size_t i = 0; i < n; ++i)

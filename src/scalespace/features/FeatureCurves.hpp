@@ -11,7 +11,8 @@
 //   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
 //      exceed v = voteThreshold * V_max in magnitude, between points of the same sign;
 //   5. (not in the thesis) regions smaller than minCurveExtent * e across are dropped: specks of
-//      one to a few points where a line grazed a corner.
+//      one to a few points where a line grazed a corner; then regions of the same sign within
+//      joinGap * e of each other are joined (the gaps where lines stop at corners).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -65,6 +66,11 @@ struct FeatureCurveOptions {
   /// Curves whose points span less than this times e (bounding-box diagonal) are dropped; 0
   /// keeps every region (the thesis).
   double minCurveExtent = 1;
+  /// (Not in the thesis) curves of the same sign whose points come within joinGap * e of each
+  /// other are one curve: lines stop short of corners, so the votes leave gaps where creases meet
+  /// and the region growing cut one connected set of creases (what the thesis calls a curve) into
+  /// pieces. 0 keeps the pieces.
+  double joinGap = 1.5;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
 };
