@@ -6,7 +6,8 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--per-curve]
+//                  [--per-curve] (per model: each ground-truth curve's share labelled and
+//                  pieces, and how far from the sharp edges the false positives lie)
 //                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
@@ -380,12 +381,16 @@ PointCloud noisyCopy(const PointCloud& clean, double sigma) {
   return noisy;
 }
 
+bool printPerCurve = false;  // --per-curve
+
 struct Model {
   std::string name;
   TriangleMesh mesh;
   PointCloud clean;     // with estimated normals
   std::vector<int> gt;  // per point: ground-truth curve or -1
-  int gtCurves = 0;     // curves with at least one point
+  std::vector<int> gt2,
+      gt3;           // the same within 2 e and 3 e (--per-curve: where false positives lie)
+  int gtCurves = 0;  // curves with at least one point
   MeshEdges edges;
   double spacing = 0, diagonal = 0;
 };
@@ -403,6 +408,12 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   const auto index = makeSpatialIndex(m.clean.positions());
   m.gt = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                               m.spacing);
+  if (printPerCurve) {
+    m.gt2 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
+                                 2 * m.spacing);
+    m.gt3 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
+                                 3 * m.spacing);
+  }
   std::vector<bool> used(std::size_t(m.edges.curves), false);
   for (int c : m.gt)
     if (c >= 0) used[std::size_t(c)] = true;
@@ -463,8 +474,6 @@ struct Scores {
   double curveDice = 0, curveHausdorff = NAN, curveRecall = 0, seconds = 0;
 };
 
-bool printPerCurve = false;  // --per-curve
-
 // Per curve: each ground-truth curve against the detected curve holding most of its points.
 void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
   const std::vector<std::vector<Index>> truth = groups(m.gt, m.edges.curves),
@@ -522,6 +531,14 @@ Scores score(const Model& m, const std::vector<int>& detected, int detectedCount
     (t ? (l ? tp : fn) : (l ? fp : tn)) += 1;
     if (t) truthSet.push_back(Index(i));
     if (l) labelledSet.push_back(Index(i));
+  }
+  if (printPerCurve) {  // false positives just beside an edge (a band too wide) or far from it
+    std::size_t within2 = 0, within3 = 0, far = 0;
+    for (std::size_t i = 0; i < m.gt.size(); ++i)
+      if (m.gt[i] < 0 && detected[i] >= 0)
+        ++(m.gt2[i] >= 0 ? within2 : m.gt3[i] >= 0 ? within3 : far);
+    std::printf("#   false positives %.0f: within 2e %zu, 2e-3e %zu, beyond 3e %zu\n", fp, within2,
+                within3, far);
   }
   Scores s;
   s.labelled = (tp + fp) / double(m.gt.size());
