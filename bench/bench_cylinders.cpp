@@ -4,7 +4,7 @@
 // of the diagonal.
 //
 //   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--scan full|one-sided]
-//                   [--scales M (ours: 8)] [--seed S]
+//                   [--scales M (ours: 8)] [--tmin T (ours: automatic)] [--seed S]
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -238,6 +238,8 @@ int main(int argc, char** argv) {
       only = argv[++i];
     else if (a == "--scales" && i + 1 < argc)
       ours.scaleCount = std::stoi(argv[++i]);
+    else if (a == "--tmin" && i + 1 < argc)
+      ours.tMin = std::stod(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
