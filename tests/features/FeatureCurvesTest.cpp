@@ -54,6 +54,13 @@ void addBox(RectangleSampler& s, double density, bool bottom) {
   s.add(Vec3(1, 0, 0), y, z, x, density);
 }
 
+/// The box without its bottom standing on the ground [-1, 2]^2 at z = 0 (without the footprint).
+void addBoxOnGround(RectangleSampler& s) {
+  addBox(s, 8000, false);
+  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
+        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+}
+
 /// Distance from p to the segment [a, b].
 double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = b - a;
@@ -140,10 +147,7 @@ TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
 
 TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
   RectangleSampler s;
-  addBox(s, 8000, false);
-  // Ground [-1, 2]^2 at z = 0, without the footprint of the box.
-  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
-        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+  addBoxOnGround(s);
   const PointCloud cloud = s.cloud();
   const FeatureCurveResult r = detectFeatureCurves(cloud, FeatureCurveOptions{});
   const double e = r.spacing;
@@ -169,9 +173,7 @@ TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
 // from the points keeps the ground away from the edges unlabelled and still finds the box's edges.
 TEST(FeatureCurves, TheSalientFloorFollowsTheNoiseReadFromThePoints) {
   RectangleSampler s;
-  addBox(s, 8000, false);
-  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
-        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+  addBoxOnGround(s);
   const PointCloud clean = s.cloud();
   const FeatureCurveResult cleanResult = detectFeatureCurves(clean, FeatureCurveOptions{});
   const double e = cleanResult.spacing, sigma = 0.13 * e;
@@ -222,9 +224,7 @@ TEST(FeatureCurves, TheSalientFloorFollowsTheNoiseReadFromThePoints) {
 // edges into pieces; joinGap joins the pieces of one sign, never a convex piece to a concave one.
 TEST(FeatureCurves, PiecesOfOneSignMeetingAtCornersAreOneCurve) {
   RectangleSampler s;
-  addBox(s, 8000, false);
-  s.add(Vec3(-1, -1, 0), Vec3(3, 0, 0), Vec3(0, 3, 0), Vec3::UnitZ(), 8000,
-        [](const Vec3& p) { return !(p.x() > 0 && p.x() < 1 && p.y() > 0 && p.y() < 1); });
+  addBoxOnGround(s);
   const PointCloud cloud = s.cloud();
   FeatureCurveOptions pieces;
   pieces.joinGap = 0;
