@@ -15,6 +15,7 @@
 
 #include "cli/CliTestSupport.hpp"
 #include "scalespace/io/CloudIO.hpp"
+#include "scalespace/io/Polylines.hpp"
 
 namespace scalespace::test {
 namespace {
@@ -198,6 +199,25 @@ TEST_F(CliView, DrawsLinesOverACloudAndAlone) {
   EXPECT_NE(notLines.err.find("edge element"), std::string::npos) << notLines.err;
 }
 
+TEST_F(CliView, ServesACylindersResultWithItsAxes) {
+  ASSERT_EQ(run("generate pipes -n 20000 -o " + path("p.ply") + " -q").code, 0);
+  ASSERT_EQ(run("cylinders " + path("p.ply") + " -o " + path("cyl") + " -q").code, 0);
+  const PolylineSet axes = readPolylines(path("cyl/axes.ply"));
+  ASSERT_GT(axes.lineCount(), 0u);
+  ViewProcess view({path("cyl"), "--no-browser", "-q"});
+  ASSERT_GT(view.port, 0) << "no URL printed";
+  const auto manifest = nlohmann::json::parse(view.get("/api/manifest?token=" + view.token).second);
+  EXPECT_EQ(manifest.at("source").at("kind"), "cylinders") << manifest.dump();
+  EXPECT_EQ(view.get("/api/cloud/positions?token=" + view.token).second.size(), 20000u * 12);
+  const auto attributes = manifest.at("cloud").dump();
+  EXPECT_NE(attributes.find("cylinder_id"), std::string::npos) << attributes;
+  std::size_t edges = 0;
+  for (std::size_t l = 0; l < axes.lineCount(); ++l)
+    edges += axes.lineSize(l) - 1 + (axes.isClosed(l) ? 1 : 0);
+  EXPECT_EQ(manifest.at("lines").at("segment_count"), edges);
+  EXPECT_EQ(view.stop(), 0);
+}
+
 TEST_F(CliView, DecimatesBeyondThePointBudget) {
   ASSERT_EQ(run("generate sphere -n 1000 -o " + path("s.ply") + " -q").code, 0);
   ViewProcess view({path("s.ply"), "--no-browser", "-q", "--point-budget", "300"});
@@ -209,7 +229,8 @@ TEST_F(CliView, RefusesWhatItCannotOpen) {
   fs::create_directories(path("folder"));
   Result r = run("view " + path("folder") + " --no-browser");
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.err.find("not a `scalespace planes` result"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not a `scalespace planes` or `cylinders` result"), std::string::npos)
+      << r.err;
   r = run("view " + path("missing.ply") + " --no-browser");
   EXPECT_NE(r.code, 0);
   r = run("view " + path("folder") + " --port 70000 --no-browser");

@@ -82,6 +82,15 @@ bool isPolylinePly(const std::string& path) {
   return false;
 }
 
+// A `scalespace cylinders` result: its cloud.ply (the input with cylinder_id and anisotropy) is
+// the cloud, its axes.ply (one polyline per component, with radius) the lines over it.
+bool isCylinderResult(const std::string& folder) {
+  std::error_code ec;
+  return fs::is_regular_file(fs::path(folder) / "cloud.ply", ec) &&
+         fs::is_regular_file(fs::path(folder) / "axes.ply", ec) &&
+         fs::is_regular_file(fs::path(folder) / "components.json", ec);
+}
+
 // A scale stack: its input positions (or the --input cloud, checked to be the stack's input, with
 // its own attributes) as the cloud, the stack's quantities over them.
 void loadStack(const ViewArgs& args, nlohmann::json& source,
@@ -113,9 +122,24 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
       loadStack(args, source, layers);
       return layers;
     }
+    if (isCylinderResult(args.path)) {
+      if (!args.input.empty())
+        throw OptionError(
+            "--input goes with a `planes` result or a scale stack, not with a "
+            "`cylinders` result (its cloud.ply is the input with its labels)");
+      InputOptions input;
+      input.path = (fs::path(args.path) / "cloud.ply").string();
+      auto cloud = std::make_shared<PointCloud>(loadCloud(input, args.quiet));
+      source = {{"path", args.path}, {"kind", "cylinders"}};
+      layers.push_back(std::make_unique<viewer::CloudLayer>(
+          cloud, viewer::displaySampleFor(cloud->size(), args.pointBudget)));
+      return layers;
+    }
     if (!isPlaneResult(args.path))
-      throw FileError(args.path, "", "is a folder but not a `scalespace planes` result",
-                      "pass a cloud file or the output folder of `scalespace planes`");
+      throw FileError(args.path, "",
+                      "is a folder but not a `scalespace planes` or `cylinders` result",
+                      "pass a cloud file or the output folder of `scalespace planes` or "
+                      "`scalespace cylinders`");
     std::string recorded;
     PlaneModel model = readPlaneModel(args.path, &recorded);
     auto cloud = std::make_shared<PointCloud>(loadResultInput(
@@ -160,16 +184,20 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
 std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayers(const ViewArgs& args,
                                                              nlohmann::json& source) {
   auto layers = loadLayersWithoutLines(args, source);
-  if (args.lines.empty()) return layers;
+  // A cylinders result brings its axes; --lines draws other polylines instead.
+  const std::string linesPath = !args.lines.empty() || source.value("kind", "") != "cylinders"
+                                    ? args.lines
+                                    : (fs::path(args.path) / "axes.ply").string();
+  if (linesPath.empty()) return layers;
   for (const auto& layer : layers)
     if (layer->name() == "lines")
       throw OptionError("--lines: " + args.path + " is a polyline file already");
-  if (!isPolylinePly(args.lines))
-    throw FileError(args.lines, "", "is not a PLY file with an edge element",
+  if (!isPolylinePly(linesPath))
+    throw FileError(linesPath, "", "is not a PLY file with an edge element",
                     "pass the .ply written by `scalespace lines` (its .obj has no attributes)");
-  PolylineSet lines = readPolylines(args.lines);
+  PolylineSet lines = readPolylines(linesPath);
   const auto origin = layers.front()->manifest().at("origin");
-  source["lines"] = args.lines;
+  source["lines"] = linesPath;
   layers.push_back(std::make_unique<viewer::LinesLayer>(
       std::move(lines),
       Vec3(origin[0].get<double>(), origin[1].get<double>(), origin[2].get<double>())));
@@ -182,11 +210,13 @@ void addViewCommand(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
       "view",
-      "explore a cloud, a `planes` result, a scale stack or polylines in the browser (local "
+      "explore a cloud, a `planes` or `cylinders` result, a scale stack or polylines in the "
+      "browser (local "
       "server, Sec. 2.4)");
   cmd->add_option("path", args->path,
-                  "a cloud (.ply .las ...), a `scalespace planes` folder, a scale stack "
-                  "(`scalespace scales`) or a polyline .ply (`scalespace lines`)")
+                  "a cloud (.ply .las ...), a `scalespace planes` or `cylinders` folder (the "
+                  "latter with its axes as lines), a scale stack (`scalespace scales`) or a "
+                  "polyline .ply (`scalespace lines`)")
       ->required();
   cmd->add_option("--port", args->port, "port on 127.0.0.1 (0 = any free port)")
       ->capture_default_str()
