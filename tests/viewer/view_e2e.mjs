@@ -1,10 +1,9 @@
 // End-to-end test of `scalespace view` in Debian's Chromium (headless, driven by playwright-core):
 // a generated `planes` result is opened, the persistence and scale sliders are moved with the
 // keyboard, a region is brushed with the mouse (and a wall hiding other faces: the depth test), a
-// dot of the persistence diagram is clicked, a
-// similarity search is run and the result exported; every point set the page shows is compared
-// with `scalespace segment` on the same input (same plane_id per point), the export with
-// segment's file byte for byte.
+// dot of the persistence diagram is clicked, a similarity search is run and the result exported;
+// every point set the page shows is compared with `scalespace segment` on the same input (same
+// plane_id per point), the export with segment's file byte for byte.
 //   node view_e2e.mjs CLI WORKDIR [--points N] [--screenshots DIR] [--measure | --cloud-only]
 //                     [--point-budget N]
 // Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
