@@ -1,9 +1,9 @@
 // End-to-end test of `scalespace view` in Debian's Chromium (headless, driven by playwright-core):
 // a generated `planes` result is opened, the persistence and scale sliders are moved with the
-// keyboard, a region is brushed with the mouse, a dot of the persistence diagram is clicked, a
-// similarity search is run and the result exported; every point set the page shows is compared
-// with `scalespace segment` on the same input (same plane_id per point), the export with
-// segment's file byte for byte.
+// keyboard, a region is brushed with the mouse (and a wall hiding other faces: the depth test), a
+// dot of the persistence diagram is clicked, a similarity search is run and the result exported;
+// every point set the page shows is compared with `scalespace segment` on the same input (same
+// plane_id per point), the export with segment's file byte for byte.
 //   node view_e2e.mjs CLI WORKDIR [--points N] [--screenshots DIR] [--measure | --cloud-only]
 //                     [--point-budget N]
 // Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
@@ -241,6 +241,103 @@ try {
     check(path.dirname(exported) === path.join(work, 'exports'), `export written to the export folder: ${exported}`);
     check(fs.readFileSync(exported).equals(fs.readFileSync(path.join(work, 'similar.csv'))),
       'the exported CSV is byte for byte segment --similar\'s');
+  }
+  if (!measureOnly) {
+    // Brush depth test (Sec. 2.4.3: the components under the stroke, on the visible surface). A
+    // place is chosen where one face of the house (gt_face) covers a 40 x 40 pixel cell entirely
+    // and another face lies behind it (a wall seen from outside, the opposite wall behind): a
+    // stroke there must select the front face's points under the stroke and none of the hidden
+    // face's, which the stroke's screen footprint covers too.
+    const plan = await page.evaluate(async () => {
+      const s = window.scalespace, token = new URLSearchParams(location.search).get('token');
+      const face = new Float32Array(await (await fetch(`/api/cloud/attribute?name=gt_face&token=${token}`)).arrayBuffer());
+      s.gtFace = face;
+      const canvas = document.querySelector('#view canvas').getBoundingClientRect();
+      const [lo, hi] = s.manifest.cloud.bounds;
+      const radius = 0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+      const C = 40, B = 8;  // cell and block sizes (pixels)
+      const cells = new Map();
+      for (let k = 0; k < s.count; ++k) {
+        const [x, y] = s.screenPosition(k);
+        const cx = Math.floor((x - canvas.left) / C), cy = Math.floor((y - canvas.top) / C);
+        if (cx < 1 || cy < 1 || (cx + 2) * C > canvas.width || (cy + 2) * C > canvas.height) continue;
+        const key = cy * 10000 + cx;
+        if (!cells.has(key)) cells.set(key, { cx, cy, pts: [] });
+        cells.get(key).pts.push([k, x - canvas.left, y - canvas.top, s.viewDepth(k), face[k]]);
+      }
+      let best = null;
+      for (const cell of cells.values()) {
+        // Front face: the nearest point's; it must be the front-most in every 8 x 8 block.
+        const front = cell.pts.reduce((a, b) => (b[3] < a[3] ? b : a))[4];
+        const blocks = new Map();
+        for (const q of cell.pts) {
+          const b = Math.floor((q[2] - cell.cx * C) / B) * 100 + Math.floor((q[1] - cell.cy * C) / B);
+          if (!blocks.has(b) || blocks.get(b)[3] > q[3]) blocks.set(b, q);
+        }
+        if (blocks.size < (C / B) ** 2) continue;
+        if ([...blocks.values()].some((q) => q[4] !== front)) continue;
+        const frontMax = Math.max(...cell.pts.filter((q) => q[4] === front).map((q) => q[3]));
+        const hidden = cell.pts.filter((q) => q[4] !== front && q[3] > frontMax + 0.05 * radius);
+        if (!best || hidden.length > best.hidden) best = { x: canvas.left + (cell.cx + 0.5) * C, y: canvas.top + (cell.cy + 0.5) * C, front, hidden: hidden.length, radius };
+      }
+      return best;
+    });
+    check(plan && plan.hidden >= 20, `depth test: a place where gt_face ${plan && plan.front} hides ${plan && plan.hidden} points of other faces`);
+    if (plan) {
+      await page.evaluate(() => { window.scalespace.lastBrush = null; });
+      await page.click('#brush');
+      await page.mouse.move(plan.x - 4, plan.y);
+      await page.mouse.down();
+      for (let k = 0; k <= 4; ++k) await page.mouse.move(plan.x - 4 + 2 * k, plan.y);
+      await page.mouse.up();
+      await page.waitForFunction(() => window.scalespace.lastBrush && window.scalespace.busy === 0, null, { timeout: 60000 });
+      await page.click('#brush');
+      const r = await page.evaluate(async (plan) => {
+        const s = window.scalespace, token = new URLSearchParams(location.search).get('token');
+        const selected = new Set(Array.from(s.lastBrush.indices, (i) => i / s.step));
+        const under = s.lastBrush.underStroke;
+        const frontMax = Math.max(...under.filter((k) => s.gtFace[k] === plan.front).map((k) => s.viewDepth(k)));
+        const isHidden = (k) => s.gtFace[k] !== plan.front && s.viewDepth(k) > frontMax + 0.05 * plan.radius;
+        const out = {
+          under: under.length, selected: selected.size,
+          frontUnder: under.filter((k) => s.gtFace[k] === plan.front).length,
+          frontSelected: under.filter((k) => s.gtFace[k] === plan.front && selected.has(k)).length,
+          hiddenUnder: under.filter(isHidden).length,
+          hiddenSelected: under.filter((k) => isHidden(k) && selected.has(k)).length,
+          hiddenFaces: [...new Set(under.filter(isHidden).map((k) => s.gtFace[k]))],
+          components: [],
+        };
+        // The share of each ranked component's points on the hidden faces, for the page's ranking
+        // and for the one of every point under the stroke (no depth test).
+        const share = async (matches) => {
+          const list = [];
+          for (const m of matches) {
+            const labels = new Int32Array(await (await fetch(`/api/planes/labels?components=${m.component}&token=${token}`)).arrayBuffer());
+            let all = 0, hidden = 0;
+            labels.forEach((l, k) => { if (l >= 0) { all++; hidden += out.hiddenFaces.includes(s.gtFace[k]); } });
+            list.push({ component: m.component, hidden: Number((hidden / Math.max(1, all)).toFixed(3)), front: labels.some((l, k) => l >= 0 && s.gtFace[k] === plan.front) });
+          }
+          return list;
+        };
+        out.components = await share(s.lastBrush.matches);
+        const everything = Uint32Array.from(under, (k) => k * s.step);
+        const noDepth = await (await fetch(`/api/planes/brush?token=${token}`, { method: 'POST', body: everything })).json();
+        out.withoutDepthTest = await share(noDepth.matches);
+        return out;
+      }, plan);
+      console.log(`     depth test: ${JSON.stringify(r)}`);
+      check(r.hiddenUnder >= 20, `depth test: the stroke covers ${r.hiddenUnder} points of hidden faces ${r.hiddenFaces} on screen`);
+      check(r.hiddenSelected === 0, `depth test: none of them is selected (${r.hiddenSelected})`);
+      check(r.frontSelected >= 0.9 * r.frontUnder && r.frontSelected > 0,
+        `depth test: the front face ${plan.front}'s points under the stroke are selected (${r.frontSelected} of ${r.frontUnder})`);
+      check(r.components.length > 0 && r.components[0].front && r.components[0].hidden < 0.5,
+        `depth test: the best component lies on the front face (${JSON.stringify(r.components[0])})`);
+      check(r.components.every((c) => c.hidden < 1),
+        `depth test: no ranked component lies entirely on the hidden faces (${JSON.stringify(r.components)})`);
+      check(r.withoutDepthTest.some((c) => c.hidden === 1),
+        `depth test: without it, the stroke would rank components lying entirely on hidden faces (${JSON.stringify(r.withoutDepthTest.filter((c) => c.hidden === 1))})`);
+      await shot('viewer_brush_depth.png');
+    }
   }
   if (!measureOnly) {
     // Colour by an attribute: the colour bar names it with its range.

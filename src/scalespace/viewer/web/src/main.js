@@ -383,17 +383,137 @@ function setSelection(ids) {
   else showLabels({ components: state.selection.join(',') }, 'selection');
 }
 
-// --- brush: screen-space stroke -> the cloud's point indices -> rankByBrush on the server ------
+// --- brush: screen-space stroke -> the visible points under it -> rankByBrush on the server ---
+// Sec. 2.4.3: the brush selects what is under the stroke on the visible surface. The drawn points'
+// view-space depths are rendered to an offscreen target (a depth pass: each pixel keeps its
+// front-most point's depth, 24 bits over [near, far]); a point under the stroke is kept only if
+// its depth is within brushTolerance of the front-most depth at its own pixel, so a wall seen from
+// outside selects that wall and not the one behind it.
 const brush = new BrushStroke(view, () => Number($('brushRadius').value));
+const DEPTH_LEVELS = 16777215;  // 2^24 - 1
+const depthMaterial = new THREE.ShaderMaterial({
+  uniforms: { size: { value: 1 }, near: { value: 0.01 }, far: { value: 1000 } },
+  vertexShader: `
+    uniform float size;
+    varying float vDepth;
+    void main() {
+      vec4 mv = modelViewMatrix * vec4(position, 1.0);
+      vDepth = -mv.z;
+      gl_Position = projectionMatrix * mv;
+      gl_PointSize = size;
+    }`,
+  fragmentShader: `
+    uniform float near, far;
+    varying float vDepth;
+    void main() {
+      float v = floor(clamp((vDepth - near) / (far - near), 0.0, 1.0) * ${DEPTH_LEVELS}.0 + 0.5);
+      float r = floor(v / 65536.0);
+      float g = floor((v - r * 65536.0) / 256.0);
+      float b = v - r * 65536.0 - g * 256.0;
+      gl_FragColor = vec4(r / 255.0, g / 255.0, b / 255.0, 1.0);
+    }`,
+});
+let depthTarget = null;
 
+// The front-most view-space depth at each pixel (w x h, row 0 at the top; NaN where no point is
+// drawn) of the points as drawn now (same point size, in CSS pixels).
+function frontDepths(w, h) {
+  if (!depthTarget || depthTarget.width !== w || depthTarget.height !== h) {
+    if (depthTarget) depthTarget.dispose();
+    depthTarget = new THREE.WebGLRenderTarget(w, h, { depthBuffer: true, generateMipmaps: false });
+  }
+  points.updateMatrixWorld();
+  const pick = new THREE.Points(points.geometry, depthMaterial);
+  pick.matrixAutoUpdate = false;
+  pick.matrix.copy(points.matrixWorld);
+  pick.frustumCulled = false;
+  const pickScene = new THREE.Scene();
+  pickScene.add(pick);
+  depthMaterial.uniforms.size.value = points.material.size;
+  depthMaterial.uniforms.near.value = camera.near;
+  depthMaterial.uniforms.far.value = camera.far;
+  const clear = renderer.getClearColor(new THREE.Color()), clearAlpha = renderer.getClearAlpha();
+  const index = points.geometry.getIndex();
+  if (index) points.geometry.setIndex(null);
+  renderer.setRenderTarget(depthTarget);
+  renderer.setClearColor(0x000000, 0);
+  renderer.clear(true, true, false);
+  renderer.render(pickScene, camera);
+  renderer.setRenderTarget(null);
+  renderer.setClearColor(clear, clearAlpha);
+  if (index) points.geometry.setIndex(index);
+  const rgba = new Uint8Array(4 * w * h);
+  renderer.readRenderTargetPixels(depthTarget, 0, 0, w, h, rgba);
+  const out = new Float32Array(w * h);
+  const scale = (camera.far - camera.near) / DEPTH_LEVELS;
+  for (let y = 0; y < h; ++y) {
+    const row = (h - 1 - y) * w;  // GL rows start at the bottom
+    for (let x = 0; x < w; ++x) {
+      const q = 4 * (row + x);
+      out[y * w + x] = rgba[q + 3] === 0 ? NaN
+        : camera.near + ((rgba[q] * 65536 + rgba[q + 1] * 256 + rgba[q + 2]) * scale);
+    }
+  }
+  return out;
+}
+
+// How far behind the front-most depth near its pixel a point may lie and still count as visible.
+// That depth is the nearest within gap + size / 2 pixels (a drawn point covers size x size
+// pixels), so on an oblique surface the point's own neighbours lie nearer by that many pixels'
+// worth of depth times the surface's slope (world size of a pixel at depth d: 2 d tan(fov/2) / h);
+// slopes up to 4 (surfaces 14 degrees from the line of sight) are allowed, plus two steps of the
+// depth encoding.
+function brushTolerance(depth, h, gap) {
+  const pixel = 2 * depth * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) / h;
+  return 4 * (gap + Math.max(1, points.material.size)) * pixel + 2 * (camera.far - camera.near) / DEPTH_LEVELS;
+}
+
+// The gaps between drawn points on screen: twice the median distance (pixels) from a point under
+// the stroke to the nearest other one (at most 16). Between the sprites of a sparse cloud the
+// surface behind shows through; the front depth is the nearest within that many pixels, so that a
+// surface hides what lies behind it, holes between its points included.
+function screenGap(xs, ys) {
+  const n = xs.length, cell = 16, grid = new Map();
+  if (n < 2) return 0;
+  for (let i = 0; i < n; ++i) {
+    const key = Math.floor(ys[i] / cell) * 65536 + Math.floor(xs[i] / cell);
+    if (!grid.has(key)) grid.set(key, []);
+    grid.get(key).push(i);
+  }
+  const nearest = new Float32Array(n);
+  for (let i = 0; i < n; ++i) {
+    const cx = Math.floor(xs[i] / cell), cy = Math.floor(ys[i] / cell);
+    let best = cell;
+    for (let dy = -1; dy <= 1; ++dy) for (let dx = -1; dx <= 1; ++dx) {
+      for (const j of grid.get((cy + dy) * 65536 + cx + dx) || []) {
+        if (j !== i) best = Math.min(best, Math.hypot(xs[j] - xs[i], ys[j] - ys[i]));
+      }
+    }
+    nearest[i] = best;
+  }
+  nearest.sort();
+  return Math.min(cell, Math.ceil(2 * nearest[n >> 1]));
+}
+
+// View-space depth of displayed point k (for the end-to-end test's reference).
+function viewDepth(k) {
+  points.updateMatrixWorld();
+  const p = state.positions;
+  return -new THREE.Vector3(p[3 * k], p[3 * k + 1], p[3 * k + 2]).applyMatrix4(points.matrixWorld).applyMatrix4(camera.matrixWorldInverse).z;
+}
+state.viewDepth = viewDepth;
+
+// The cloud's own indices of the visible points under the stroke, and (`underStroke`, display
+// indices) every drawn point under it whatever its depth.
 function brushedIndices() {
   const w = view.clientWidth, h = view.clientHeight;
   const mask = brush.mask(w, h);
   points.updateMatrixWorld();
+  const mv = new THREE.Matrix4().multiplyMatrices(camera.matrixWorldInverse, points.matrixWorld).elements;
   const e = new THREE.Matrix4()
     .multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse)
     .multiply(points.matrixWorld).elements;
-  const p = state.positions, out = [];
+  const p = state.positions, underStroke = [], xs = [], ys = [], depths = [];
   for (let i = 0; i < state.count; ++i) {
     const x = p[3 * i], y = p[3 * i + 1], z = p[3 * i + 2];
     const cw = e[3] * x + e[7] * y + e[11] * z + e[15];
@@ -401,19 +521,50 @@ function brushedIndices() {
     const sx = ((e[0] * x + e[4] * y + e[8] * z + e[12]) / cw * 0.5 + 0.5) * w;
     const sy = (0.5 - (e[1] * x + e[5] * y + e[9] * z + e[13]) / cw * 0.5) * h;
     if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
-    if (mask[(sy | 0) * w + (sx | 0)]) out.push(i * state.step);  // the cloud's own index
+    if (!mask[(sy | 0) * w + (sx | 0)]) continue;
+    underStroke.push(i);
+    xs.push(sx);
+    ys.push(sy);
+    depths.push(-(mv[2] * x + mv[6] * y + mv[10] * z + mv[14]));
   }
-  return Uint32Array.from(out);
+  if (underStroke.length === 0) return { indices: new Uint32Array(0), underStroke };
+  const front = frontDepths(w, h);
+  // Two passes: the gaps of all the points under the stroke (surfaces behind interleave with the
+  // front one's, so they look denser than it is), then those of the points found visible.
+  let gap = screenGap(xs, ys), visible = [];
+  for (let pass = 0; pass < 2; ++pass) {
+    const nearby = new Map();  // pixel -> the nearest depth within `gap` pixels
+    visible = [];
+    for (let c = 0; c < underStroke.length; ++c) {
+      const px = xs[c] | 0, py = ys[c] | 0, pixel = py * w + px;
+      let f = nearby.get(pixel);
+      if (f === undefined) {
+        f = Infinity;
+        for (let y = Math.max(0, py - gap); y <= Math.min(h - 1, py + gap); ++y) {
+          for (let x = Math.max(0, px - gap); x <= Math.min(w - 1, px + gap); ++x) {
+            const d = front[y * w + x];
+            if (d < f) f = d;  // NaN (nothing drawn) never is
+          }
+        }
+        nearby.set(pixel, f);
+      }
+      if (depths[c] <= f + brushTolerance(depths[c], h, gap)) visible.push(c);
+    }
+    if (pass === 0) gap = Math.max(gap, screenGap(visible.map((c) => xs[c]), visible.map((c) => ys[c])));
+  }
+  const out = visible.map((c) => underStroke[c] * state.step);  // the cloud's own indices
+  state.brushGap = gap;
+  return { indices: Uint32Array.from(out), underStroke };
 }
 
 async function onBrushStroke() {
-  const indices = brushedIndices();
+  const { indices, underStroke } = brushedIndices();
   brush.clear();
   if (indices.length === 0) { status('brush: no point under the stroke'); return; }
   state.busy++;
   try {
     const { matches } = await post('/api/planes/brush', {}, indices);
-    state.lastBrush = { indices, matches };
+    state.lastBrush = { indices, matches, underStroke };
     if (matches.length === 0) { status(`brush: ${indices.length} points, no component holds them`); return; }
     status(`brush: ${indices.length} points, ${matches.length} components; best ${matches[0].component} ` +
       `(score ${matches[0].score.toPrecision(3)}, overlap ${matches[0].overlap.toPrecision(3)})`);
