@@ -8,47 +8,21 @@
 //                     [--point-budget N]
 // Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
 import { spawn, execFileSync } from 'node:child_process';
-import { createRequire } from 'node:module';
 import fs from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const webDir = path.join(here, '..', '..', 'src', 'scalespace', 'viewer', 'web');
-const SKIP = 77;
-const [cli, work, ...rest] = process.argv.slice(2);
-const option = (name, fallback) => {
-  const k = rest.indexOf(name);
-  return k >= 0 ? rest[k + 1] : fallback;
-};
+import { checks, chromiumOrSkip, commandLine, launchChromium, runner } from './e2e_common.mjs';
+
+const { cli, work, rest, option } = commandLine();
 const pointCount = Number(option('--points', '20000'));
 const screenshots = option('--screenshots', null);
 const measureOnly = rest.includes('--measure') || rest.includes('--cloud-only');
 const cloudOnly = rest.includes('--cloud-only');  // view the generated cloud itself (no planes)
-const chromiumPath = process.env.SCALESPACE_CHROMIUM || '/usr/bin/chromium';
 
-let chromium;
-try {
-  ({ chromium } = createRequire(path.join(webDir, 'package.json'))('playwright-core'));
-} catch {
-  console.log(`SKIP: playwright-core is not installed in ${webDir}/node_modules (run scripts/setup_web.sh)`);
-  process.exit(SKIP);
-}
-if (!fs.existsSync(chromiumPath)) {
-  console.log(`SKIP: no Chromium at ${chromiumPath} (Debian package chromium; scripts/setup.sh installs it)`);
-  process.exit(SKIP);
-}
-if (!fs.existsSync(path.join(path.dirname(cli), 'viewer-page', 'app.js'))) {
-  console.log('SKIP: the viewer page was not bundled (no node_modules at build time: run scripts/setup_web.sh, then rebuild)');
-  process.exit(SKIP);
-}
+const chromium = chromiumOrSkip(cli);
 
-let failures = 0;
-function check(ok, what) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures++;
-}
-const run = (...args) => execFileSync(cli, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+const { check, failures } = checks();
+const run = runner(cli);
 
 // plane_id column of a CSV written by `segment -o X.csv` (header names the columns).
 function planeIds(file) {
@@ -113,17 +87,7 @@ const url = await new Promise((resolve, reject) => {
 });
 const tUrl = performance.now() - t0;
 
-const userDataDir = fs.mkdtempSync(path.join(work, 'chromium-'));
-// A fresh profile each run (launchPersistentContext's folder is Chromium's --user-data-dir).
-const browser = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: chromiumPath,
-  headless: true,
-  viewport: { width: 1400, height: 860 },
-  // A closed network: nothing that would try to reach the outside; software WebGL (no GPU here).
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const { browser, userDataDir } = await launchChromium(chromium, work);
 const results = { points: pointCount, planesSeconds: Number(planesSeconds.toFixed(1)) };
 try {
   const page = browser.pages()[0] || await browser.newPage();
@@ -372,8 +336,8 @@ try {
   fs.rmSync(userDataDir, { recursive: true, force: true });
 }
 console.log(`measured: ${JSON.stringify(results)}`);
-if (failures) {
-  console.log(`${failures} check(s) failed`);
+if (failures()) {
+  console.log(`${failures()} check(s) failed`);
   process.exit(1);
 }
 console.log('view end-to-end: all checks passed');

@@ -10,48 +10,22 @@
 // Screenshots (viewer_stack.png, viewer_lines.png, viewer_lines_alone.png) go to WORKDIR unless
 // --screenshots names another folder.
 // Exit 0: passed; 1: a check failed; 77: skipped (what is missing is printed).
-import { spawn, execFileSync } from 'node:child_process';
-import { createRequire } from 'node:module';
+import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const webDir = path.join(here, '..', '..', 'src', 'scalespace', 'viewer', 'web');
-const SKIP = 77;
-const [cli, work, ...rest] = process.argv.slice(2);
-const option = (name, fallback) => {
-  const k = rest.indexOf(name);
-  return k >= 0 ? rest[k + 1] : fallback;
-};
+import { checks, chromiumOrSkip, commandLine, launchChromium, runner } from './e2e_common.mjs';
+
+const { cli, work, rest, option } = commandLine();
 const measure = rest.includes('--measure');
 const pointCount = Number(option('--points', measure ? '200000' : '20000'));
 const scaleCount = Number(option('--scales', measure ? '20' : '12'));
 const screenshots = option('--screenshots', work);  // default: beside the test's files
-const chromiumPath = process.env.SCALESPACE_CHROMIUM || '/usr/bin/chromium';
 
-let chromium;
-try {
-  ({ chromium } = createRequire(path.join(webDir, 'package.json'))('playwright-core'));
-} catch {
-  console.log(`SKIP: playwright-core is not installed in ${webDir}/node_modules (run scripts/setup_web.sh)`);
-  process.exit(SKIP);
-}
-if (!fs.existsSync(chromiumPath)) {
-  console.log(`SKIP: no Chromium at ${chromiumPath} (Debian package chromium; scripts/setup.sh installs it)`);
-  process.exit(SKIP);
-}
-if (!fs.existsSync(path.join(path.dirname(cli), 'viewer-page', 'app.js'))) {
-  console.log('SKIP: the viewer page was not bundled (no node_modules at build time: run scripts/setup_web.sh, then rebuild)');
-  process.exit(SKIP);
-}
+const chromium = chromiumOrSkip(cli);
 
-let failures = 0;
-function check(ok, what) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures++;
-}
-const run = (...args) => execFileSync(cli, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 1 << 30 });
+const { check, failures } = checks();
+const run = runner(cli);
 
 // Columns of a CSV written by `scalespace export` (header names them), as numbers.
 function csvColumns(text) {
@@ -115,16 +89,7 @@ const t0 = performance.now();
 const stackUrl = await startView([stack]);
 const urlMs = Math.round(performance.now() - t0);
 
-const userDataDir = fs.mkdtempSync(path.join(work, 'chromium-'));
-const browser = await chromium.launchPersistentContext(userDataDir, {
-  executablePath: chromiumPath,
-  headless: true,
-  viewport: { width: 1400, height: 860 },
-  // A closed network: nothing that would try to reach the outside; software WebGL (no GPU here).
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const { browser, userDataDir } = await launchChromium(chromium, work);
 const results = { points: pointCount, scales: scaleCount };
 const shot = async (page, name) => { if (screenshots) await page.screenshot({ path: path.join(screenshots, name) }); };
 
@@ -273,8 +238,8 @@ try {
   fs.rmSync(userDataDir, { recursive: true, force: true });
 }
 console.log(`measured: ${JSON.stringify(results)}`);
-if (failures) {
-  console.log(`${failures} check(s) failed`);
+if (failures()) {
+  console.log(`${failures()} check(s) failed`);
   process.exit(1);
 }
 console.log('view stack and lines end-to-end: all checks passed');
