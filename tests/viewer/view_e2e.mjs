@@ -21,7 +21,7 @@ const cloudOnly = rest.includes('--cloud-only');  // view the generated cloud it
 
 const chromium = chromiumOrSkip(cli);
 
-const { check, failures } = checks();
+const { check, finish } = checks();
 const run = runner(cli);
 
 // plane_id column of a CSV written by `segment -o X.csv` (header names the columns).
@@ -335,10 +335,4 @@ try {
   server.kill('SIGTERM');
   fs.rmSync(userDataDir, { recursive: true, force: true });
 }
-console.log(`measured: ${JSON.stringify(results)}`);
-if (failures()) {
-  console.log(`${failures()} check(s) failed`);
-  process.exit(1);
-}
-console.log('view end-to-end: all checks passed');
-process.exit(0);  // now: the server's pipe would keep the event loop (and ctest) waiting
+finish(results, 'view end-to-end');

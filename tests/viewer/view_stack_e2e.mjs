@@ -24,7 +24,7 @@ const screenshots = option('--screenshots', work);  // default: beside the test'
 
 const chromium = chromiumOrSkip(cli);
 
-const { check, failures } = checks();
+const { check, finish } = checks();
 const run = runner(cli);
 
 // Columns of a CSV written by `scalespace export` (header names them), as numbers.
@@ -237,10 +237,4 @@ try {
   for (const s of servers) s.kill('SIGTERM');
   fs.rmSync(userDataDir, { recursive: true, force: true });
 }
-console.log(`measured: ${JSON.stringify(results)}`);
-if (failures()) {
-  console.log(`${failures()} check(s) failed`);
-  process.exit(1);
-}
-console.log('view stack and lines end-to-end: all checks passed');
-process.exit(0);
+finish(results, 'view stack and lines end-to-end');
