@@ -7,7 +7,8 @@
 //     parameterization's LSCM (free border) and discrete authalic (circular border).
 // Every map is scored by the same meshless measures (param/MeshlessDistortion, MapDefects):
 // the share of points that fold or overlap, and the median eps_conf and eps_auth (Eq. 4.3-4.4)
-// at 16 and 64 neighbours. The mesh peers are scored on the mesh's vertices.
+// at 16 and 64 neighbours, and the median stretch of the 16-neighbour local maps (the ratio of
+// their singular values, MapDefects::stretch). The mesh peers are scored on the mesh's vertices.
 //
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]
 //                     [--scales M (50)] [--resolution R (128): the peers' mesh grid]
@@ -50,6 +51,7 @@ struct Score {
   std::string method;
   double folds = 0, overlaps = 0;  // % of the points
   double conf16 = 0, auth16 = 0, conf64 = 0, auth64 = 0;
+  double stretch = 0;  // median singular-value ratio of the 16-neighbour local maps
   double seconds = 0;
   std::string note;
 };
@@ -63,6 +65,7 @@ Score scoreMap(const std::string& method, const std::vector<Vec3>& positions,
   const double n = double(positions.size());
   s.folds = 100.0 * double(defects.folds) / n;
   s.overlaps = 100.0 * double(defects.overlaps) / n;
+  s.stretch = defects.medianStretch;
   const DistortionResult d = measureDistortion(positions, normals, domain, {{16, 64}});
   s.conf16 = d.sizes[0].medianConformal;
   s.auth16 = d.sizes[0].medianAuthalic;
@@ -143,9 +146,9 @@ void print(const std::string& shape, double noise, const Score& s) {
                 s.note.c_str(), s.seconds);
     return;
   }
-  std::printf("%-15s %-7g %-16s %7.3f %8.3f %7.3f %7.3f %7.3f %7.3f %8.2f  %s\n", shape.c_str(),
-              noise, s.method.c_str(), s.folds, s.overlaps, s.conf16, s.auth16, s.conf64, s.auth64,
-              s.seconds, s.note.c_str());
+  std::printf("%-15s %-7g %-16s %7.3f %8.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8.2f  %s\n",
+              shape.c_str(), noise, s.method.c_str(), s.folds, s.overlaps, s.conf16, s.auth16,
+              s.conf64, s.auth64, s.stretch, s.seconds, s.note.c_str());
   std::fflush(stdout);
 }
 
@@ -193,8 +196,8 @@ int main(int argc, char** argv) {
   ThreadLimit limit(threads);
   std::printf("points %zu, scales %d, peers' mesh grid %d, threads %zu\n", points, scales,
               resolution, ThreadLimit::active());
-  std::printf("%-15s %-7s %-16s %7s %8s %7s %7s %7s %7s %8s\n", "shape", "noise", "method",
-              "folds%", "overlap%", "conf16", "auth16", "conf64", "auth64", "seconds");
+  std::printf("%-15s %-7s %-16s %7s %8s %7s %7s %7s %7s %7s %8s\n", "shape", "noise", "method",
+              "folds%", "overlap%", "conf16", "auth16", "conf64", "auth64", "stretch", "seconds");
   for (ParamShape shape : shapes) {
     const std::string name = paramShapeName(shape);
     const ParamTopology topology = paramShapeTopology(shape);

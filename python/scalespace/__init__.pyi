@@ -154,5 +154,7 @@ def distortion(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
                scales_k: Sequence[int] = ..., threads: Optional[int] = ...,
                progress: Progress = ...) -> Dict[str, object]:
     """Meshless distortion (Sec. 4.4) of the map given as uv or direction: per size the
-    eps_conf / eps_auth arrays and their median and 90th percentile; fold and overlap flags."""
+    eps_conf / eps_auth arrays and their median and 90th percentile; fold and overlap flags;
+    stretch: the local maps' singular-value ratio (exact conformal distortion) and its median
+    and 90th percentile."""
     ...

@@ -66,6 +66,8 @@ TEST(MeshlessDistortion, AnIsometryHasNone) {
   const MapDefects defects = findMapDefects(points, normals, map);
   EXPECT_EQ(defects.folds + defects.overlaps + defects.undetermined, 0u);
   EXPECT_NEAR(defects.localScale[100], 1, 1e-6);
+  EXPECT_NEAR(defects.medianStretch, 1, 1e-6);
+  EXPECT_NEAR(defects.p90Stretch, 1, 1e-6);
 }
 
 TEST(MeshlessDistortion, AStretchIsConformalDistortionOnly) {
@@ -85,6 +87,12 @@ TEST(MeshlessDistortion, AStretchIsConformalDistortionOnly) {
   EXPECT_GT(positiveQuantile(conf, 0.1), 1.6);
   EXPECT_LT(positiveQuantile(conf, 0.9), 2.4);
   EXPECT_NEAR(positiveQuantile(auth, 0.9), 1, 1e-6);
+  // The local maps' singular values read the stretch exactly, everywhere (borders included):
+  // the least-squares linear map of a linear map is that map.
+  const MapDefects stretched = findMapDefects(points, normals, map);
+  EXPECT_EQ(stretched.undetermined, 0u);
+  for (const float r : stretched.stretch) ASSERT_NEAR(r, 2, 1e-5);
+  EXPECT_NEAR(stretched.medianStretch, 2, 1e-5);
   // A mirror is no fold: every local map flips alike.
   const DomainMap mirror = planeMap(points, [](const Vec3& p) { return Vec2(-p.x(), p.y()); });
   const MapDefects defects = findMapDefects(points, normals, mirror);

@@ -472,7 +472,10 @@ def test_parametrize_equals_the_cli(tmp_path):
     d = ss.distortion(cloud.points, cloud.normals, uv=got["uv"], scales_k=[16, 64])
     cli("distortion", tmp_path / "d.ply", tmp_path / "p.ply", "--scales-k", "16,64",
         "-o", tmp_path / "e.ply")
-    expected = json.loads((tmp_path / "e.json").read_text())["sizes"]
+    summary = json.loads((tmp_path / "e.json").read_text())
+    expected = summary["sizes"]
+    np.testing.assert_allclose(d["median_stretch"], summary["median_stretch"], rtol=1e-6)
+    assert d["stretch"].shape == (4000,) and 1 <= d["median_stretch"] < 1.2
     for g, e in zip(d["sizes"], expected):
         assert g["neighbors"] == e["neighbors"]
         np.testing.assert_allclose(g["median_conformal"], e["median_conformal"], rtol=1e-6)

@@ -316,9 +316,11 @@ void addDistortionCommand(CLI::App& app) {
     }
     AttributeColumn& fold = cloud.addAttribute("fold", ScalarType::UInt8);
     AttributeColumn& overlap = cloud.addAttribute("overlap", ScalarType::UInt8);
+    AttributeColumn& stretch = cloud.addAttribute("stretch", ScalarType::Float32);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       fold.values[i] = defects.fold[i];
       overlap.values[i] = defects.overlap[i];
+      stretch.values[i] = defects.stretch[i];
     }
     writeCloud(cloud, args->output, WriteOptions{args->ascii});
     const nlohmann::json json = {
@@ -334,6 +336,8 @@ void addDistortionCommand(CLI::App& app) {
         {"sizes", sizes},
         {"folds", defects.folds},
         {"overlaps", defects.overlaps},
+        {"median_stretch", defects.medianStretch},
+        {"p90_stretch", defects.p90Stretch},
         {"seconds", std::chrono::duration<double>(Clock::now() - start).count()}};
     writeJson(summaryPathFor(args->output), json);
     if (!args->quiet) {
@@ -343,8 +347,11 @@ void addDistortionCommand(CLI::App& app) {
                      "(90%% %.3f)\n",
                      s.neighbors, s.medianConformal, s.p90Conformal, s.medianAuthalic,
                      s.p90Authalic);
-      std::fprintf(stderr, "distortion: %zu folds, %zu overlaps -> %s\n", defects.folds,
-                   defects.overlaps, args->output.c_str());
+      std::fprintf(stderr,
+                   "distortion: local maps' stretch median %.3f (90%% %.3f); %zu folds, %zu "
+                   "overlaps -> %s\n",
+                   defects.medianStretch, defects.p90Stretch, defects.folds, defects.overlaps,
+                   args->output.c_str());
     }
     reportDone("distortion", start, args->quiet);
   });

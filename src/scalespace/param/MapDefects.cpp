@@ -8,6 +8,7 @@
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/param/LocalMapSample.hpp"
+#include "scalespace/param/MeshlessDistortion.hpp"
 
 namespace scalespace {
 
@@ -32,6 +33,7 @@ MapDefects findMapDefects(const std::vector<Vec3>& positions, const std::vector<
   result.fold.assign(n, 0);
   result.overlap.assign(n, 0);
   result.localScale.assign(n, 0);
+  result.stretch.assign(n, 0);
   if (n < 3) return result;
 
   const auto index = makeSpatialIndex(positions);
@@ -61,6 +63,7 @@ MapDefects findMapDefects(const std::vector<Vec3>& positions, const std::vector<
                     jacobian[i] = a;
                     determined[i] = 1;
                     result.localScale[i] = float(std::sqrt(std::abs(a.determinant())));
+                    result.stretch[i] = float(s0 / s1);
                   });
   std::size_t positive = 0, negative = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -71,6 +74,8 @@ MapDefects findMapDefects(const std::vector<Vec3>& positions, const std::vector<
     (jacobian[i].determinant() > 0 ? positive : negative) += 1;
   }
   result.majoritySign = positive >= negative ? 1 : -1;
+  result.medianStretch = positiveQuantile(result.stretch, 0.5);
+  result.p90Stretch = positiveQuantile(result.stretch, 0.9);
   for (std::size_t i = 0; i < n; ++i)
     if (determined[i] && (jacobian[i].determinant() > 0 ? 1 : -1) != result.majoritySign) {
       result.fold[i] = 1;

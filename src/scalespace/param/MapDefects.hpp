@@ -38,6 +38,12 @@ struct MapDefects {
   /// Per point: sqrt|det A_i|, the local map's area scale (domain length per 3D length), 0 where
   /// the map had no verdict.
   std::vector<float> localScale;
+  /// Per point: the ratio of A_i's singular values, largest over smallest, the exact conformal
+  /// distortion of the local map (1: circles stay circles, 2: twice stretched one way); 0 where
+  /// the map had no verdict. Eq. 4.3 compares the anisotropies of two neighbourhood ellipses
+  /// instead, which under-reads a stretch where the 3D neighbourhood is itself anisotropic.
+  std::vector<float> stretch;
+  double medianStretch = 0, p90Stretch = 0;  // over the points with a verdict
   std::size_t folds = 0, overlaps = 0, undetermined = 0;
   int majoritySign = 1;  // orientation of most local maps
 };

@@ -131,6 +131,9 @@ py::dict distortionPy(const py::handle& points, const py::handle& normals, const
   out["sizes"] = sizes;
   out["fold"] = toArray(std::vector<std::uint8_t>(defects.fold));
   out["overlap"] = toArray(std::vector<std::uint8_t>(defects.overlap));
+  out["stretch"] = toArray(std::vector<float>(defects.stretch));
+  out["median_stretch"] = defects.medianStretch;
+  out["p90_stretch"] = defects.p90Stretch;
   out["folds"] = defects.folds;
   out["overlaps"] = defects.overlaps;
   return out;
