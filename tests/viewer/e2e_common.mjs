@@ -83,3 +83,15 @@ export async function launchChromium(chromium, work) {
   });
   return { browser, userDataDir };
 }
+
+// Opens the viewer's URL in `page` and waits until it is ready (or failed); `errors` collects the
+// page's exceptions and `outside` the requests that left the local server (there must be none).
+export async function openViewer(page, url) {
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  const outside = [];
+  page.on('request', (r) => { if (!r.url().startsWith(url.slice(0, url.indexOf('/?')))) outside.push(r.url()); });
+  await page.goto(url);
+  await page.waitForFunction(() => window.scalespace && (window.scalespace.ready || window.scalespace.error), null, { timeout: 120000 });
+  return { errors, outside };
+}

@@ -11,7 +11,7 @@ import { spawn, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 
-import { checks, chromiumOrSkip, commandLine, launchChromium, runner } from './e2e_common.mjs';
+import { checks, chromiumOrSkip, commandLine, launchChromium, openViewer, runner } from './e2e_common.mjs';
 
 const { cli, work, rest, option } = commandLine();
 const pointCount = Number(option('--points', '20000'));
@@ -91,12 +91,7 @@ const { browser, userDataDir } = await launchChromium(chromium, work);
 const results = { points: pointCount, planesSeconds: Number(planesSeconds.toFixed(1)) };
 try {
   const page = browser.pages()[0] || await browser.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  const outside = [];
-  page.on('request', (r) => { if (!r.url().startsWith(url.slice(0, url.indexOf('/?')))) outside.push(r.url()); });
-  await page.goto(url);
-  await page.waitForFunction(() => window.scalespace && (window.scalespace.ready || window.scalespace.error), null, { timeout: 120000 });
+  const { errors, outside } = await openViewer(page, url);
   results.urlMs = Math.round(tUrl);
   results.firstFrameMs = Math.round(await page.evaluate(() => window.scalespace.firstFrameMs));
   results.commandToFirstFrameMs = Math.round(performance.now() - t0 - (await page.evaluate(() => performance.now() - window.scalespace.firstFrameMs)));

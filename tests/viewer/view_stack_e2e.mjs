@@ -14,7 +14,7 @@ import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 
-import { checks, chromiumOrSkip, commandLine, launchChromium, runner } from './e2e_common.mjs';
+import { checks, chromiumOrSkip, commandLine, launchChromium, openViewer, runner } from './e2e_common.mjs';
 
 const { cli, work, rest, option } = commandLine();
 const measure = rest.includes('--measure');
@@ -96,12 +96,7 @@ const shot = async (page, name) => { if (screenshots) await page.screenshot({ pa
 // Opens URL in a fresh tab and waits for the first frame; checks no request leaves the server.
 async function openPage(url) {
   const page = await browser.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  const outside = [];
-  page.on('request', (r) => { if (!r.url().startsWith(url.slice(0, url.indexOf('/?')))) outside.push(r.url()); });
-  await page.goto(url);
-  await page.waitForFunction(() => window.scalespace && (window.scalespace.ready || window.scalespace.error), null, { timeout: 120000 });
+  const { errors, outside } = await openViewer(page, url);
   check(!(await page.evaluate(() => window.scalespace.error)), `the page loaded without an error ${await page.evaluate(() => window.scalespace.error || '')}`);
   const idle = () => page.waitForFunction(() => window.scalespace.busy === 0, null, { timeout: 60000 });
   const done = () => {
