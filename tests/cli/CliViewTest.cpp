@@ -129,9 +129,15 @@ TEST_F(CliView, ServesAPlanesResultWithSegmentsLabelsAndStopsOnSigterm) {
   const AttributeColumn* id = segmented.findAttribute("plane_id");
   ASSERT_NE(id, nullptr);
   ASSERT_EQ(labels.second.size(), 4 * segmented.size());
-  for (std::size_t i = 0; i < segmented.size(); ++i) {
+  // The served arrays follow the drawn points (/api/cloud/indices): every point, coarse to fine.
+  const auto drawn = view.get("/api/cloud/indices?token=" + view.token);
+  ASSERT_EQ(drawn.second.size(), labels.second.size());
+  for (std::size_t k = 0; k < segmented.size(); ++k) {
     std::int32_t v;
-    std::memcpy(&v, labels.second.data() + 4 * i, 4);
+    std::uint32_t i;
+    std::memcpy(&v, labels.second.data() + 4 * k, 4);
+    std::memcpy(&i, drawn.second.data() + 4 * k, 4);
+    ASSERT_LT(i, segmented.size());
     ASSERT_EQ(v, id->values[i]) << "point " << i;
   }
   EXPECT_EQ(view.stop(), 0);
@@ -222,7 +228,8 @@ TEST_F(CliView, DecimatesBeyondThePointBudget) {
   ASSERT_EQ(run("generate sphere -n 1000 -o " + path("s.ply") + " -q").code, 0);
   ViewProcess view({path("s.ply"), "--no-browser", "-q", "--point-budget", "300"});
   ASSERT_GT(view.port, 0);
-  EXPECT_EQ(view.get("/api/cloud/positions?token=" + view.token).second.size(), 250u * 12);
+  EXPECT_EQ(view.get("/api/cloud/positions?token=" + view.token).second.size(), 300u * 12);
+  EXPECT_EQ(view.get("/api/cloud/indices?token=" + view.token).second.size(), 300u * 4);
 }
 
 TEST_F(CliView, RefusesWhatItCannotOpen) {

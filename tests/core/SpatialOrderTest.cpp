@@ -112,3 +112,68 @@ TEST(Parallel, ParallelForVisitsEveryIndexOnceAndThreadLimitApplies) {
   { ThreadLimit all(0); }
   EXPECT_THROW(ThreadLimit(-1), OptionError);
 }
+
+namespace {
+// The octree cell (cells `side` wide, a 16-wide lattice) of a lattice point.
+int cellOf(const Vec3& p, int side) {
+  const int n = 16 / side;
+  return (int(p.x()) / side) + n * ((int(p.y()) / side) + n * (int(p.z()) / side));
+}
+}  // namespace
+
+TEST(CoarseToFineOrder, EveryLevelsPrefixHoldsOnePointPerCell) {
+  // A 16^3 lattice, shuffled: the first 8 points are one per octant, the first 64 one per cell of
+  // the 4x4x4 grid, the first 512 one per cell of the 8x8x8 grid.
+  std::vector<Vec3> lattice;
+  for (int z = 0; z < 16; ++z)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) lattice.emplace_back(x, y, z);
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < lattice.size(); ++i) points.push_back(lattice[(i * 1999) % 4096]);
+  const std::vector<Index> order = coarseToFineOrder(points);
+  EXPECT_TRUE(isPermutation(order));
+  for (int side : {8, 4, 2}) {
+    const std::size_t cells = std::size_t(16 / side) * (16 / side) * (16 / side);
+    std::vector<int> hits(cells, 0);
+    for (std::size_t k = 0; k < cells; ++k) ++hits[std::size_t(cellOf(points[order[k]], side))];
+    EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), std::ptrdiff_t(cells)) << side;
+  }
+}
+
+TEST(CoarseToFineOrder, APrefixIsEvenWhereEveryKthPointIsNot) {
+  // 90% of the points in a corner 1/1000 of the volume (a scan's points near the scanner): the
+  // first 1000 points of the order hold few of them, every k-th point nine in ten.
+  std::vector<Vec3> points = testclouds::uniformCube(20000, 21);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (i % 10 != 0) points[i] *= 0.1;
+  const auto inCorner = [](const Vec3& p) { return (p.array() <= 0.1).all(); };
+  const std::vector<Index> order = coarseToFineOrder(points);
+  std::size_t corner = 0, everyKth = 0;
+  for (std::size_t k = 0; k < 1000; ++k) {
+    corner += inCorner(points[order[k]]);
+    everyKth += inCorner(points[19 * k]);
+  }
+  EXPECT_GE(everyKth, 850u);
+  EXPECT_LE(corner, 250u);
+}
+
+TEST(CoarseToFineOrder, IsDeterministicForAnyThreadCountWithNonFinitePointsLast) {
+  std::vector<Vec3> points = testclouds::uniformCube(30000, 22);
+  points[5] = Vec3(std::numeric_limits<double>::infinity(), 0, 0);
+  points.push_back(points[7]);  // a repeated point
+  std::vector<Index> one, two;
+  {
+    ThreadLimit limit(1);
+    one = coarseToFineOrder(points);
+  }
+  {
+    ThreadLimit limit(2);
+    two = coarseToFineOrder(points);
+  }
+  EXPECT_TRUE(isPermutation(one));
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one.back(), 5u);
+  EXPECT_TRUE(coarseToFineOrder({}).empty());
+  EXPECT_EQ(coarseToFineOrder({Vec3(1, 2, 3)}), std::vector<Index>{0});
+  EXPECT_EQ(coarseToFineOrder(std::vector<Vec3>(3, Vec3(1, 1, 1))).size(), 3u);
+}

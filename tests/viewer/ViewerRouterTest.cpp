@@ -2,6 +2,7 @@
 // strict parameters, and answers equal to the library's queries (what `segment` computes).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <set>
 
@@ -185,22 +186,23 @@ TEST(ViewerRouter, RefusesMalformedBodies) {
 
 TEST(ViewerLayers, LabelsAreTheLibrarysQueries) {
   const auto router = smallRouter();
+  const auto shown = displayed(*router);
   const PlaneModel model = smallPlaneModel();
   for (int p = 0; p <= 3; ++p)
     EXPECT_EQ(
         decode<int>(
             router->route(request("/api/planes/labels", {{"min_persistence", std::to_string(p)}}))
                 .body),
-        labelsByPersistence(model, p))
+        inDisplayOrder(labelsByPersistence(model, p), shown))
         << p;
   for (int level = 0; level < 3; ++level)
     EXPECT_EQ(
         decode<int>(
             router->route(request("/api/planes/labels", {{"level", std::to_string(level)}})).body),
-        labelsAtScale(model, model.scales[std::size_t(level)]))
+        inDisplayOrder(labelsAtScale(model, model.scales[std::size_t(level)]), shown))
         << level;
   EXPECT_EQ(decode<int>(router->route(request("/api/planes/labels", {{"components", "2,1"}})).body),
-            labelsOfComponents(model, {2, 1}));
+            inDisplayOrder(labelsOfComponents(model, {2, 1}), shown));
   EXPECT_EQ(decode<int>(router->route(request("/api/planes/labels", {{"components", ""}})).body),
             std::vector<int>(8, -1));
 }
@@ -209,7 +211,8 @@ TEST(ViewerLayers, ALongSelectionTravelsInTheBody) {
   const auto router = smallRouter();
   ViewerRequest r = request("/api/planes/labels", {{"components", "body"}}, "POST");
   r.body = indexBody({2, 1});
-  EXPECT_EQ(decode<int>(router->route(r).body), labelsOfComponents(smallPlaneModel(), {2, 1}));
+  EXPECT_EQ(decode<int>(router->route(r).body),
+            inDisplayOrder(labelsOfComponents(smallPlaneModel(), {2, 1}), displayed(*router)));
   r.body = indexBody({3});  // no component 3
   EXPECT_EQ(router->route(r).status, 400);
   r.body = "abc";
@@ -261,20 +264,29 @@ TEST(ViewerLayers, ComponentsTableHoldsEveryField) {
 TEST(ViewerLayers, CloudArraysAreFloat32AtTheDisplaySample) {
   const auto all = smallRouter();
   const auto cloud = smallCloud();
+  const auto shown = displayed(*all);
+  std::vector<std::uint32_t> sorted = shown;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, (std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5, 6, 7}));  // within the budget
   const auto positions = decode<float>(all->route(request("/api/cloud/positions")).body);
   ASSERT_EQ(positions.size(), 24u);
-  EXPECT_FLOAT_EQ(positions[3 * 5 + 1], float(cloud->positions()[5].y()));
-  const auto decimated = smallRouter(".", 3);  // 8 points, budget 3: every 3rd point
+  for (std::size_t k = 0; k < 8; ++k)
+    for (int d = 0; d < 3; ++d)
+      EXPECT_EQ(positions[3 * k + std::size_t(d)], float(cloud->positions()[shown[k]][d]));
+  const auto decimated = smallRouter(".", 3);  // 8 points, budget 3: the first 3 coarse to fine
   const auto manifest = nlohmann::json::parse(decimated->route(request("/api/manifest")).body);
-  EXPECT_EQ(manifest.at("cloud").at("display_step"), 3);
+  EXPECT_EQ(manifest.at("cloud").at("display_order"), "coarse_to_fine");
   EXPECT_EQ(manifest.at("cloud").at("display_count"), 3);
+  const auto few = displayed(*decimated);
+  EXPECT_EQ(few, std::vector<std::uint32_t>(shown.begin(), shown.begin() + 3));
+  std::vector<float> intensity;
+  for (std::uint32_t i : few) intensity.push_back(float(10 * i));
   EXPECT_EQ(decode<float>(
                 decimated->route(request("/api/cloud/attribute", {{"name", "intensity"}})).body),
-            (std::vector<float>{0, 30, 60}));
-  const auto full = labelsByPersistence(smallPlaneModel(), 0);
+            intensity);
   EXPECT_EQ(
       decode<int>(decimated->route(request("/api/planes/labels", {{"min_persistence", "0"}})).body),
-      (std::vector<int>{full[0], full[3], full[6]}));
+      inDisplayOrder(labelsByPersistence(smallPlaneModel(), 0), few));
 }
 
 TEST(ViewerLayers, ExportWritesNewFilesWithSegmentsColumns) {

@@ -57,7 +57,7 @@ inline std::unique_ptr<viewer::ViewerRouter> smallRouter(
     const std::string& exportDir = ".", std::size_t budget = 100,
     viewer::PageAssets page = {"<p>%SCALESPACE_TOKEN%</p>", "js", ""}) {
   auto cloud = smallCloud();
-  const auto sample = viewer::displaySampleFor(cloud->size(), budget);
+  const auto sample = viewer::displaySampleFor(cloud->positions(), budget);
   std::vector<std::unique_ptr<viewer::ViewerLayer>> layers;
   layers.push_back(std::make_unique<viewer::CloudLayer>(cloud, sample));
   viewer::PlanesLayerOptions options;
@@ -86,6 +86,20 @@ template <typename T>
 std::vector<T> decode(const std::string& bytes) {
   std::vector<T> out(bytes.size() / sizeof(T));
   std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));  // the tests run little-endian
+  return out;
+}
+
+/// The cloud's indices of the points the router draws, in the order of every per-point array.
+inline std::vector<std::uint32_t> displayed(const viewer::ViewerRouter& router) {
+  return decode<std::uint32_t>(router.route(request("/api/cloud/indices")).body);
+}
+
+/// values[indices[k]] for every k: a whole-cloud array in the display order.
+template <typename T>
+std::vector<T> inDisplayOrder(const std::vector<T>& values,
+                              const std::vector<std::uint32_t>& indices) {
+  std::vector<T> out;
+  for (std::uint32_t i : indices) out.push_back(values.at(i));
   return out;
 }
 

@@ -99,6 +99,10 @@ try {
   const manifest = await page.evaluate(() => window.scalespace.manifest);
   const idle = () => page.waitForFunction(() => window.scalespace.busy === 0, null, { timeout: 60000 });
   const labels = async () => Int32Array.from(await page.evaluate(() => Array.from(window.scalespace.labels)));
+  // The page's arrays follow its drawn points (/api/cloud/indices, coarse to fine); a whole-cloud
+  // array (segment's plane_id, in input order) is compared at the same points.
+  const drawn = await page.evaluate(() => Array.from(window.scalespace.indices));
+  const drawnOrder = (whole) => Int32Array.from(drawn, (i) => whole[i]);
   const shot = async (name) => { if (screenshots) await page.screenshot({ path: path.join(screenshots, name) }); };
 
   if (cloudOnly) {
@@ -113,7 +117,6 @@ try {
     });
     results.recolorMs = Math.round(t1);
     results.displayCount = manifest.cloud.display_count;
-    results.displayStep = manifest.cloud.display_step;
   }
   // Persistence slider: a few key presses down from its start, then the labels against segment.
   if (!cloudOnly) await page.focus('#persistence');
@@ -124,7 +127,7 @@ try {
   await page.waitForFunction((p) => window.scalespace.labelsQuery && window.scalespace.labelsQuery.min_persistence === String(p) && window.scalespace.busy === 0, persistence);
   if (!measureOnly) {
     run('segment', planes, '--min-persistence', String(persistence), '-o', path.join(work, 'pers.csv'), '-q');
-    const d = sameLabels(await labels(), planeIds(path.join(work, 'pers.csv')));
+    const d = sameLabels(await labels(), drawnOrder(planeIds(path.join(work, 'pers.csv'))));
     check(!d, `persistence slider at ${persistence}: same labels as segment --min-persistence ${persistence} ${d}`);
   }
   await shot('viewer_persistence.png');
@@ -137,7 +140,7 @@ try {
   const t = manifest.planes.scales[level];
   if (!measureOnly) {
     run('segment', planes, '--scale', String(t), '-o', path.join(work, 'scale.csv'), '-q');
-    const d = sameLabels(await labels(), planeIds(path.join(work, 'scale.csv')));
+    const d = sameLabels(await labels(), drawnOrder(planeIds(path.join(work, 'scale.csv'))));
     check(!d, `scale slider at level ${level} (t = ${t}): same labels as segment --scale ${t} ${d}`);
   }
   await shot('viewer_scale.png');
@@ -179,7 +182,7 @@ try {
       .trim().split('\n').slice(1).map((l) => Number(l.split(',')[0]));
     check(JSON.stringify(ranking) === JSON.stringify(matches.map((m) => m.component)),
       `brush ranking equals segment --brush's (${ranking.slice(0, 5)}...)`);
-    const db = sameLabels(await labels(), planeIds(path.join(work, 'brush.csv')));
+    const db = sameLabels(await labels(), drawnOrder(planeIds(path.join(work, 'brush.csv'))));
     check(!db, `brush: the best component's points equal segment --brush's ${db}`);
     await shot('viewer_brush.png');
 
@@ -189,7 +192,7 @@ try {
     const similar = await page.evaluate(() => window.scalespace.lastSimilar);
     fs.writeFileSync(path.join(work, 'all.txt'), Array.from({ length: pointCount }, (_, i) => i).join('\n'));
     run('segment', planes, '--similar', String(similar.query), '--within', path.join(work, 'all.txt'), '-o', path.join(work, 'similar.csv'), '-q');
-    const ds = sameLabels(await labels(), planeIds(path.join(work, 'similar.csv')));
+    const ds = sameLabels(await labels(), drawnOrder(planeIds(path.join(work, 'similar.csv'))));
     check(!ds, `similar to ${similar.query}: ${similar.components.length} components, same points as segment --similar ${ds}`);
     await shot('viewer_similar.png');
 
@@ -253,7 +256,8 @@ try {
       await page.click('#brush');
       const r = await page.evaluate(async (plan) => {
         const s = window.scalespace, token = new URLSearchParams(location.search).get('token');
-        const selected = new Set(Array.from(s.lastBrush.indices, (i) => i / s.step));
+        const drawnAt = new Map(Array.from(s.indices, (i, k) => [i, k]));  // cloud index -> drawn
+        const selected = new Set(Array.from(s.lastBrush.indices, (i) => drawnAt.get(i)));
         const under = s.lastBrush.underStroke;
         const frontMax = Math.max(...under.filter((k) => s.gtFace[k] === plan.front).map((k) => s.viewDepth(k)));
         const isHidden = (k) => s.gtFace[k] !== plan.front && s.viewDepth(k) > frontMax + 0.05 * plan.radius;
@@ -279,7 +283,7 @@ try {
           return list;
         };
         out.components = await share(s.lastBrush.matches);
-        const everything = Uint32Array.from(under, (k) => k * s.step);
+        const everything = Uint32Array.from(under, (k) => s.indices[k]);
         const noDepth = await (await fetch(`/api/planes/brush?token=${token}`, { method: 'POST', body: everything })).json();
         out.withoutDepthTest = await share(noDepth.matches);
         return out;

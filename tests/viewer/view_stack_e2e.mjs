@@ -39,11 +39,16 @@ function csvColumns(text) {
   return columns;
 }
 // Float32 values served against the CSV's (printed from the same float32 with 9+ digits).
-function sameFloat32(served, expected, step = 1) {
-  const n = Math.ceil(expected.length / step);
+// With `indices` (the page's drawn points, /api/cloud/indices), served[k] is the value of point
+// indices[k].
+function sameFloat32(served, expected, indices = null) {
+  const n = indices ? indices.length : expected.length;
   if (served.length !== n) return `lengths ${served.length} and ${n}`;
   let differ = 0;
-  for (let k = 0; k < n; ++k) differ += served[k] !== Math.fround(expected[k * step]) && !(Number.isNaN(served[k]) && Number.isNaN(expected[k * step]));
+  for (let k = 0; k < n; ++k) {
+    const e = expected[indices ? indices[k] : k];
+    differ += served[k] !== Math.fround(e) && !(Number.isNaN(served[k]) && Number.isNaN(e));
+  }
   return differ === 0 ? '' : `${differ} values differ`;
 }
 // The edge count in a PLY header.
@@ -114,7 +119,9 @@ try {
   const manifest = await page.evaluate(() => window.scalespace.manifest);
   check(manifest.source.kind === 'stack' && manifest.stack.scale_count === scaleCount && manifest.stack.point_count === pointCount,
     `manifest: a stack of ${manifest.stack.point_count} points at ${manifest.stack.scale_count} scales`);
-  const step = manifest.cloud.display_step;
+  const indices = await page.evaluate(() => Array.from(window.scalespace.indices));
+  check(indices.length === manifest.cloud.display_count && new Set(indices).size === indices.length &&
+    indices.every((i) => i < pointCount), `the page draws ${indices.length} distinct points of the cloud`);
   const served = async () => Float32Array.from(await page.evaluate(() => Array.from(window.scalespace.stackValues)));
   const exported = new Map();  // scale -> CSV columns of `export --scale`
   const exportScale = (j) => {
@@ -127,7 +134,7 @@ try {
   };
   const checkShown = async (what) => {
     const q = await page.evaluate(() => window.scalespace.stackQuery);
-    const d = sameFloat32(await served(), exportScale(Number(q.scale))[q.quantity], step);
+    const d = sameFloat32(await served(), exportScale(Number(q.scale))[q.quantity], indices);
     check(!d, `${what}: ${q.quantity} at scale ${q.scale} equals export --scale ${q.scale}'s ${d}`);
     // Colours: a value at or below the colour bar's low end is viridis' first colour, at or above
     // its high end the last.

@@ -106,7 +106,8 @@ void loadStack(const ViewArgs& args, nlohmann::json& source,
     cloud = std::make_shared<PointCloud>();
     cloud->setAbsolutePositions(reader->inputPositions());
   }
-  const viewer::DisplaySample sample = viewer::displaySampleFor(cloud->size(), args.pointBudget);
+  const viewer::DisplaySample sample =
+      viewer::displaySampleFor(cloud->positions(), args.pointBudget);
   source = {{"path", args.path}, {"kind", "stack"}};
   if (!args.input.empty()) source["input"] = args.input;
   layers.push_back(std::make_unique<viewer::CloudLayer>(cloud, sample));
@@ -132,7 +133,7 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
       auto cloud = std::make_shared<PointCloud>(loadCloud(input, args.quiet));
       source = {{"path", args.path}, {"kind", "cylinders"}};
       layers.push_back(std::make_unique<viewer::CloudLayer>(
-          cloud, viewer::displaySampleFor(cloud->size(), args.pointBudget)));
+          cloud, viewer::displaySampleFor(cloud->positions(), args.pointBudget)));
       return layers;
     }
     if (!isPlaneResult(args.path))
@@ -146,7 +147,8 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
         recorded, args.input, args.path, "planes", model.membership.pointCount, "", args.quiet));
     // As `segment`: the saved offsets are absolute, the queries work relative to the origin.
     for (auto& c : model.components) c.plane.offset -= c.plane.normal.dot(cloud->origin());
-    const viewer::DisplaySample sample = viewer::displaySampleFor(cloud->size(), args.pointBudget);
+    const viewer::DisplaySample sample =
+        viewer::displaySampleFor(cloud->positions(), args.pointBudget);
     viewer::PlanesLayerOptions options;
     options.exportDirectory = fs::absolute(args.exportDir, ec).lexically_normal().string();
     options.protectedPaths = {args.input.empty() ? recorded : args.input};
@@ -166,7 +168,7 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
     auto cloud = std::make_shared<PointCloud>(lines.vertices);
     source = {{"path", args.path}, {"kind", "lines"}};
     layers.push_back(std::make_unique<viewer::CloudLayer>(
-        cloud, viewer::displaySampleFor(cloud->size(), args.pointBudget)));
+        cloud, viewer::displaySampleFor(cloud->positions(), args.pointBudget)));
     layers.push_back(std::make_unique<viewer::LinesLayer>(std::move(lines), cloud->origin()));
     return layers;
   }
@@ -175,7 +177,7 @@ std::vector<std::unique_ptr<viewer::ViewerLayer>> loadLayersWithoutLines(const V
   auto cloud = std::make_shared<PointCloud>(loadCloud(input, args.quiet));
   source = {{"path", args.path}, {"kind", "cloud"}};
   layers.push_back(std::make_unique<viewer::CloudLayer>(
-      cloud, viewer::displaySampleFor(cloud->size(), args.pointBudget)));
+      cloud, viewer::displaySampleFor(cloud->positions(), args.pointBudget)));
   return layers;
 }
 
@@ -223,8 +225,8 @@ void addViewCommand(CLI::App& app) {
       ->check(CLI::Range(0, 65535));
   cmd->add_flag("--no-browser", args->noBrowser, "only print the URL (no xdg-open)");
   cmd->add_option("--point-budget", args->pointBudget,
-                  "draw at most this many points (every k-th point beyond it; queries still use "
-                  "all points)")
+                  "draw at most this many points (beyond it, a subset spread evenly over the "
+                  "cloud; queries still use all points)")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t(1), std::size_t(1) << 31));
   cmd->add_option("--export-dir", args->exportDir,

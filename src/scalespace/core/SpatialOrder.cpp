@@ -21,16 +21,21 @@ std::uint64_t spreadBits(std::uint64_t v) {
   return v;
 }
 
-}  // namespace
+constexpr std::uint64_t kNonFinite = std::numeric_limits<std::uint64_t>::max();
 
-std::uint64_t mortonCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-  return spreadBits(x) | spreadBits(y) << 1 | spreadBits(z) << 2;
+// SplitMix64's finaliser: a fixed shuffle of the points within one level.
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
 }
 
-std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
+// (Morton code, index) of every point, sorted by code then index.
+std::vector<KeyedIndex> sortedMortonCodes(const std::vector<Vec3>& points, const char* caller) {
   const std::size_t n = points.size();
   if (n > std::size_t(std::numeric_limits<Index>::max()))
-    throw OptionError("spatialOrder: at most 2^32 - 1 points");
+    throw OptionError(std::string(caller) + ": at most 2^32 - 1 points");
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 hi = -lo;
   for (const Vec3& p : points)
@@ -46,7 +51,7 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     const Vec3& p = points[i];
     if (!p.allFinite()) {
-      keyed[i] = {std::numeric_limits<std::uint64_t>::max(), Index(i)};
+      keyed[i] = {kNonFinite, Index(i)};
       return;
     }
     const Vec3 c = ((p - lo) * scale).array().floor().min(kCells - 1.0).max(0.0);
@@ -55,9 +60,46 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
   });
   // Stable by code over increasing indices: ties are broken by index.
   radixSortStable(keyed);
-  std::vector<Index> order(n);
-  tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { order[i] = keyed[i].index; });
+  return keyed;
+}
+
+std::vector<Index> indicesOf(const std::vector<KeyedIndex>& keyed) {
+  std::vector<Index> order(keyed.size());
+  tbb::parallel_for(std::size_t(0), keyed.size(),
+                    [&](std::size_t i) { order[i] = keyed[i].index; });
   return order;
+}
+
+}  // namespace
+
+std::uint64_t mortonCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  return spreadBits(x) | spreadBits(y) << 1 | spreadBits(z) << 2;
+}
+
+std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
+  return indicesOf(sortedMortonCodes(points, "spatialOrder"));
+}
+
+std::vector<Index> coarseToFineOrder(const std::vector<Vec3>& points) {
+  const std::vector<KeyedIndex> sorted = sortedMortonCodes(points, "coarseToFineOrder");
+  // Along the curve, a point is the first of its cell at level L (cells 2^-L of the cube wide)
+  // exactly when it shares no level-L cell with the point before it: its level is one more than
+  // the deepest level they share (21 bits per axis: levels 0..21; 22 for a repeated finest cell).
+  constexpr std::uint64_t kRepeated = 22, kLast = 23;
+  std::vector<KeyedIndex> ranked(sorted.size());
+  tbb::parallel_for(std::size_t(0), sorted.size(), [&](std::size_t i) {
+    const std::uint64_t code = sorted[i].key;
+    std::uint64_t level = 0;
+    if (code == kNonFinite) {
+      level = kLast;
+    } else if (i > 0) {
+      const std::uint64_t differ = code ^ sorted[i - 1].key;
+      level = differ == 0 ? kRepeated : 21 - std::uint64_t(63 - __builtin_clzll(differ)) / 3;
+    }
+    ranked[i] = {level << 58 | mix(sorted[i].index) >> 6, sorted[i].index};
+  });
+  radixSortStable(ranked);
+  return indicesOf(ranked);
 }
 
 std::vector<Index> invertPermutation(const std::vector<Index>& order) {

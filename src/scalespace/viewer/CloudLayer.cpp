@@ -18,7 +18,7 @@ nlohmann::json CloudLayer::manifest() const {
   const Vec3& o = cloud_->origin();
   return {{"point_count", sample_.pointCount},
           {"display_count", sample_.count()},
-          {"display_step", sample_.step},
+          {"display_order", "coarse_to_fine"},
           {"origin", {o.x(), o.y(), o.z()}},
           {"bounds", {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}}},
           {"has_normals", cloud_->hasNormals()},
@@ -29,13 +29,20 @@ ViewerResponse CloudLayer::handle(const std::string& endpoint, const ViewerReque
   auto vectors = [&](const std::vector<Vec3>& values) {
     std::string out;
     out.reserve(sample_.count() * 12);
-    for (std::size_t i = 0; i < sample_.pointCount; i += sample_.step)
-      for (int d = 0; d < 3; ++d) appendFloat32(out, float(values[i][d]));
+    for (std::size_t k = 0; k < sample_.count(); ++k)
+      for (int d = 0; d < 3; ++d) appendFloat32(out, float(values[sample_[k]][d]));
     return binaryResponse(std::move(out));
   };
   if (endpoint == "positions") {
     requireMethod(request, "GET");
     return vectors(cloud_->positions());
+  }
+  if (endpoint == "indices") {
+    requireMethod(request, "GET");
+    std::string out;
+    out.reserve(sample_.count() * 4);
+    for (std::size_t k = 0; k < sample_.count(); ++k) appendUint32(out, sample_[k]);
+    return binaryResponse(std::move(out));
   }
   if (endpoint == "normals") {
     requireMethod(request, "GET");

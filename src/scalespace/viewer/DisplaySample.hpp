@@ -1,29 +1,36 @@
 #pragma once
-// The points the page draws: every step-th point, so that a cloud beyond the point budget reaches
-// the browser decimated instead of freezing the tab. Every per-point array the viewer serves
-// (positions, attributes, labels) is taken at the same points; indices the page sends back (brush,
-// search domain) are the cloud's own, k * step.
+// The points the page draws, as the cloud's indices in coarse-to-fine order (coarseToFineOrder):
+// every prefix is spread evenly over the cloud. A cloud beyond the point budget reaches the browser
+// as the budget's first points, an even level of detail rather than a freezing tab; the page draws
+// a shorter prefix while the view moves. Every per-point array the viewer serves (positions,
+// attributes, labels, stack values) is taken at the same points in the same order; indices the page
+// sends back (brush, series) are the cloud's own, looked up in /api/cloud/indices.
 #include <cstddef>
+#include <memory>
 #include <string>
+#include <vector>
+
+#include "scalespace/core/Types.hpp"
 
 namespace scalespace::viewer {
 
 struct DisplaySample {
-  std::size_t pointCount = 0;  // the cloud's
-  std::size_t step = 1;
-  std::size_t count() const { return step == 0 ? 0 : (pointCount + step - 1) / step; }
+  std::size_t pointCount = 0;                        // the cloud's
+  std::shared_ptr<const std::vector<Index>> points;  // the drawn points, coarse to fine
+  std::size_t count() const { return points ? points->size() : 0; }
+  Index operator[](std::size_t k) const { return (*points)[k]; }
 };
 
-/// The smallest step that keeps count() <= budget. Throws OptionError naming
-/// ViewerOptions::pointBudget when budget is 0.
-DisplaySample displaySampleFor(std::size_t pointCount, std::size_t budget);
+/// The first min(size, budget) points of coarseToFineOrder(positions). Throws OptionError when
+/// budget is 0.
+DisplaySample displaySampleFor(const std::vector<Vec3>& positions, std::size_t budget);
 
-/// Values v[k * step], k < count(), encoded with `append` (BinaryArrays.hpp).
+/// Values v[sample[k]], k < count(), encoded with `append` (BinaryArrays.hpp).
 template <typename Values, typename Append>
 std::string sampledArray(const DisplaySample& sample, const Values& values, Append append) {
   std::string out;
   out.reserve(sample.count() * 4);
-  for (std::size_t i = 0; i < sample.pointCount; i += sample.step) append(out, values[i]);
+  for (std::size_t k = 0; k < sample.count(); ++k) append(out, values[sample[k]]);
   return out;
 }
 

@@ -68,7 +68,6 @@ nlohmann::json StackLayer::manifest() const {
         {{"name", kQuantities[k].name}, {"description", kQuantities[k].description}});
   return {{"point_count", reader_->pointCount()},
           {"display_count", sample_.count()},
-          {"display_step", sample_.step},
           {"scale_count", reader_->scaleCount()},
           {"scales", info.scales},
           {"encoding", stackEncodingName(info.encoding)},
@@ -98,7 +97,8 @@ ViewerResponse StackLayer::handle(const std::string& endpoint, const ViewerReque
     const ScaleLayer layer = reader_->readScale(std::size_t(*j));
     std::string out;
     out.reserve(sample_.count() * 4);
-    for (std::size_t i = 0; i < n; i += sample_.step) appendFloat32(out, q.value(layer, i));
+    for (std::size_t k = 0; k < sample_.count(); ++k)
+      appendFloat32(out, q.value(layer, sample_[k]));
     return binaryResponse(std::move(out));
   }
   if (endpoint == "series") {

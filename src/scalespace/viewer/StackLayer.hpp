@@ -1,7 +1,8 @@
 #pragma once
 // A scale stack (`scalespace scales`, docs/STACK_FORMAT.md), read through ScaleStackReader: every
 // answer is what the reader returns (the compact encoding decoded by it), nothing recomputed.
-//   GET /api/stack/values?quantity=Q&scale=J   float32 per displayed point: quantity Q at scale j
+//   GET /api/stack/values?quantity=Q&scale=J   float32 per displayed point (the cloud layer's
+//        order): quantity Q at scale j
 //   GET /api/stack/series?point=I[&quantities=Q1,Q2]  float32, quantity after quantity (in the
 //        order asked; default: every quantity of the manifest), each over the M scales: point I
 //        (the cloud's own index, input order) at every scale
@@ -23,7 +24,7 @@ class StackLayer : public ViewerLayer {
   /// `sample` is the display sample of the cloud layer (same point count as the stack).
   StackLayer(std::shared_ptr<const ScaleStackReader> reader, DisplaySample sample);
   std::string name() const override { return "stack"; }
-  /// point_count, display_count, display_step, scale_count, scales, encoding, format_version and
+  /// point_count, display_count, scale_count, scales, encoding, format_version and
   /// quantities (name and description each).
   nlohmann::json manifest() const override;
   ViewerResponse handle(const std::string& endpoint, const ViewerRequest& request) const override;

@@ -16,7 +16,7 @@ const $ = (id) => document.getElementById(id);
 
 // Everything the page knows; the end-to-end test (tests/viewer) reads it as window.scalespace.
 const state = {
-  manifest: null, step: 1, count: 0, positions: null, labels: null, labelsQuery: null,
+  manifest: null, indices: null, count: 0, positions: null, labels: null, labelsQuery: null,
   components: [], selection: [], lastBrush: null, lastSimilar: null, lastExport: null,
   timings: [], firstFrameMs: null, busy: 0, error: null,
   stackQuery: null, stackValues: null, stackRange: null, series: null,
@@ -64,22 +64,18 @@ function requestRender() {
 function nextFrame() { return new Promise((resolve) => { frameWaiters.push(resolve); requestRender(); }); }
 controls.addEventListener('change', requestRender);
 
-// While the view is dragged, every k-th point only (at most INTERACTIVE_POINTS): a frame of a
-// million points takes 0.4 s in software WebGL (no GPU), a quarter of them a quarter of that. The
-// whole cloud is drawn again when the drag ends.
+// While the view is dragged, the first INTERACTIVE_POINTS points only: the server sends them
+// coarse to fine, so that prefix covers the whole cloud evenly. A frame of a million points takes
+// 0.4 s in software WebGL (no GPU), a quarter of them a quarter of that. The whole cloud is drawn
+// again when the drag ends.
 const INTERACTIVE_POINTS = 250000;
-let interactionIndex = null;
 controls.addEventListener('start', () => {
   if (!points || state.count <= INTERACTIVE_POINTS) return;
-  if (!interactionIndex) {
-    const k = Math.ceil(state.count / INTERACTIVE_POINTS);
-    interactionIndex = new THREE.BufferAttribute(new Uint32Array(Math.ceil(state.count / k)).map((_, i) => i * k), 1);
-  }
-  points.geometry.setIndex(interactionIndex);
+  points.geometry.setDrawRange(0, INTERACTIVE_POINTS);
 });
 controls.addEventListener('end', () => {
-  if (!points || !points.geometry.getIndex()) return;
-  points.geometry.setIndex(null);
+  if (!points || points.geometry.drawRange.count === Infinity) return;
+  points.geometry.setDrawRange(0, Infinity);
   requestRender();
 });
 
@@ -255,7 +251,7 @@ function plotSeries() {
 }
 
 async function showSeries(k) {
-  const point = k * state.step;  // the cloud's own index
+  const point = state.indices[k];  // the cloud's own index
   state.busy++;
   try {
     const names = state.manifest.stack.quantities.map((q) => q.name);
@@ -552,7 +548,7 @@ function brushedIndices() {
     }
     if (pass === 0) gap = Math.max(gap, screenGap(visible.map((c) => xs[c]), visible.map((c) => ys[c])));
   }
-  const out = visible.map((c) => underStroke[c] * state.step);  // the cloud's own indices
+  const out = visible.map((c) => state.indices[underStroke[c]]);  // the cloud's own indices
   state.brushGap = gap;
   return { indices: Uint32Array.from(out), underStroke };
 }
@@ -729,10 +725,10 @@ async function start() {
   const t0 = performance.now();
   state.manifest = await getJson('/api/manifest');
   const cloud = state.manifest.cloud;
-  state.step = cloud.display_step;
   state.count = cloud.display_count;
   $('source').textContent = `${state.manifest.source.path}\n${cloud.point_count.toLocaleString()} points` +
-    (state.step > 1 ? `, every ${state.step}th drawn (${state.count.toLocaleString()}; --point-budget)` : '');
+    (state.count < cloud.point_count ? `, ${state.count.toLocaleString()} drawn, spread evenly (--point-budget)` : '');
+  state.indices = new Uint32Array(await getBytes('/api/cloud/indices'));
   status('loading positions…');
   state.positions = new Float32Array(await getBytes('/api/cloud/positions', {}, (got, total) => progress(total ? got / total : 0)));
   const geometry = new THREE.BufferGeometry();
