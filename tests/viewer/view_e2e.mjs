@@ -262,6 +262,7 @@ try {
         const frontMax = Math.max(...under.filter((k) => s.gtFace[k] === plan.front).map((k) => s.viewDepth(k)));
         const isHidden = (k) => s.gtFace[k] !== plan.front && s.viewDepth(k) > frontMax + 0.05 * plan.radius;
         const out = {
+          selectMs: Math.round(s.lastBrush.selectMs), rankMs: Math.round(s.lastBrush.rankMs), gap: s.brushGap,
           under: under.length, selected: selected.size,
           frontUnder: under.filter((k) => s.gtFace[k] === plan.front).length,
           frontSelected: under.filter((k) => s.gtFace[k] === plan.front && selected.has(k)).length,

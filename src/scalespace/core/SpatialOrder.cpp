@@ -2,7 +2,10 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <array>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "scalespace/core/RadixSort.hpp"
@@ -22,14 +25,6 @@ std::uint64_t spreadBits(std::uint64_t v) {
 }
 
 constexpr std::uint64_t kNonFinite = std::numeric_limits<std::uint64_t>::max();
-
-// SplitMix64's finaliser: a fixed shuffle of the points within one level.
-std::uint64_t mix(std::uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
 
 // (Morton code, index) of every point, sorted by code then index.
 std::vector<KeyedIndex> sortedMortonCodes(const std::vector<Vec3>& points, const char* caller) {
@@ -82,24 +77,45 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points) {
 
 std::vector<Index> coarseToFineOrder(const std::vector<Vec3>& points) {
   const std::vector<KeyedIndex> sorted = sortedMortonCodes(points, "coarseToFineOrder");
+  const std::size_t n = sorted.size();
   // Along the curve, a point is the first of its cell at level L (cells 2^-L of the cube wide)
   // exactly when it shares no level-L cell with the point before it: its level is one more than
   // the deepest level they share (21 bits per axis: levels 0..21; 22 for a repeated finest cell).
-  constexpr std::uint64_t kRepeated = 22, kLast = 23;
-  std::vector<KeyedIndex> ranked(sorted.size());
-  tbb::parallel_for(std::size_t(0), sorted.size(), [&](std::size_t i) {
+  constexpr std::size_t kRepeated = 22, kLast = 23, kLevels = 24;
+  std::vector<std::uint8_t> level(n);
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     const std::uint64_t code = sorted[i].key;
-    std::uint64_t level = 0;
+    std::size_t l = 0;
     if (code == kNonFinite) {
-      level = kLast;
+      l = kLast;
     } else if (i > 0) {
       const std::uint64_t differ = code ^ sorted[i - 1].key;
-      level = differ == 0 ? kRepeated : 21 - std::uint64_t(63 - __builtin_clzll(differ)) / 3;
+      l = differ == 0 ? kRepeated : 21 - std::size_t(63 - __builtin_clzll(differ)) / 3;
     }
-    ranked[i] = {level << 58 | mix(sorted[i].index) >> 6, sorted[i].index};
+    level[i] = std::uint8_t(l);
   });
-  radixSortStable(ranked);
-  return indicesOf(ranked);
+  // Group by level, each level in curve order (a counting sort)...
+  std::array<std::size_t, kLevels + 1> start{};
+  for (std::uint8_t l : level) ++start[l + 1];
+  for (std::size_t l = 0; l < kLevels; ++l) start[l + 1] += start[l];
+  std::vector<Index> byLevel(n);
+  std::array<std::size_t, kLevels> next{};
+  std::copy(start.begin(), start.begin() + kLevels, next.begin());
+  for (std::size_t i = 0; i < n; ++i) byLevel[next[level[i]]++] = sorted[i].index;
+  // ... then within a level the k-th point is the (k * stride mod count)-th along the curve, a
+  // stride near count / golden ratio and prime to count: any prefix of a level visits the curve
+  // evenly (a Kronecker sequence), without a second sort.
+  std::vector<Index> order(n);
+  for (std::size_t l = 0; l < kLevels; ++l) {
+    const std::size_t first = start[l], count = start[l + 1] - start[l];
+    if (count == 0) continue;
+    std::size_t stride = std::max<std::size_t>(1, std::size_t(double(count) * 0.6180339887498949));
+    while (std::gcd(stride, count) != 1) ++stride;
+    tbb::parallel_for(std::size_t(0), count, [&](std::size_t k) {
+      order[first + k] = byLevel[first + (k * stride) % count];
+    });
+  }
+  return order;
 }
 
 std::vector<Index> invertPermutation(const std::vector<Index>& order) {

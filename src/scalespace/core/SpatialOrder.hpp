@@ -24,8 +24,8 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points);
 /// A permutation whose every prefix is spread evenly over the points: first one point per occupied
 /// cell of the Morton grid's coarsest level, then one per newly occupied cell of each finer level
 /// (the levels of an octree over the bounding cube), then the points that share a finest cell.
-/// Within a level the order is a fixed pseudo-random shuffle, so that a prefix ending inside a
-/// level is still even. Deterministic for any thread count; non-finite points come last. The
+/// Within a level the points are visited along the curve with a golden-ratio stride, so that a
+/// prefix ending inside a level is still even. Deterministic for any thread count; non-finite points come last. The
 /// viewer draws a prefix of it as its level of detail.
 std::vector<Index> coarseToFineOrder(const std::vector<Vec3>& points);
 

@@ -467,28 +467,41 @@ function brushTolerance(depth, h, gap) {
 // The gaps between drawn points on screen: twice the median distance (pixels) from a point under
 // the stroke to the nearest other one (at most 16). Between the sprites of a sparse cloud the
 // surface behind shows through; the front depth is the nearest within that many pixels, so that a
-// surface hides what lies behind it, holes between its points included.
+// surface hides what lies behind it, holes between its points included. The median is taken over
+// at most 2,000 of the points (evenly spread in the list, itself in the server's coarse-to-fine
+// order), each searched ring by ring of pixels around it: a dense stroke (a million-point cloud
+// puts thousands of points in a few pixels) costs no more than a sparse one.
+const GAP_LIMIT = 16, GAP_QUERIES = 2000;
 function screenGap(xs, ys) {
-  const n = xs.length, cell = 16, grid = new Map();
+  const n = xs.length;
   if (n < 2) return 0;
+  const grid = new Map();  // pixel -> the points in it
   for (let i = 0; i < n; ++i) {
-    const key = Math.floor(ys[i] / cell) * 65536 + Math.floor(xs[i] / cell);
-    if (!grid.has(key)) grid.set(key, []);
-    grid.get(key).push(i);
+    const key = (ys[i] | 0) * 65536 + (xs[i] | 0);
+    const list = grid.get(key);
+    if (list) list.push(i); else grid.set(key, [i]);
   }
-  const nearest = new Float32Array(n);
-  for (let i = 0; i < n; ++i) {
-    const cx = Math.floor(xs[i] / cell), cy = Math.floor(ys[i] / cell);
-    let best = cell;
-    for (let dy = -1; dy <= 1; ++dy) for (let dx = -1; dx <= 1; ++dx) {
-      for (const j of grid.get((cy + dy) * 65536 + cx + dx) || []) {
+  const queries = Math.min(n, GAP_QUERIES), nearest = new Float32Array(queries);
+  for (let q = 0; q < queries; ++q) {
+    const i = Math.floor(q * n / queries), px = xs[i] | 0, py = ys[i] | 0;
+    let best = GAP_LIMIT;
+    const visit = (x, y) => {
+      for (const j of grid.get(y * 65536 + x) || []) {
         if (j !== i) best = Math.min(best, Math.hypot(xs[j] - xs[i], ys[j] - ys[i]));
       }
+    };
+    // Ring r holds the pixels r steps away: none of their points is nearer than r - 1.
+    for (let r = 0; r <= GAP_LIMIT && r - 1 < best; ++r) {
+      if (r === 0) { visit(px, py); continue; }
+      for (let d = -r; d <= r; ++d) {
+        visit(px + d, py - r); visit(px + d, py + r);
+        if (d > -r && d < r) { visit(px - r, py + d); visit(px + r, py + d); }
+      }
     }
-    nearest[i] = best;
+    nearest[q] = best;
   }
   nearest.sort();
-  return Math.min(cell, Math.ceil(2 * nearest[n >> 1]));
+  return Math.min(GAP_LIMIT, Math.ceil(2 * nearest[queries >> 1]));
 }
 
 // View-space depth of displayed point k (for the end-to-end test's reference).
@@ -554,13 +567,15 @@ function brushedIndices() {
 }
 
 async function onBrushStroke() {
+  const start = performance.now();
   const { indices, underStroke } = brushedIndices();
+  const selectMs = performance.now() - start;  // the points under the stroke and the depth test
   brush.clear();
   if (indices.length === 0) { status('brush: no point under the stroke'); return; }
   state.busy++;
   try {
     const { matches } = await post('/api/planes/brush', {}, indices);
-    state.lastBrush = { indices, matches, underStroke };
+    state.lastBrush = { indices, matches, underStroke, selectMs, rankMs: performance.now() - start - selectMs };
     if (matches.length === 0) { status(`brush: ${indices.length} points, no component holds them`); return; }
     status(`brush: ${indices.length} points, ${matches.length} components; best ${matches[0].component} ` +
       `(score ${matches[0].score.toPrecision(3)}, overlap ${matches[0].overlap.toPrecision(3)})`);
