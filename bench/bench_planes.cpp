@@ -212,6 +212,10 @@ int main(int argc, char** argv) {
       detection.growing.maxStep = std::atof(argv[++i]);
     } else if (a == "--max-rms" && i + 1 < argc) {
       detection.planarity.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--merge-rms" && i + 1 < argc) {
+      detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--merge-width" && i + 1 < argc) {
+      detection.merging.minRelativeWidth = std::atof(argv[++i]);
     } else if (a == "--scene" && i + 1 < argc) {
       onlyScene = argv[++i];
     } else if (a == "--noise" && i + 1 < argc) {

@@ -467,6 +467,12 @@ int main(int argc, char** argv) {
       minPersistence = std::atoi(argv[++i]);
     } else if (a == "--max-step" && hasValue) {
       detection.growing.maxStep = std::atof(argv[++i]);
+    } else if (a == "--merge-rms" && hasValue) {
+      detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--merge-width" && hasValue) {
+      detection.merging.minRelativeWidth = std::atof(argv[++i]);
+    } else if (a == "--merge-deviation" && hasValue) {
+      detection.merging.maxRelativeDeviation = std::atof(argv[++i]);
     } else if (a == "--max-rms" && hasValue) {
       detection.planarity.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--no-robust") {

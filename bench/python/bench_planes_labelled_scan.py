@@ -4,7 +4,7 @@ check): CGAL's building.ply (libcgal-demo's data.tar.gz, data/points_3/building.
 with normals and `segment_index`, 19 planes, -1 elsewhere). Per labelled segment, the best IoU
 with a region of some scale, with a persistent component (>= 5 levels) at its representative
 level, and with the labels of `segment --min-persistence 5`; a segment is found at IoU >= 0.8.
-Runs the defaults and the thesis' method (max_step=0, max_rms=0), or the keyword sets given.
+Runs the defaults and the thesis' method (max_step=0, max_rms=0, merge_rms=0), or the keyword sets given.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python/bench_planes_labelled_scan.py \\
         path/to/building.ply [--label segment_index] ["dict(angle=10)" ...]
@@ -38,7 +38,7 @@ def main():
     gt = cloud.attributes[args.label].astype(int)
     segments = [int(s) for s in np.unique(gt) if s >= 0]
     runs = [(r, eval(r)) for r in args.runs] or [
-        ("defaults", {}), ("thesis", dict(max_step=0, max_rms=0))]
+        ("defaults", {}), ("thesis", dict(max_step=0, max_rms=0, merge_rms=0))]
     for name, kw in runs:
         start = time.time()
         planes = ss.planes(cloud.points, cloud.normals, **kw)

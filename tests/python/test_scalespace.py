@@ -135,6 +135,15 @@ def test_planes_and_segments_equal_the_cli(data, tmp_path):
     assert ranked["score"][0] == ranked["score"].max() and len(ranked["component"]) > 1
 
 
+def test_planes_merge_options_are_checked_before_any_work(data):
+    cloud = ss.read(str(data / "house.ply"))
+    for kwargs, name in [({"merge_rms": -1}, "merge_rms"),
+                         ({"merge_deviation": float("nan")}, "merge_deviation")]:
+        with pytest.raises(ss.OptionError, match=name) as e:
+            ss.planes(cloud.points, **kwargs)
+        assert "Options::" not in str(e.value)
+
+
 def test_stack_in_memory_equals_the_stack_on_disk_and_the_export(data, tmp_path):
     cloud = ss.read(str(data / "sphere.ply"))
     cli("scales", data / "sphere.ply", "-o", tmp_path / "s.stack", "--scales", 4, "--encoding",

@@ -316,6 +316,15 @@ void addPlanesCommand(CLI::App& app) {
                   "of t and twice the noise is not planar: never linked to a planar one, its "
                   "component flagged (0 = link any regions, Sec. 2.3.2)")
       ->capture_default_str();
+  cmd->add_option("--merge-rms", args->detection.merging.maxRelativeRms,
+                  "before the filter, adjacent regions each smaller than the scale are merged "
+                  "where their union's plane RMS is at most this fraction of t (a staircase "
+                  "becomes its mean ramp; 0 = as grown, Sec. 2.3.1)")
+      ->capture_default_str();
+  cmd->add_option("--merge-deviation", args->detection.merging.maxRelativeDeviation,
+                  "... and no point of the union is farther from that plane than this fraction "
+                  "of t")
+      ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")

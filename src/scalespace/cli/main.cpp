@@ -36,6 +36,8 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"ScaleSpaceOptions::alpha", "--alpha"},
     {"RegionGrowingOptions::maxStep", "--max-step"},
     {"PlanarityOptions::maxRelativeRms", "--max-rms"},
+    {"RegionMergeOptions::maxRelativeRms", "--merge-rms"},
+    {"RegionMergeOptions::maxRelativeDeviation", "--merge-deviation"},
     {"RegionGrowingOptions::maxAngleDegrees", "--angle"},
     {"StackWriteOptions::encoding", "--encoding"},
     {"RenderOptions::up", "--up"},

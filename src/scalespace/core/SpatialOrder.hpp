@@ -25,8 +25,8 @@ std::vector<Index> spatialOrder(const std::vector<Vec3>& points);
 /// cell of the Morton grid's coarsest level, then one per newly occupied cell of each finer level
 /// (the levels of an octree over the bounding cube), then the points that share a finest cell.
 /// Within a level the points are visited along the curve with a golden-ratio stride, so that a
-/// prefix ending inside a level is still even. Deterministic for any thread count; non-finite points come last. The
-/// viewer draws a prefix of it as its level of detail.
+/// prefix ending inside a level is still even. Deterministic for any thread count; non-finite
+/// points come last. The viewer draws a prefix of it as its level of detail.
 std::vector<Index> coarseToFineOrder(const std::vector<Vec3>& points);
 
 /// The Morton code of a point whose coordinates are quantised to [0, 2^21) per axis.

@@ -127,7 +127,9 @@ std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& p
         index->radiusSearch(points[i], gap, near);
         for (const Neighbor& nb : near) {
           const Index a = owner[i], b = owner[nb.index];
-          if (a < b && sign[a] == sign[b]) pairs.emplace_back(a, b);
+          // Points come curve by curve, so a pair repeats along a shared stretch: kept once.
+          if (a < b && sign[a] == sign[b] && (pairs.empty() || pairs.back() != std::pair(a, b)))
+            pairs.emplace_back(a, b);
         }
       }
     });

@@ -24,15 +24,20 @@ void validatePlaneDetectionOptions(const PlaneDetectionOptions& options) {
   validateRegionGrowingOptions(options.growing);
   validateRegionFilterOptions(filterOptionsOf(options));
   validate(options.planarity);
+  validate(options.merging);
   if (!(options.minJaccard >= 0 && options.minJaccard < 1))
     throw OptionError("PlaneDetectionOptions::minJaccard must be in [0, 1)");
 }
 
 RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
-                         const ScaleFeatures& scale, const PlaneDetectionOptions& options,
-                         PlaneDetectionTimings& timings) {
+                         const ScaleFeatures& scale, double noiseRms,
+                         const PlaneDetectionOptions& options, PlaneDetectionTimings& timings) {
   auto start = std::chrono::steady_clock::now();
-  const Segmentation seg = growRegions(knn, scale, options.growing);
+  Segmentation seg = growRegions(knn, scale, options.growing);
+  if (options.merging.maxRelativeRms > 0)
+    seg =
+        mergeCoplanarRegions(positions, knn, std::move(seg), scale.t,
+                             std::pow(options.alphaFactor * scale.t, 2), noiseRms, options.merging);
   timings.segmentation += secondsSince(start);
   start = std::chrono::steady_clock::now();
   RegionLevel level;
@@ -81,15 +86,15 @@ PlaneDetection detectPlanes(const std::vector<Vec3>& positions, const KnnGraph& 
   if (knn.size() != positions.size())
     throw OptionError("plane detection: the neighbour graph was built on another cloud");
   checkScaleFeatures(scales, positions.size());
+  const double noise = pointNoiseRms(positions, knn);
   PlaneDetectionTimings timings;
   std::vector<RegionLevel> levels;
   for (std::size_t j = 0; j < scales.size(); ++j) {
     if (progress && !progress(double(j) / double(scales.size()), "planar segmentations"))
       throw Cancelled();
-    levels.push_back(segmentScale(positions, knn, scales[j], options, timings));
+    levels.push_back(segmentScale(positions, knn, scales[j], noise, options, timings));
   }
-  return buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn), options,
-                             timings, progress);
+  return buildPlaneDetection(positions, std::move(levels), noise, options, timings, progress);
 }
 
 }  // namespace scalespace

@@ -45,6 +45,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
   const auto& positions = cloud.positions();
   auto start = std::chrono::steady_clock::now();
   const KnnGraph knn = buildKnnGraph(positions, 10);  // k = 10 (Sec. 2.3.1)
+  const double noise = pointNoiseRms(positions, knn);
   out.knnSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Scale j is segmented and filtered in a task while the stack projects scale j+1: region
   // growing is sequential and the filter's time goes to a few large regions, so done in the sink
@@ -87,7 +88,7 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
     // before the task counts as finished: the pool outlives every task (all are waited for).
     segmentations.run([&, &slot = slot, copy, t = stats.t] {
       const ScaleFeatures features = scaleFeaturesFromLayer(*copy, t);
-      slot.level = segmentScale(positions, knn, features, options, slot.timings);
+      slot.level = segmentScale(positions, knn, features, noise, options, slot.timings);
       --pending;
     });
   };
@@ -124,8 +125,8 @@ StackPlaneDetection detectPlanesInCloud(const PointCloud& cloud,
     timings.filtering += slot.timings.filtering;
     levels.push_back(std::move(slot.level));
   }
-  out.detection = buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn),
-                                      options, timings, progress);
+  out.detection =
+      buildPlaneDetection(positions, std::move(levels), noise, options, timings, progress);
   out.totalSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return out;
@@ -138,17 +139,17 @@ PlaneDetection detectPlanesFromStack(const PointCloud& cloud, const ScaleStackRe
   stack.checkInput(cloud, "the input cloud");
   const auto& positions = cloud.positions();
   const KnnGraph knn = buildKnnGraph(positions, 10);
+  const double noise = pointNoiseRms(positions, knn);
   PlaneDetectionTimings timings;
   std::vector<RegionLevel> levels;
   const std::size_t m = stack.scaleCount();
   for (std::size_t j = 0; j < m; ++j) {
     if (progress && !progress(double(j) / double(m), "planar segmentations")) throw Cancelled();
     levels.push_back(segmentScale(
-        positions, knn, scaleFeaturesFromLayer(stack.readScale(j), stack.info().scales[j]), options,
-        timings));
+        positions, knn, scaleFeaturesFromLayer(stack.readScale(j), stack.info().scales[j]), noise,
+        options, timings));
   }
-  return buildPlaneDetection(positions, std::move(levels), pointNoiseRms(positions, knn), options,
-                             timings, progress);
+  return buildPlaneDetection(positions, std::move(levels), noise, options, timings, progress);
 }
 
 }  // namespace scalespace

@@ -45,6 +45,8 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"ScaleSpaceOptions::alpha", "alpha"},
     {"RegionGrowingOptions::maxStep", "max_step"},
     {"PlanarityOptions::maxRelativeRms", "max_rms"},
+    {"RegionMergeOptions::maxRelativeRms", "merge_rms"},
+    {"RegionMergeOptions::maxRelativeDeviation", "merge_deviation"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},
     {"RenderOptions::up", "up"},

@@ -166,7 +166,8 @@ class Planes {
 
 std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& normals, int scales,
                                  double alpha, double angle, double maxStep, double maxRms,
-                                 bool robust, const std::optional<std::string>& stack,
+                                 double mergeRms, double mergeDeviation, bool robust,
+                                 const std::optional<std::string>& stack,
                                  const std::optional<std::string>& output, const std::string& input,
                                  std::optional<int> threads, py::object progress) {
   // `scalespace planes`' options and checks, before any work.
@@ -178,6 +179,8 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   PlaneDetectionOptions options;
   options.growing.maxStep = maxStep;
   options.planarity.maxRelativeRms = maxRms;
+  options.merging.maxRelativeRms = mergeRms;
+  options.merging.maxRelativeDeviation = mergeDeviation;
   options.growing.maxAngleDegrees = angle;
   validateScaleSpaceOptions(stackOptions);
   validatePlaneDetectionOptions(options);
@@ -272,16 +275,21 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
       });
   m.def("planes", &planesPy, "points"_a, "normals"_a = py::none(), py::kw_only(), "scales"_a = 50,
         "alpha"_a = 0.1, "angle"_a = 5.0, "max_step"_a = PlaneDetectionOptions{}.growing.maxStep,
-        "max_rms"_a = PlaneDetectionOptions{}.planarity.maxRelativeRms, "robust"_a = true,
-        "stack"_a = py::none(), "output"_a = py::none(), "input"_a = "", "threads"_a = py::none(),
-        "progress"_a = py::none(),
+        "max_rms"_a = PlaneDetectionOptions{}.planarity.maxRelativeRms,
+        "merge_rms"_a = PlaneDetectionOptions{}.merging.maxRelativeRms,
+        "merge_deviation"_a = PlaneDetectionOptions{}.merging.maxRelativeDeviation,
+        "robust"_a = true, "stack"_a = py::none(), "output"_a = py::none(), "input"_a = "",
+        "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Multi-scale planes by persistence (Chapter 2), as `scalespace planes`.
 
 scales: M log-spaced scales; alpha: the stack's Poisson-disk factor; angle: region growing theta
 (degrees); max_step: the largest step (fraction of t) a region crosses along its seed's normal
 (0.05; 0: the angle alone, Sec. 2.3.1); max_rms: regions whose plane RMS exceeds this fraction of
 t and twice the noise are not planar, never linked to planar ones and their components flagged
-(0.05; 0: the graph of Sec. 2.3.2); robust: the robust APSS of Sec. 2.3. stack: a stack folder
+(0.05; 0: the graph of Sec. 2.3.2); merge_rms, merge_deviation: adjacent regions each smaller
+than the scale are merged before the filter where their union's plane RMS is at most merge_rms t
+and no point is farther than merge_deviation t (0.1, 0.3: a staircase becomes its mean ramp;
+merge_rms 0: as grown, Sec. 2.3.1); robust: the robust APSS of Sec. 2.3. stack: a stack folder
 computed from these points instead of computing one. output: also write the result folder
 (input: the cloud file to record in it).)doc");
   m.def(

@@ -1,0 +1,231 @@
+#include "scalespace/planes/RegionMerging.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <tuple>
+#include <utility>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/fit/PointSetPlane.hpp"
+
+namespace scalespace {
+namespace {
+
+// First and second moments of a point set: enough for the least-squares plane of any union.
+struct Moments {
+  double count = 0;
+  Vec3 sum = Vec3::Zero();
+  Mat3 outer = Mat3::Zero();
+  void add(const Moments& o) {
+    count += o.count;
+    sum += o.sum;
+    outer += o.outer;
+  }
+};
+
+struct UnionPlane {
+  Vec3 normal, centroid, axisU, axisV;
+  double rms;
+};
+
+UnionPlane planeOf(const Moments& m) {
+  const Vec3 c = m.sum / m.count;
+  const Mat3 cov = m.outer / m.count - c * c.transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(cov);
+  return {eig.eigenvectors().col(0), c, eig.eigenvectors().col(1), eig.eigenvectors().col(2),
+          std::sqrt(std::max(0.0, eig.eigenvalues()(0)))};
+}
+
+using Box = std::array<Vec3, 8>;  // corners
+
+// The box around a grown region along its own plane's axes (through its centroid), and its
+// in-plane area.
+Box boxOf(const std::vector<Vec3>& positions, const std::vector<Index>& region, double& area) {
+  Box box;
+  box.fill(positions[region.front()]);
+  area = 0;
+  if (region.size() < 3) return box;  // a point or two: any corner is one of the points
+  const PlaneFit plane = fitPlane(positions, region);
+  const Vec3 axes[3] = {plane.axisU, plane.axisV, plane.normal};
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Index i : region) {
+    const Vec3 d = positions[i] - plane.centroid;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], d.dot(axes[k]));
+      hi[k] = std::max(hi[k], d.dot(axes[k]));
+    }
+  }
+  area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+  for (int c = 0; c < 8; ++c) {
+    box[std::size_t(c)] = plane.centroid;
+    for (int k = 0; k < 3; ++k) box[std::size_t(c)] += ((c >> k) & 1 ? hi[k] : lo[k]) * axes[k];
+  }
+  return box;
+}
+
+}  // namespace
+
+void validate(const RegionMergeOptions& options) {
+  if (!(options.maxRelativeRms >= 0) || !std::isfinite(options.maxRelativeRms))
+    throw OptionError("RegionMergeOptions::maxRelativeRms must be finite and >= 0");
+  if (!(options.maxRelativeDeviation >= 0) || !std::isfinite(options.maxRelativeDeviation))
+    throw OptionError("RegionMergeOptions::maxRelativeDeviation must be finite and >= 0");
+  if (!(options.noiseFactor >= 0) || !std::isfinite(options.noiseFactor))
+    throw OptionError("RegionMergeOptions::noiseFactor must be finite and >= 0");
+}
+
+Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                                  Segmentation segmentation, double t, double smallArea,
+                                  double noiseRms, const RegionMergeOptions& options) {
+  validate(options);
+  if (!(t > 0)) throw OptionError("region merging: the scale t must be positive");
+  if (!(noiseRms >= 0) || !std::isfinite(noiseRms))
+    throw OptionError("region merging: the noise RMS must be finite and >= 0");
+  const std::size_t n = segmentation.labels.size();
+  if (positions.size() != n || knn.size() != n)
+    throw OptionError("region merging: positions, labels and the k-NN graph differ in size");
+  const std::size_t regionCount = segmentation.regions.size();
+  const double maxRms = options.maxRelativeRms * t;
+  const double maxDeviation = options.maxRelativeDeviation * t;
+  const double minWidth = options.minRelativeWidth * t;
+  if (maxRms == 0 || maxRms < options.noiseFactor * noiseRms || regionCount < 2)
+    return segmentation;
+
+  // Each grown region: its box and in-plane area; the small ones' moments.
+  std::vector<Moments> moments(regionCount);
+  std::vector<std::vector<Box>> boxes(regionCount);
+  std::vector<double> area(regionCount);
+  std::vector<std::uint8_t> small(regionCount);
+  tbb::parallel_for(std::size_t(0), regionCount, [&](std::size_t r) {
+    boxes[r] = {boxOf(positions, segmentation.regions[r], area[r])};
+    small[r] = area[r] < smallArea;
+    if (!small[r]) return;
+    for (const Index i : segmentation.regions[r]) {
+      const Vec3& p = positions[i];
+      moments[r].count += 1;
+      moments[r].sum += p;
+      moments[r].outer += p * p.transpose();
+    }
+  });
+
+  // Adjacency of the small regions: joined by a k-NN edge (collected per thread, then sorted: the
+  // same set for any thread count).
+  tbb::enumerable_thread_specific<std::vector<std::pair<Index, Index>>> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, regionCount, 64), [&](const auto& range) {
+    auto& pairs = found.local();
+    for (std::size_t a = range.begin(); a != range.end(); ++a) {
+      if (!small[a]) continue;
+      for (const Index i : segmentation.regions[a])
+        for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+          const int b = segmentation.labels[knn.neighbors[e]];
+          if (b > int(a) && small[std::size_t(b)] &&
+              (pairs.empty() || pairs.back() != std::pair(Index(a), Index(b))))
+            pairs.emplace_back(Index(a), Index(b));
+        }
+    }
+  });
+  std::vector<std::pair<Index, Index>> edges;
+  for (const auto& pairs : found) edges.insert(edges.end(), pairs.begin(), pairs.end());
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<std::vector<Index>> adjacent(regionCount);
+  for (const auto& [a, b] : edges) {
+    adjacent[a].push_back(b);
+    adjacent[b].push_back(a);
+  }
+
+  // Greedy merging, the smallest union RMS first; a merged region keeps the smaller index.
+  std::vector<Index> version(regionCount, 0);
+  std::vector<std::uint8_t> alive(regionCount, 1);
+  std::vector<std::vector<Index>> members(regionCount);
+  for (std::size_t r = 0; r < regionCount; ++r) members[r] = {Index(r)};
+  using Candidate = std::tuple<double, Index, Index, Index, Index>;  // rms, a, b, versions
+  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue;
+  const auto consider = [&](Index a, Index b) {
+    if (a > b) std::swap(a, b);
+    Moments m = moments[a];
+    m.add(moments[b]);
+    const UnionPlane plane = planeOf(m);
+    if (!(plane.rms <= maxRms)) return;
+    for (const Index r : {a, b})
+      for (const Box& box : boxes[r])
+        for (const Vec3& corner : box)
+          if (std::abs(plane.normal.dot(corner - plane.centroid)) > maxDeviation) return;
+    queue.emplace(plane.rms, a, b, version[a], version[b]);
+  };
+  for (const auto& [a, b] : edges) consider(a, b);
+  while (!queue.empty()) {
+    const auto [rms, a, b, va, vb] = queue.top();
+    queue.pop();
+    if (!alive[a] || !alive[b] || version[a] != va || version[b] != vb) continue;
+    moments[a].add(moments[b]);
+    boxes[a].insert(boxes[a].end(), boxes[b].begin(), boxes[b].end());
+    members[a].insert(members[a].end(), members[b].begin(), members[b].end());
+    alive[b] = 0;
+    ++version[a];
+    std::vector<Index> joined;
+    for (const Index r : {a, b})
+      for (const Index c : adjacent[r])
+        if (c != a && c != b && alive[c]) joined.push_back(c);
+    std::sort(joined.begin(), joined.end());
+    joined.erase(std::unique(joined.begin(), joined.end()), joined.end());
+    for (const Index c : joined) {
+      auto& back = adjacent[c];
+      std::replace(back.begin(), back.end(), b, a);
+      std::sort(back.begin(), back.end());
+      back.erase(std::unique(back.begin(), back.end()), back.end());
+    }
+    adjacent[a] = joined;
+    adjacent[b].clear();
+    for (const Index c : joined) consider(a, c);
+  }
+
+  // A union narrower than minWidth in its plane (bounded by its boxes' corners) is undone: the
+  // slivers along a crease make such a bevel.
+  std::vector<std::pair<Index, std::vector<Index>>> kept;  // first grown region, members
+  for (std::size_t r = 0; r < regionCount; ++r) {
+    if (!alive[r]) continue;
+    bool wide = members[r].size() == 1;
+    if (!wide) {
+      const UnionPlane plane = planeOf(moments[r]);
+      Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      for (const Box& box : boxes[r])
+        for (const Vec3& corner : box) {
+          const Vec2 q((corner - plane.centroid).dot(plane.axisU),
+                       (corner - plane.centroid).dot(plane.axisV));
+          lo = lo.cwiseMin(q);
+          hi = hi.cwiseMax(q);
+        }
+      wide = (hi - lo).minCoeff() >= minWidth;
+    }
+    if (wide) {
+      kept.emplace_back(Index(r), members[r]);
+    } else {
+      for (const Index m : members[r]) kept.emplace_back(m, std::vector<Index>{m});
+    }
+  }
+  std::sort(kept.begin(), kept.end());
+
+  // The merged regions, in the order of their first grown region.
+  Segmentation merged;
+  merged.labels.assign(n, -1);
+  for (const auto& [first, parts] : kept) {
+    std::vector<Index> points;
+    for (const Index m : parts)
+      points.insert(points.end(), segmentation.regions[m].begin(), segmentation.regions[m].end());
+    std::sort(points.begin(), points.end());
+    for (const Index i : points) merged.labels[i] = int(merged.regions.size());
+    merged.regions.push_back(std::move(points));
+  }
+  return merged;
+}
+
+}  // namespace scalespace
