@@ -42,6 +42,18 @@ TEST_F(Cli, WrongOptionsGiveOneLineAndNonZeroExit) {
   }
 }
 
+TEST_F(Cli, StackInfoOfADamagedManifestSaysWhatIsWrong) {
+  ASSERT_EQ(run("generate sphere -n 300 -q -o " + path("s.ply")).code, 0);
+  ASSERT_EQ(run("scales " + path("s.ply") + " -o " + path("s.stack") + " --scales 2 -q").code, 0);
+  std::ofstream(path("s.stack/manifest.json")) << "{\n";
+  const Result r = run("stack-info " + path("s.stack"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  // Not "no manifest.json": it is there, and unreadable.
+  EXPECT_EQ(r.err.find("no manifest.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("invalid JSON"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, CurvatureOfASphereKeepsRowsAndNamesColumns) {
   ASSERT_EQ(run("generate sphere -n 20000 --seed 3 -q -o " + path("s.ply")).code, 0);
   const PointCloud input = readCloud(path("s.ply"));
