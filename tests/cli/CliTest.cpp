@@ -42,6 +42,20 @@ TEST_F(Cli, WrongOptionsGiveOneLineAndNonZeroExit) {
   }
 }
 
+TEST_F(Cli, GenerateNamesEveryShapeAndBoundsThePointCount) {
+  Result r = run("generate blah -q -o " + path("g.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  // Every shape the command takes, not only the five analytic surfaces.
+  for (const char* shape : {"sphere", "pipes", "house", "ring"})
+    EXPECT_NE(r.err.find(shape), std::string::npos) << shape << ": " << r.err;
+  // A count no machine holds: a clear bound, not "std::bad_alloc".
+  r = run("generate sphere -n 4000000000 -q -o " + path("g.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--points must be in [1, 100000000], got 4000000000"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("g.ply")));
+}
+
 TEST_F(Cli, StackInfoOfADamagedManifestSaysWhatIsWrong) {
   ASSERT_EQ(run("generate sphere -n 300 -q -o " + path("s.ply")).code, 0);
   ASSERT_EQ(run("scales " + path("s.ply") + " -o " + path("s.stack") + " --scales 2 -q").code, 0);
