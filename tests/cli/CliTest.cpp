@@ -56,6 +56,19 @@ TEST_F(Cli, GenerateNamesEveryShapeAndBoundsThePointCount) {
   EXPECT_FALSE(fs::exists(path("g.ply")));
 }
 
+TEST_F(Cli, OrientTakesTheViewpointQuotedAsTheHelpShowsIt) {
+  ASSERT_EQ(run("generate sphere -n 500 -q -o " + path("s.ply")).code, 0);
+  for (const std::string orient : {"viewpoint 0 0 10", "'viewpoint 0 0 10'", "'mst'"}) {
+    const Result r =
+        run("normals " + path("s.ply") + " --orient " + orient + " -q -o " + path("n.ply"));
+    EXPECT_EQ(r.code, 0) << orient << ": " << r.err;
+  }
+  const Result r =
+      run("normals " + path("s.ply") + " --orient 'viewpoint 0 0' -q -o " + path("m.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--orient takes"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, StackInfoOfADamagedManifestSaysWhatIsWrong) {
   ASSERT_EQ(run("generate sphere -n 300 -q -o " + path("s.ply")).code, 0);
   ASSERT_EQ(run("scales " + path("s.ply") + " -o " + path("s.stack") + " --scales 2 -q").code, 0);

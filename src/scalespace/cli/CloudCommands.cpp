@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <memory>
+#include <sstream>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/CylinderCommands.hpp"
@@ -182,7 +184,12 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
       ->expected(1, 4);
 }
 
-NormalOrientationOptions orientationFrom(const NormalArgs& a, const PointCloud& cloud) {
+NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointCloud& cloud) {
+  NormalArgs a = args;
+  if (a.orient.size() == 1) {  // quoted as the help shows it: --orient 'viewpoint X Y Z'
+    std::istringstream words(a.orient[0]);
+    a.orient.assign(std::istream_iterator<std::string>(words), {});
+  }
   NormalOrientationOptions o;
   o.k = a.k;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {
