@@ -125,6 +125,9 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("lines " + c + " --scale 0.1 --gamma 0 -o " + path("out.ply"), "--gamma");
   refused("lines " + c + " --scale 0.1 --alpha 0.9 -o " + path("out.ply"), "--alpha");
   refused("lines " + c + " --scale 0.1 -o " + c, "never overwritten");
+  // features' two outputs on one file: the lines replaced the labelled cloud (exit 0).
+  refused("features " + c + " -o " + path("out.ply") + " --lines " + path("out.ply"),
+          "--lines " + path("out.ply") + " is the output");
   // --scales with bounds the wrong way round: both reported as given, not one clamped onto the
   // other ("tmin=0.01 tmax=0.01").
   refused("lines " + c + " --scales 3 --tmin 0.01 --tmax 0.001 -o " + path("out.ply"),

@@ -160,6 +160,17 @@ void checkOutput(const std::string& output, OutputKind kind,
                     "choose another output folder or check its permissions");
 }
 
+void checkSecondOutput(const std::string& second, const std::string& flag,
+                       const std::string& output) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path a = fs::weakly_canonical(fs::absolute(second, ec), ec);
+  const fs::path b = fs::weakly_canonical(fs::absolute(output, ec), ec);
+  if (a == b || (fs::exists(second, ec) && fs::equivalent(second, output, ec)))
+    throw OptionError(flag + " " + second + " is the output " + output +
+                      ": give each output its own name (one would replace the other)");
+}
+
 PointCloud loadResultInput(const std::string& recorded, const std::string& override,
                            const std::string& directory, const std::string& what,
                            std::size_t pointCount, const std::string& output, bool quiet) {

@@ -266,7 +266,10 @@ void addFeaturesCommand(CLI::App& app) {
       throw OptionError("--mesh-samples must be in [1, 10000]");
     std::vector<std::string> inputs{args->input.path};
     checkOutput(args->output, OutputKind::Cloud, inputs);
-    if (!args->linesOutput.empty()) checkOutput(args->linesOutput, OutputKind::Lines, inputs);
+    if (!args->linesOutput.empty()) {
+      checkOutput(args->linesOutput, OutputKind::Lines, inputs);
+      checkSecondOutput(args->linesOutput, "--lines", args->output);
+    }
 
     // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
     // edges; a cloud labels its own points on its k-NN graph.
