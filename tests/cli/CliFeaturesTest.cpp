@@ -125,6 +125,13 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("lines " + c + " --scale 0.1 --gamma 0 -o " + path("out.ply"), "--gamma");
   refused("lines " + c + " --scale 0.1 --alpha 0.9 -o " + path("out.ply"), "--alpha");
   refused("lines " + c + " --scale 0.1 -o " + c, "never overwritten");
+  // features' two outputs on one file: the lines replaced the labelled cloud (exit 0).
+  refused("features " + c + " -o " + path("out.ply") + " --lines " + path("out.ply"),
+          "--lines " + path("out.ply") + " is the output");
+  // --scales with bounds the wrong way round: both reported as given, not one clamped onto the
+  // other ("tmin=0.01 tmax=0.01").
+  refused("lines " + c + " --scales 3 --tmin 0.01 --tmax 0.001 -o " + path("out.ply"),
+          "--tmin = 0.010000 is not below --tmax = 0.001000");
   refused("features " + c + " --salient 2 -o " + path("out.ply"), "--salient");
   refused("features " + c + " --scales 0 -o " + path("out.ply"), "--scales");
   refused("features " + c + " --min-scales 9 -o " + path("out.ply"), "--min-scales");
@@ -134,4 +141,18 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("features " + path("bad.off") + " -o " + path("out.ply"), "vertex 2", 1);
   std::ofstream(path("flat.off")) << "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n";
   refused("features " + path("flat.off") + " -o " + path("out.ply"), "no faces", 1);
+}
+
+TEST_F(Cli, LinesSayWhenTheDefaultScalesCollapse) {
+  // 20 points on a sphere: the mean distance to the 16th neighbour is far above 10% of the
+  // diagonal, so the default bounds cross. The error names them as defaults, with their rules.
+  ASSERT_EQ(run("generate sphere -n 20 -q -o " + path("s.ply")).code, 0);
+  const auto r = run("lines " + path("s.ply") + " --scales 3 -q -o " + path("l.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("the default --tmin (the mean distance to the 16th neighbour)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("the default --tmax (10% of the bounding-box diagonal)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("l.ply")));
 }

@@ -102,6 +102,12 @@ TEST_F(Cli, ParametrizeAndDistortionRejectBadInput) {
           path("p.ply"));
   EXPECT_EQ(r.code, 2);
   EXPECT_FALSE(fs::exists(path("p.ply")));
+  // The same file spelled another way: still one output replacing the other.
+  r = run("parametrize " + path("h.ply") + " -o " + path("p.ply") + " --flattened " +
+          (dir_ / "." / "p.ply").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--flattened"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("p.ply")));
   // distortion needs parametrization columns, the same point count, sizes that are integers.
   r = run("distortion " + path("h.ply") + " -o " + path("e.ply"));
   EXPECT_EQ(r.code, 1);

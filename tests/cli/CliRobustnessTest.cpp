@@ -266,6 +266,22 @@ TEST_F(Cli, OutputsAreCheckedBeforeTheInputIsRead) {
   EXPECT_TRUE(fs::exists(path("c/d/k.ply")) && fs::exists(path("c/d/k.json")));
 }
 
+TEST_F(Cli, OutputsNeverReplaceAFileOfAnInputFolder) {
+  ASSERT_EQ(run("generate box -n 2000 -q -o " + path("box.ply")).code, 0);
+  ASSERT_EQ(run("planes " + path("box.ply") + " -o " + path("p") + " --scales 4 -q").code, 0);
+  const std::string table = readText(path("p/components.csv"));
+  // components.csv is a cloud extension: segment wrote its labelled points over the table.
+  const Result r =
+      run("segment " + path("p") + " --min-persistence 1 -q -o " + path("p/components.csv"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("is a file of the input"), std::string::npos) << r.err;
+  EXPECT_EQ(readText(path("p/components.csv")), table);
+  // The user's own files inside the folder may be written and replaced.
+  for (int pass = 0; pass < 2; ++pass)
+    EXPECT_EQ(
+        run("segment " + path("p") + " --min-persistence 1 -q -o " + path("p/labels.ply")).code, 0);
+}
+
 // --------------------------------------------------------------------------- 9. smaller ones
 
 TEST_F(Cli, MeshesCanBeSampledByArea) {

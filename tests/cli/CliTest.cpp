@@ -42,6 +42,45 @@ TEST_F(Cli, WrongOptionsGiveOneLineAndNonZeroExit) {
   }
 }
 
+TEST_F(Cli, GenerateNamesEveryShapeAndBoundsThePointCount) {
+  Result r = run("generate blah -q -o " + path("g.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  // Every shape the command takes, not only the five analytic surfaces.
+  for (const char* shape : {"sphere", "pipes", "house", "ring"})
+    EXPECT_NE(r.err.find(shape), std::string::npos) << shape << ": " << r.err;
+  // A count no machine holds: a clear bound, not "std::bad_alloc".
+  r = run("generate sphere -n 4000000000 -q -o " + path("g.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--points must be in [1, 100000000], got 4000000000"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("g.ply")));
+}
+
+TEST_F(Cli, OrientTakesTheViewpointQuotedAsTheHelpShowsIt) {
+  ASSERT_EQ(run("generate sphere -n 500 -q -o " + path("s.ply")).code, 0);
+  for (const std::string orient : {"viewpoint 0 0 10", "'viewpoint 0 0 10'", "'mst'"}) {
+    const Result r =
+        run("normals " + path("s.ply") + " --orient " + orient + " -q -o " + path("n.ply"));
+    EXPECT_EQ(r.code, 0) << orient << ": " << r.err;
+  }
+  const Result r =
+      run("normals " + path("s.ply") + " --orient 'viewpoint 0 0' -q -o " + path("m.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--orient takes"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, StackInfoOfADamagedManifestSaysWhatIsWrong) {
+  ASSERT_EQ(run("generate sphere -n 300 -q -o " + path("s.ply")).code, 0);
+  ASSERT_EQ(run("scales " + path("s.ply") + " -o " + path("s.stack") + " --scales 2 -q").code, 0);
+  std::ofstream(path("s.stack/manifest.json")) << "{\n";
+  const Result r = run("stack-info " + path("s.stack"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  // Not "no manifest.json": it is there, and unreadable.
+  EXPECT_EQ(r.err.find("no manifest.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("manifest.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("invalid JSON"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, CurvatureOfASphereKeepsRowsAndNamesColumns) {
   ASSERT_EQ(run("generate sphere -n 20000 --seed 3 -q -o " + path("s.ply")).code, 0);
   const PointCloud input = readCloud(path("s.ply"));

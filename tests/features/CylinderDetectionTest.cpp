@@ -246,3 +246,26 @@ TEST(Cylinders, OptionsAreChecked) {
   automatic.tMax = 0.5;
   EXPECT_THROW(detectCylinders(cloud, automatic), OptionError);
 }
+
+TEST(Cylinders, AutomaticScalesOfASparseCloudSayTheyWereComputed) {
+  // 60 points over a 10-unit tube: the 10th neighbour is farther than a tenth of the diagonal,
+  // so the automatic tMin exceeds the automatic tMax. The message must not read as if the
+  // caller had set them.
+  Tube tube;
+  tube.length = 10;
+  const PointCloud cloud = sampleTube(tube, 60);
+  try {
+    detectCylinders(cloud, CylinderOptions{});
+    ADD_FAILURE() << "a sparse cloud gave automatic scales";
+  } catch (const OptionError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the automatic CylinderOptions::tMax (a tenth of the diagonal"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("the automatic CylinderOptions::tMin (twice the median distance"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("give CylinderOptions::tMin and CylinderOptions::tMax"), std::string::npos)
+        << what;
+  }
+}

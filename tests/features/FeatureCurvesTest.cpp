@@ -307,6 +307,10 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   refused([](auto& o) { o.salientPercentile = 2; }, "FeatureCurveOptions::salientPercentile");
   refused([](auto& o) { o.voteThreshold = 1; }, "FeatureCurveOptions::voteThreshold");
   refused([](auto& o) { o.graphNeighbors = 0; }, "FeatureCurveOptions::graphNeighbors");
+  // One scale cannot give the default 3 voting scales: the message names both fields and values.
+  refused([](auto& o) { o.scaleCount = 1; },
+          "FeatureCurveOptions::minVotingScales must be in [1, FeatureCurveOptions::scaleCount = "
+          "1], got 3");
   refused([](auto& o) { o.lines.gamma = 0; }, "CurvatureLineOptions::gamma");
   // All points at one place: a clear error, not a division by zero.
   PointCloud same;

@@ -88,6 +88,15 @@ bool isWithin(const std::filesystem::path& inner, const std::filesystem::path& o
   return true;
 }
 
+// The files `planes`, `cylinders` and `scales` write into their folders.
+bool isResultFile(const std::filesystem::path& path) {
+  const std::string name = path.filename().string();
+  for (const char* own : {"components.json", "components.csv", "outlines.obj", "persistence.svg",
+                          "membership.bin", "cloud.ply", "axes.ply", "manifest.json"})
+    if (name == own) return true;
+  return path.extension() == ".npy";
+}
+
 }  // namespace
 
 void checkOutput(const std::string& output, OutputKind kind,
@@ -104,6 +113,11 @@ void checkOutput(const std::string& output, OutputKind kind,
                         ": choose another output name (inputs are never overwritten)");
     if (isWithin(in, out))
       throw OptionError("output " + output + " holds the input " + input +
+                        ": choose another output (inputs are never overwritten)");
+    // An input folder (a `planes` or `cylinders` result, a stack) may take the user's files, but
+    // none of its own may be replaced: `segment P -o P/components.csv` overwrote the table.
+    if (in != out && isWithin(out, in) && isResultFile(out))
+      throw OptionError("output " + output + " is a file of the input " + input +
                         ": choose another output (inputs are never overwritten)");
   }
   const std::string ext = lowerExtension(output);
@@ -158,6 +172,17 @@ void checkOutput(const std::string& output, OutputKind kind,
   if (::access(parent.c_str(), W_OK) != 0)
     throw FileError(output, "", "the folder " + parent.string() + " is not writable",
                     "choose another output folder or check its permissions");
+}
+
+void checkSecondOutput(const std::string& second, const std::string& flag,
+                       const std::string& output) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path a = fs::weakly_canonical(fs::absolute(second, ec), ec);
+  const fs::path b = fs::weakly_canonical(fs::absolute(output, ec), ec);
+  if (a == b || (fs::exists(second, ec) && fs::equivalent(second, output, ec)))
+    throw OptionError(flag + " " + second + " is the output " + output +
+                      ": give each output its own name (one would replace the other)");
 }
 
 PointCloud loadResultInput(const std::string& recorded, const std::string& override,

@@ -55,6 +55,11 @@ enum class OutputKind {
 void checkOutput(const std::string& output, OutputKind kind,
                  const std::vector<std::string>& inputs);
 
+/// Refuses a second output (`flag`) that names the same file as the first one (-o), however the
+/// two paths are spelled (./a.ply, a symlink): one file would silently replace the other.
+void checkSecondOutput(const std::string& second, const std::string& flag,
+                       const std::string& output);
+
 /// "warning: ..." lines on stderr, also with --quiet: they are about the results, not progress.
 void printWarnings(const std::vector<std::string>& warnings);
 

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <memory>
+#include <sstream>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/CylinderCommands.hpp"
@@ -101,11 +103,11 @@ void addGenerateCommand(CLI::App& app) {
       "piecewise-planar scene (Table 2.1's, or house / yard in metres; face labels as gt_face, "
       "house / yard also group labels as gt_group), or the pipe rack of the cylinders (pipe labels "
       "as gt_pipe, elbow parts and cable strands as gt_part)");
-  cmd->add_option("shape", args->shape,
-                  "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | "
-                  "house | yard | pipes | bumpy-disk | hemisphere | relief | holed-sheet | "
-                  "partial-sphere | triaxial | blob | rounded-cube | tube | ring (the shapes of "
-                  "`parametrize`)")
+  static const char* const kShapes =
+      "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | house | yard "
+      "| pipes | bumpy-disk | hemisphere | relief | holed-sheet | partial-sphere | triaxial | blob "
+      "| rounded-cube | tube | ring";
+  cmd->add_option("shape", args->shape, std::string(kShapes) + " (the shapes of `parametrize`)")
       ->required();
   cmd->add_option("-n,--points", args->options.pointCount, "number of points")
       ->capture_default_str();
@@ -121,7 +123,12 @@ void addGenerateCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
     const auto start = Clock::now();
-    if (args->options.pointCount == 0) throw OptionError("--points must be >= 1");
+    // Beyond 100M points (~10 GB through a fit) an extra zero is likelier than intent; 4e9 ended
+    // in "std::bad_alloc".
+    constexpr std::size_t kMaxPoints = 100'000'000;
+    if (args->options.pointCount == 0 || args->options.pointCount > kMaxPoints)
+      throw OptionError("--points must be in [1, " + std::to_string(kMaxPoints) + "], got " +
+                        std::to_string(args->options.pointCount));
     if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
     checkOutput(args->output, OutputKind::Cloud, {});
     if (args->oneSided && args->shape != "pipes")
@@ -142,7 +149,11 @@ void addGenerateCommand(CLI::App& app) {
       cloud = generateParamShape(parseParamShape(args->shape), o);
     } else if (!generateScene(args->shape, args->options, cloud)) {
       SurfaceSampleOptions o;
-      o.shape = parseSurfaceShape(args->shape);  // OptionError names the accepted shapes
+      try {
+        o.shape = parseSurfaceShape(args->shape);
+      } catch (const OptionError&) {  // it names the analytic surfaces only
+        throw OptionError("unknown shape '" + args->shape + "' (use one of " + kShapes + ")");
+      }
       o.count = args->options.pointCount;
       o.seed = args->options.seed;
       o.normalNoiseDegrees = args->normalNoise;
@@ -173,7 +184,12 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
       ->expected(1, 4);
 }
 
-NormalOrientationOptions orientationFrom(const NormalArgs& a, const PointCloud& cloud) {
+NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointCloud& cloud) {
+  NormalArgs a = args;
+  if (a.orient.size() == 1) {  // quoted as the help shows it: --orient 'viewpoint X Y Z'
+    std::istringstream words(a.orient[0]);
+    a.orient.assign(std::istream_iterator<std::string>(words), {});
+  }
   NormalOrientationOptions o;
   o.k = a.k;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {

@@ -122,6 +122,22 @@ void addLinesCommand(CLI::App& app) {
       const double lo =
           args->tMin > 0 ? args->tMin : meanKthNeighborDistance(cloud.positions(), 16);
       const double hi = args->tMax > 0 ? args->tMax : 0.1 * cloud.boundingBoxDiagonal();
+      if (args->scales > 1 && !(lo < hi)) {
+        // Name the bounds as they were set: computed ones with their rule (a sparse or tiny
+        // cloud has its 16th neighbour beyond a tenth of its diagonal), given ones as given.
+        const auto bound = [](const char* flag, double value, bool given, const char* rule) {
+          return std::string(given ? flag
+                                   : std::string("the default ") + flag + " (" + rule + ")") +
+                 " = " + std::to_string(value);
+        };
+        throw OptionError(
+            "--scales " + std::to_string(args->scales) + " needs the smallest scale below the " +
+            "largest, but " +
+            bound("--tmin", lo, args->tMin > 0, "the mean distance to the 16th neighbour") +
+            " is not below " +
+            bound("--tmax", hi, args->tMax > 0, "10% of the bounding-box diagonal") +
+            ": give --tmin and --tmax with tmin < tmax, or one scale with --scale T");
+      }
       ts = scaleSeries(lo, std::max(hi, lo), args->scales, ScaleSpacing::Log);
     }
     const auto progress = makeProgressBar(args->quiet);
@@ -250,7 +266,10 @@ void addFeaturesCommand(CLI::App& app) {
       throw OptionError("--mesh-samples must be in [1, 10000]");
     std::vector<std::string> inputs{args->input.path};
     checkOutput(args->output, OutputKind::Cloud, inputs);
-    if (!args->linesOutput.empty()) checkOutput(args->linesOutput, OutputKind::Lines, inputs);
+    if (!args->linesOutput.empty()) {
+      checkOutput(args->linesOutput, OutputKind::Lines, inputs);
+      checkSecondOutput(args->linesOutput, "--lines", args->output);
+    }
 
     // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
     // edges; a cloud labels its own points on its k-NN graph.

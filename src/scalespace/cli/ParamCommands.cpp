@@ -127,8 +127,7 @@ void addParametrizeCommand(CLI::App& app) {
     checkOutput(args->output, OutputKind::Cloud, inputs);
     if (!args->flattened.empty()) {
       checkOutput(args->flattened, OutputKind::Cloud, inputs);
-      if (args->flattened == args->output)
-        throw OptionError("--flattened must differ from the output");
+      checkSecondOutput(args->flattened, "--flattened", args->output);
     }
     PointCloud cloud = loadCloud(args->input, args->quiet);
     ensureNormals(cloud, args->quiet);

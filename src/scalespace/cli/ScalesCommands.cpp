@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -285,9 +286,17 @@ void addStackInfoCommand(CLI::App& app) {
       app.add_subcommand("stack-info", "describe a scale stack (scales, statistics, files)");
   cmd->add_option("STACK", *path, "stack directory")->required();
   cmd->callback([path] {
-    if (!printStackInfo(*path, std::cout))
-      throw FileError(*path, "", "not a scale stack (no manifest.json)",
-                      "give a NAME.stack directory");
+    if (printStackInfo(*path, std::cout)) return;
+    // A manifest that is there but not recognised (damaged, or not a stack's): the reader says
+    // what is wrong with it, as `export` does.
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(std::filesystem::path(*path) / "manifest.json", ec)) {
+      (void)ScaleStackReader(*path);
+      throw FileError(*path, "", "not a scale stack (its manifest.json has no stack format tag)",
+                      "give a NAME.stack directory written by 'scalespace scales'");
+    }
+    throw FileError(*path, "", "not a scale stack (no manifest.json)",
+                    "give a NAME.stack directory");
   });
 }
 

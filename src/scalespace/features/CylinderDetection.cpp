@@ -104,15 +104,33 @@ std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph
                         std::to_string(options.graphNeighbors) + "th neighbour)");
     tMin = 2 * lowerMedian(graph.kthDistance);
     if (!(tMin > 0))
-      throw OptionError(
-          "most points have 10 duplicates: the automatic CylinderOptions::tMin is 0 "
-          "(remove the duplicates or give "
-          "CylinderOptions::tMin)");
+      throw OptionError("most points have " + std::to_string(options.graphNeighbors) +
+                        " duplicates: the automatic CylinderOptions::tMin is 0 (remove the "
+                        "duplicates or give CylinderOptions::tMin)");
   }
   if (tMax == 0) tMax = cloud.boundingBoxDiagonal() / 10;
-  if (!(tMax > tMin))
-    throw OptionError("CylinderOptions::tMax (" + std::to_string(tMax) +
-                      ") must be > CylinderOptions::tMin (" + std::to_string(tMin) + ")");
+  if (!(tMax > tMin)) {
+    // Say which bound was computed, and from what: a user who gave neither reads two values
+    // they never set (a sparse cloud: its neighbour spacing is over a tenth of its diagonal).
+    const auto bound = [](const char* field, double value, bool automatic,
+                          const std::string& rule) {
+      std::string text = automatic ? "the automatic " : "";
+      text += field;
+      text += " (" + (automatic ? rule + ", " : std::string()) + std::to_string(value) + ")";
+      return text;
+    };
+    const bool autoMin = options.tMin == 0, autoMax = options.tMax == 0;
+    std::string message = bound("CylinderOptions::tMax", tMax, autoMax, "a tenth of the diagonal") +
+                          " must be > " +
+                          bound("CylinderOptions::tMin", tMin, autoMin,
+                                "twice the median distance to the " +
+                                    std::to_string(options.graphNeighbors) + "th neighbour");
+    if (autoMin || autoMax)
+      message +=
+          ": the points are too sparse for the automatic scales; give CylinderOptions::tMin and "
+          "CylinderOptions::tMax";
+    throw OptionError(message);
+  }
   return scaleSeries(tMin, tMax, options.scaleCount, ScaleSpacing::Log);
 }
 

@@ -180,7 +180,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
   require(std::isfinite(o.voteThreshold) && o.voteThreshold >= 0 && o.voteThreshold < 1,
           "FeatureCurveOptions::voteThreshold must be in [0, 1)");
   require(o.minVotingScales >= 1 && o.minVotingScales <= o.scaleCount,
-          "FeatureCurveOptions::minVotingScales must be in [1, scaleCount]");
+          "FeatureCurveOptions::minVotingScales must be in [1, FeatureCurveOptions::scaleCount = " +
+              std::to_string(o.scaleCount) + "], got " + std::to_string(o.minVotingScales));
   require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
           "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
   require(o.graphNeighbors >= 1 && std::size_t(o.graphNeighbors) <= kMaxNeighborCount,

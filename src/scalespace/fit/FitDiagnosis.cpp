@@ -19,6 +19,13 @@ std::vector<std::string> invalidFitWarnings(const PointCloud& cloud, const FitCo
                 counts.total, 100.0 * double(counts.invalid) / double(counts.total));
   std::string summary = text;
   std::vector<std::string> causes;
+  const double diagonal = cloud.boundingBoxDiagonal();
+  if (!(diagonal > 0) && cloud.size() > 1) {
+    // No scale helps here: advising a larger one (the neighbour count below) would mislead.
+    std::snprintf(text, sizeof text,
+                  "all %zu points are at one position: there is no surface to fit", cloud.size());
+    return {summary + ": " + text};
+  }
   if (const std::size_t bad = unusableNormalCount(cloud); bad > 0) {
     std::snprintf(text, sizeof text,
                   "%zu input normals are NaN/Inf or zero and every fit reaching one of them is "
@@ -26,15 +33,17 @@ std::vector<std::string> invalidFitWarnings(const PointCloud& cloud, const FitCo
                   bad);
     causes.push_back(text);
   }
-  const double diagonal = cloud.boundingBoxDiagonal();
-  if (counts.largestScale > diagonal && diagonal > 0) {
+  const bool beyondCloud = counts.largestScale > diagonal && diagonal > 0;
+  if (beyondCloud) {
     std::snprintf(text, sizeof text,
                   "the scale t = %.6g is %.3g times the cloud's diagonal (%.6g): a fit over the "
                   "whole cloud describes no local surface; choose t below the diagonal",
                   counts.largestScale, counts.largestScale / diagonal, diagonal);
     causes.push_back(text);
   }
-  if (counts.meanNeighbors < 2.0 * counts.minNeighbors) {
+  // A scale beyond the cloud with few neighbours: the fits read a sparse level (Poisson-disk
+  // radius alpha t), and a larger scale makes it sparser; the advice above stands alone.
+  if (counts.meanNeighbors < 2.0 * counts.minNeighbors && !beyondCloud) {
     std::snprintf(text, sizeof text,
                   "fits have %.1f neighbours on average and need at least %d: choose a larger "
                   "scale",
