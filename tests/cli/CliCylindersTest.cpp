@@ -101,9 +101,13 @@ TEST_F(Cli, CylindersFindThePipesOfTheRack) {
   r = run("cylinders-segment " + path("out") + " -q -o " + path("seg_default.ply"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(labelsOf("seg_default.ply"), id->values);
-  // A folder that is no cylinders result, and a cloud of another size, are refused.
+  // A folder that is no cylinders result, and a cloud of another size, are refused; `segment`
+  // on a cylinders result points to cylinders-segment.
   r = run("cylinders-segment " + path(".") + " -q -o " + path("x.ply"));
   EXPECT_NE(r.code, 0);
+  r = run("segment " + path("out") + " --min-persistence 1 -q -o " + path("x.ply"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("cylinders-segment"), std::string::npos) << r.err;
   ASSERT_EQ(run("generate cylinder -n 100 -q -o " + path("small.ply")).code, 0);
   r = run("cylinders-segment " + path("out") + " --input " + path("small.ply") + " -q -o " +
           path("x.ply"));

@@ -26,13 +26,6 @@ namespace fs = std::filesystem;
 // The marker that tells our folder from a user's: components.json names the result.
 constexpr const char* kResultTag = "\"result\":\"cylinders\"";
 
-bool isCylinderResult(const std::string& directory) {
-  std::ifstream in(fs::path(directory) / "components.json");
-  std::stringstream text;
-  text << in.rdbuf();
-  return in && text.str().find(kResultTag) != std::string::npos;
-}
-
 nlohmann::json point(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
 
 // The axes of the components (their representative tubes) as polylines with the radius profile.
@@ -335,6 +328,13 @@ void addCylindersSegmentCommand(CLI::App& app) {
 }
 
 }  // namespace
+
+bool isCylinderResult(const std::string& directory) {
+  std::ifstream in(fs::path(directory) / "components.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  return in && text.str().find(kResultTag) != std::string::npos;
+}
 
 void checkCylinderResultDestination(const std::string& directory) {
   std::error_code ec;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/CylinderCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
@@ -225,6 +226,9 @@ void addSegmentCommand(CLI::App& app) {
       throw OptionError("segment needs one of --min-persistence, --scale, --brush, --similar");
     validate(args->coverageOptions);  // before any reading
     validate(args->similarity);
+    if (isCylinderResult(args->directory))
+      throw FileError(args->directory, "", "is a `scalespace cylinders` result, not a `planes` one",
+                      "label its points with `scalespace cylinders-segment`");
     std::string recorded;
     PlaneModel model = readPlaneModel(args->directory, &recorded);
     PointCloud cloud = loadResultInput(recorded, args->input, args->directory, "planes",

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "scalespace/cli/CliCommon.hpp"
+#include "scalespace/cli/CylinderCommands.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/Polylines.hpp"
@@ -80,15 +81,6 @@ bool isPolylinePly(const std::string& path) {
     if (line.rfind("element edge ", 0) == 0) return true;
   }
   return false;
-}
-
-// A `scalespace cylinders` result: its cloud.ply (the input with cylinder_id and anisotropy) is
-// the cloud, its axes.ply (one polyline per component, with radius) the lines over it.
-bool isCylinderResult(const std::string& folder) {
-  std::error_code ec;
-  return fs::is_regular_file(fs::path(folder) / "cloud.ply", ec) &&
-         fs::is_regular_file(fs::path(folder) / "axes.ply", ec) &&
-         fs::is_regular_file(fs::path(folder) / "components.json", ec);
 }
 
 // A scale stack: its input positions (or the --input cloud, checked to be the stack's input, with
