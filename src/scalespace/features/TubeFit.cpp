@@ -106,7 +106,9 @@ bool fitStraightAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>
 }
 
 // The curved axis: axis points x - n / kappa1 averaged in cells of size h, chained along the
-// longest path of their minimum spanning tree.
+// longest path of their minimum spanning tree. The cells are anchored at the proposals' lower
+// corner, not at the coordinates' zero: a grid fixed in space would cut a translated region
+// differently (other nodes, another axis, the tube accepted or not as the cloud moves).
 std::vector<Vec3> curvedAxis(const std::vector<Vec3>& positions,
                              const std::vector<Vec3>& scaleNormals,
                              const std::vector<float>& kappa1, const std::vector<Index>& points,
@@ -115,12 +117,14 @@ std::vector<Vec3> curvedAxis(const std::vector<Vec3>& positions,
   proposals.reserve(points.size());
   for (const Index i : points)
     if (kappa1[i] != 0) proposals.push_back(positions[i] - scaleNormals[i] / double(kappa1[i]));
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  for (const Vec3& p : proposals) lo = lo.cwiseMin(p);
   std::vector<Vec3> nodes;
   for (;; h *= 2) {
     std::vector<std::pair<std::int64_t, std::size_t>> keyed;
     keyed.reserve(proposals.size());
     for (std::size_t k = 0; k < proposals.size(); ++k) {
-      const Vec3& p = proposals[k];
+      const Vec3 p = proposals[k] - lo;
       const auto cell = [&](double v) { return std::int64_t(std::floor(v / h)) & 0x1fffff; };
       keyed.emplace_back((cell(p.x()) << 42) | (cell(p.y()) << 21) | cell(p.z()), k);
     }
