@@ -207,6 +207,15 @@ TEST(Parametrization, BadInputsAreRejected) {
   EXPECT_THROW(parametrize(c.positions, zero), OptionError);
   const std::vector<Vec3> same(50, Vec3(1, 2, 3));
   EXPECT_THROW(parametrize(same, std::vector<Vec3>(50, Vec3::UnitZ())), OptionError);
+  // Collinear points: refused with what is wrong, not mapped as a curve.
+  std::vector<Vec3> line;
+  for (int i = 0; i < 200; ++i) line.emplace_back(0.01 * i, 0.02 * i, 5.0);
+  try {
+    parametrize(line, std::vector<Vec3>(line.size(), Vec3::UnitZ()));
+    FAIL() << "collinear points were parametrized";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("lie on a line"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Parametrization, DuplicatePointsStillMap) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "scalespace/core/Error.hpp"
@@ -33,6 +34,20 @@ double diagonalOf(const std::vector<Vec3>& positions) {
     hi = hi.cwiseMax(p);
   }
   return (hi - lo).norm();
+}
+
+// The points' spread across their main direction over the spread along it (square roots of the
+// covariance's two largest eigenvalues): 0 for collinear points, which no surface holds.
+double crossSpreadRatio(const std::vector<Vec3>& positions) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : positions) mean += p;
+  mean /= double(positions.size());
+  Mat3 covariance = Mat3::Zero();
+  for (const Vec3& p : positions) covariance += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(covariance);
+  const Vec3 ev = eig.eigenvalues();  // increasing
+  return ev(2) > 0 ? std::sqrt(std::max(0.0, ev(1)) / ev(2)) : 0.0;
 }
 
 }  // namespace
@@ -122,6 +137,16 @@ FlatteningResult flattenScaleSpace(const std::vector<Vec3>& inputPositions,
   result.diagonal = diagonalOf(inputPositions);
   if (!(result.diagonal > 0))
     throw OptionError("the flattening needs points that are not all equal");
+  // A line has no surface to flow onto: the map would be a curve's, silently (a strip a thousand
+  // times longer than wide is one at every scale the flattening visits).
+  if (const double ratio = crossSpreadRatio(inputPositions); ratio < 1e-3) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the flattening needs points spread over a surface; these lie on a line (their "
+                  "spread across it is %.3g of their spread along it)",
+                  ratio);
+    throw OptionError(text);
+  }
   result.tMax = options.tMax > 0 ? options.tMax : result.diagonal;
 
   // Points along a Morton curve of the input: they move coherently, so the order stays a good
