@@ -9,10 +9,12 @@
 // the exact normals of the scene; ours uses them only as the stack's input normals. Usage:
 // bench_planes [points per scene, default 100000] [scales M, default 50]
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
-//                     [--robust-iterations N] [--max-step F] [--max-rms F]
+//                     [--robust-iterations N] [--max-step F] [--max-rms F] [--merge-rms F]
+//                     [--merge-width F]
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
-// --max-step F / --max-rms F set PlaneDetectionOptions (growing.maxStep, planarity.maxRelativeRms;
-// 0 0 is the thesis' Sec. 2.3), --robust-tolerance / --robust-iterations set the stack's
+// --max-step F / --max-rms F / --merge-rms F / --merge-width F set PlaneDetectionOptions
+// (growing.maxStep, planarity.maxRelativeRms, merging.maxRelativeRms, merging.minRelativeWidth;
+// 0 0 0 is the thesis' Sec. 2.3), --robust-tolerance / --robust-iterations set the stack's
 // ScaleSpaceOptions::fit.robustTolerance / robustIterations (default: the library's; 0 iterations =
 // the plain APSS stack).
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>

@@ -23,8 +23,9 @@
 // its regions, components and segmentation; its rms column is relative to epsilon. Usage:
 // bench_planes_scenes [--points N (300000)] [--scales M (50)] [--scene house|yard|stairs]
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
-//                            [--max-step F] [--max-rms F] (PlaneDetectionOptions; default: the
-//                            library's) [--no-robust] (the plain APSS stack)
+//                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
+//                            [--merge-width F] (PlaneDetectionOptions; default: the library's)
+//                            [--no-robust] (the plain APSS stack)
 // --diagnose also prints, per group and level, the region holding most of the group; per level
 // the tile tops found and where their points went; the faces of the largest component along its
 // life; the counted faces not found.

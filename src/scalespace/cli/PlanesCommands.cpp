@@ -326,8 +326,8 @@ void addPlanesCommand(CLI::App& app) {
                   "becomes its mean ramp; 0 = as grown, Sec. 2.3.1)")
       ->capture_default_str();
   cmd->add_option("--merge-deviation", args->detection.merging.maxRelativeDeviation,
-                  "... and no point of the union is farther from that plane than this fraction "
-                  "of t")
+                  "with --merge-rms: the farthest any point of a merged union may lie from its "
+                  "plane, as a fraction of t")
       ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");

@@ -27,11 +27,9 @@ nlohmann::json CloudLayer::manifest() const {
 
 ViewerResponse CloudLayer::handle(const std::string& endpoint, const ViewerRequest& request) const {
   auto vectors = [&](const std::vector<Vec3>& values) {
-    std::string out;
-    out.reserve(sample_.count() * 12);
-    for (std::size_t k = 0; k < sample_.count(); ++k)
-      for (int d = 0; d < 3; ++d) appendFloat32(out, float(values[sample_[k]][d]));
-    return binaryResponse(std::move(out));
+    return binaryResponse(sampledArray(sample_, values, [](std::string& out, const Vec3& v) {
+      for (int d = 0; d < 3; ++d) appendFloat32(out, float(v[d]));
+    }));
   };
   if (endpoint == "positions") {
     requireMethod(request, "GET");
