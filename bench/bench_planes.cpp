@@ -10,13 +10,13 @@
 // bench_planes [points per scene, default 100000] [scales M, default 50]
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
 //                     [--robust-iterations N] [--max-step F] [--max-rms F] [--merge-rms F]
-//                     [--merge-width F]
+//                     [--merge-width F] [--refine-distance F] [--refine-gain F] [--refine-offset F]
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
 // --max-step F / --max-rms F / --merge-rms F / --merge-width F set PlaneDetectionOptions
 // (growing.maxStep, planarity.maxRelativeRms, merging.maxRelativeRms, merging.minRelativeWidth;
-// 0 0 0 is the thesis' Sec. 2.3), --robust-tolerance / --robust-iterations set the stack's
-// ScaleSpaceOptions::fit.robustTolerance / robustIterations (default: the library's; 0 iterations =
-// the plain APSS stack).
+// 0 0 0 is the thesis' Sec. 2.3), --refine-* its refinement (BoundaryRefinementOptions),
+// --robust-tolerance / --robust-iterations set the stack's ScaleSpaceOptions::fit.robustTolerance /
+// robustIterations (default: the library's; 0 iterations = the plain APSS stack).
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set.h>
 #include <CGAL/property_map.h>
@@ -216,6 +216,12 @@ int main(int argc, char** argv) {
       detection.planarity.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--merge-rms" && i + 1 < argc) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--refine-distance" && i + 1 < argc) {
+      detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
+    } else if (a == "--refine-gain" && i + 1 < argc) {
+      detection.refinement.minRelativeGain = std::atof(argv[++i]);
+    } else if (a == "--refine-offset" && i + 1 < argc) {
+      detection.refinement.minRelativeOffset = std::atof(argv[++i]);
     } else if (a == "--merge-width" && i + 1 < argc) {
       detection.merging.minRelativeWidth = std::atof(argv[++i]);
     } else if (a == "--scene" && i + 1 < argc) {

@@ -24,7 +24,8 @@
 // bench_planes_scenes [--points N (300000)] [--scales M (50)] [--scene house|yard|stairs]
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
 //                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
-//                            [--merge-width F] (PlaneDetectionOptions; default: the library's)
+//                            [--merge-width F] [--refine-distance F] [--refine-gain F]
+//                            [--refine-offset F] (PlaneDetectionOptions; default: the library's)
 //                            [--no-robust] (the plain APSS stack)
 // --diagnose also prints, per group and level, the region holding most of the group; per level
 // the tile tops found and where their points went; the faces of the largest component along its
@@ -470,6 +471,12 @@ int main(int argc, char** argv) {
       detection.growing.maxStep = std::atof(argv[++i]);
     } else if (a == "--merge-rms" && hasValue) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--refine-distance" && hasValue) {
+      detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
+    } else if (a == "--refine-gain" && hasValue) {
+      detection.refinement.minRelativeGain = std::atof(argv[++i]);
+    } else if (a == "--refine-offset" && hasValue) {
+      detection.refinement.minRelativeOffset = std::atof(argv[++i]);
     } else if (a == "--merge-width" && hasValue) {
       detection.merging.minRelativeWidth = std::atof(argv[++i]);
     } else if (a == "--merge-deviation" && hasValue) {

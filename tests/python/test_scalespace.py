@@ -138,7 +138,8 @@ def test_planes_and_segments_equal_the_cli(data, tmp_path):
 def test_planes_merge_options_are_checked_before_any_work(data):
     cloud = ss.read(str(data / "house.ply"))
     for kwargs, name in [({"merge_rms": -1}, "merge_rms"),
-                         ({"merge_deviation": float("nan")}, "merge_deviation")]:
+                         ({"merge_deviation": float("nan")}, "merge_deviation"),
+                         ({"refine_distance": -0.1}, "refine_distance")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.planes(cloud.points, **kwargs)
         assert "Options::" not in str(e.value)

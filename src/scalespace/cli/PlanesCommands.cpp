@@ -329,6 +329,11 @@ void addPlanesCommand(CLI::App& app) {
                   "with --merge-rms: the farthest any point of a merged union may lie from its "
                   "plane, as a fraction of t")
       ->capture_default_str();
+  cmd->add_option("--refine-distance", args->detection.refinement.maxRelativeDistance,
+                  "with --merge-rms: a merged union takes the neighbouring points that lie nearer "
+                  "its plane than their own region's, within this fraction of t of it (its "
+                  "edges, which the robust fit gives to the surfaces it meets; 0 = as grown)")
+      ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")

@@ -25,6 +25,7 @@ void validatePlaneDetectionOptions(const PlaneDetectionOptions& options) {
   validateRegionFilterOptions(filterOptionsOf(options));
   validate(options.planarity);
   validate(options.merging);
+  validate(options.refinement);
   if (!(options.minJaccard >= 0 && options.minJaccard < 1))
     throw OptionError("PlaneDetectionOptions::minJaccard must be in [0, 1)");
 }
@@ -34,10 +35,14 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
                          const PlaneDetectionOptions& options, PlaneDetectionTimings& timings) {
   auto start = std::chrono::steady_clock::now();
   Segmentation seg = growRegions(knn, scale, options.growing);
-  if (options.merging.maxRelativeRms > 0)
-    seg =
-        mergeCoplanarRegions(positions, knn, std::move(seg), scale.t,
-                             std::pow(options.alphaFactor * scale.t, 2), noiseRms, options.merging);
+  if (options.merging.maxRelativeRms > 0) {
+    std::vector<RegionOrigin> origins;
+    seg = mergeCoplanarRegions(positions, knn, std::move(seg), scale.t,
+                               std::pow(options.alphaFactor * scale.t, 2), noiseRms,
+                               options.merging, &origins);
+    seg = refineRegionBoundaries(positions, knn, std::move(seg), origins, scale.t, noiseRms,
+                                 options.refinement);
+  }
   timings.segmentation += secondsSince(start);
   start = std::chrono::steady_clock::now();
   RegionLevel level;

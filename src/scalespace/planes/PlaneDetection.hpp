@@ -6,6 +6,7 @@
 #include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/core/RegionGraph.hpp"
+#include "scalespace/planes/BoundaryRefinement.hpp"
 #include "scalespace/planes/PlaneComponent.hpp"
 #include "scalespace/planes/RegionGrowing.hpp"
 #include "scalespace/planes/RegionMerging.hpp"
@@ -22,6 +23,9 @@ struct PlaneDetectionOptions {
   /// Adjacent grown regions whose union a plane describes are merged before the filter (a
   /// departure, docs/THESIS_NOTES.md, coplanar merging; maxRelativeRms 0: the thesis).
   RegionMergeOptions merging;
+  /// Then the points between two regions go to the nearer plane (a departure, docs/THESIS_NOTES.md,
+  /// boundary refinement; maxRelativeDistance 0: the thesis).
+  BoundaryRefinementOptions refinement;
   double alphaFactor = 2.0;    // alpha-shape radius and minimum extent: 2t
   PlanarityOptions planarity;  // RMS <= 5% of t or 2 x noise (maxRelativeRms 0: the thesis)
   double minJaccard = 0.5;     // Sec. 2.3.2
@@ -50,7 +54,8 @@ struct PlaneDetection {
 void validatePlaneDetectionOptions(const PlaneDetectionOptions& options);
 
 /// Sec. 2.3.1 for one scale: region growing, the coplanar merging (with options.merging, allowing
-/// for `noiseRms`, the cloud's pointNoiseRms), then the alpha-shape filter; adds the time spent
+/// for `noiseRms`, the cloud's pointNoiseRms), the boundary refinement (options.refinement, same
+/// noise), then the alpha-shape filter; adds the time spent
 /// to `timings` (segmentation, filtering).
 RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
                          const ScaleFeatures& scale, double noiseRms,

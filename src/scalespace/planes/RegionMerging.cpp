@@ -84,8 +84,10 @@ void validate(const RegionMergeOptions& options) {
 
 Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnGraph& knn,
                                   Segmentation segmentation, double t, double smallArea,
-                                  double noiseRms, const RegionMergeOptions& options) {
+                                  double noiseRms, const RegionMergeOptions& options,
+                                  std::vector<RegionOrigin>* origins) {
   validate(options);
+  if (origins) origins->clear();
   if (!(t > 0)) throw OptionError("region merging: the scale t must be positive");
   if (!(noiseRms >= 0) || !std::isfinite(noiseRms))
     throw OptionError("region merging: the noise RMS must be finite and >= 0");
@@ -218,6 +220,10 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   Segmentation merged;
   merged.labels.assign(n, -1);
   for (const auto& [first, parts] : kept) {
+    if (origins)
+      origins->push_back(parts.size() > 1       ? RegionOrigin::merged
+                         : small[parts.front()] ? RegionOrigin::small
+                                                : RegionOrigin::large);
     std::vector<Index> points;
     for (const Index m : parts)
       points.insert(points.end(), segmentation.regions[m].begin(), segmentation.regions[m].end());

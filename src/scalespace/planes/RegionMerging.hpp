@@ -7,6 +7,7 @@
 // treads and risers is what a plane describes within a fraction of t: merged before the filter,
 // it is a region of its own. The same test joins a recessed window or a raised tile to its wall
 // or roof once the scale is coarse enough to see them as one surface.
+#include <cstdint>
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"
@@ -32,6 +33,11 @@ struct RegionMergeOptions {
   double minRelativeWidth = 1.0;
 };
 
+/// What a region of the merged segmentation is: a grown region smaller than the filter's area
+/// (left alone: none of its neighbours made a plane with it), a grown region large enough to
+/// stand alone, or the union of several small ones.
+enum class RegionOrigin : std::uint8_t { small, large, merged };
+
 /// OptionError naming the field unless the bounds and noiseFactor are finite and >= 0.
 void validate(const RegionMergeOptions& options);
 
@@ -43,9 +49,11 @@ void validate(const RegionMergeOptions& options);
 /// roof its tiles: they are faces at the scales where they are regions). Regions of the result are
 /// ordered by their first grown region, point lists increasing, labels updated. Sequential and
 /// deterministic (same result for any thread count).
-/// `noiseRms` is the cloud's sensor noise (pointNoiseRms).
+/// `noiseRms` is the cloud's sensor noise (pointNoiseRms). When `origins` is given, it receives
+/// each resulting region's origin, or is left empty where nothing could merge at this scale.
 Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnGraph& knn,
                                   Segmentation segmentation, double t, double smallArea,
-                                  double noiseRms, const RegionMergeOptions& options = {});
+                                  double noiseRms, const RegionMergeOptions& options = {},
+                                  std::vector<RegionOrigin>* origins = nullptr);
 
 }  // namespace scalespace

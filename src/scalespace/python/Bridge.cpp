@@ -47,6 +47,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"PlanarityOptions::maxRelativeRms", "max_rms"},
     {"RegionMergeOptions::maxRelativeRms", "merge_rms"},
     {"RegionMergeOptions::maxRelativeDeviation", "merge_deviation"},
+    {"BoundaryRefinementOptions::maxRelativeDistance", "refine_distance"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},
     {"RenderOptions::up", "up"},

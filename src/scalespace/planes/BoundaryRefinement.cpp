@@ -1,0 +1,139 @@
+#include "scalespace/planes/BoundaryRefinement.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/fit/PointSetPlane.hpp"
+
+namespace scalespace {
+namespace {
+constexpr int kPasses = 3;  // plane fits: the first, then two refits
+}  // namespace
+
+void validate(const BoundaryRefinementOptions& options) {
+  if (!(options.maxRelativeDistance >= 0) || !std::isfinite(options.maxRelativeDistance))
+    throw OptionError("BoundaryRefinementOptions::maxRelativeDistance must be finite and >= 0");
+  if (!(options.minRelativeGain >= 0) || !std::isfinite(options.minRelativeGain))
+    throw OptionError("BoundaryRefinementOptions::minRelativeGain must be finite and >= 0");
+  if (!(options.minRelativeOffset >= 0) || !std::isfinite(options.minRelativeOffset))
+    throw OptionError("BoundaryRefinementOptions::minRelativeOffset must be finite and >= 0");
+  if (!(options.noiseFactor >= 0) || !std::isfinite(options.noiseFactor))
+    throw OptionError("BoundaryRefinementOptions::noiseFactor must be finite and >= 0");
+}
+
+Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                                    Segmentation segmentation,
+                                    const std::vector<RegionOrigin>& origins, double t,
+                                    double noiseRms, const BoundaryRefinementOptions& options) {
+  validate(options);
+  if (!(t > 0)) throw OptionError("boundary refinement: the scale t must be positive");
+  if (!(noiseRms >= 0) || !std::isfinite(noiseRms))
+    throw OptionError("boundary refinement: the noise RMS must be finite and >= 0");
+  const std::size_t n = segmentation.labels.size();
+  if (positions.size() != n || knn.size() != n)
+    throw OptionError("boundary refinement: positions, labels and the k-NN graph differ in size");
+  const std::size_t regionCount = segmentation.regions.size();
+  if (!origins.empty() && origins.size() != regionCount)
+    throw OptionError("boundary refinement: one origin per region is needed");
+  // Unions take points; they and the regions large enough to stand alone give them. A small
+  // grown region next to a union keeps its points: it was not merged, so it is a piece of
+  // another surface (a box's side under its top), not an overhang of one.
+  std::vector<std::uint8_t> takes(regionCount, 0), gives(regionCount, 0);
+  for (std::size_t r = 0; r < origins.size(); ++r) {
+    takes[r] = origins[r] == RegionOrigin::merged;
+    gives[r] = origins[r] != RegionOrigin::small;
+  }
+  const double reach = options.maxRelativeDistance * t;
+  const double margin = std::max(options.minRelativeGain * t, options.noiseFactor * noiseRms);
+  const double minOffset = options.minRelativeOffset * t;
+  if (reach == 0 || regionCount < 2 ||
+      std::none_of(takes.begin(), takes.end(), [](std::uint8_t x) { return x != 0; }))
+    return segmentation;
+
+  std::vector<int>& labels = segmentation.labels;
+  std::vector<std::vector<Index>> regions = std::move(segmentation.regions);
+  std::vector<PlaneFit> planes(regionCount);
+  const auto distance = [&](Index i, int r) {
+    const PlaneFit& plane = planes[std::size_t(r)];
+    return plane.valid ? std::abs(plane.normal.dot(positions[i]) - plane.offset)
+                       : std::numeric_limits<double>::infinity();
+  };
+  std::vector<int> target(n, -1);
+  std::vector<std::uint8_t> queued(n, 0);
+  for (int pass = 0; pass < kPasses; ++pass) {
+    // The planes, fixed through a pass's rounds so that a move only ever lowers a point's distance
+    // to its region's plane (by more than the margin) and the rounds end; refitted between passes,
+    // since the points a region gave away had tilted and shifted its plane.
+    tbb::parallel_for(std::size_t(0), regionCount,
+                      [&](std::size_t r) { planes[r] = fitPlane(positions, regions[r]); });
+    // The points to look at: the labelled points next to a target's point in the first round,
+    // then the moved points' neighbours and the moved points themselves.
+    std::vector<Index> frontier;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (labels[i] < 0 || !gives[std::size_t(labels[i])]) continue;
+      for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+        const int r = labels[knn.neighbors[e]];
+        if (r >= 0 && r != labels[i] && takes[std::size_t(r)]) {
+          frontier.push_back(Index(i));
+          break;
+        }
+      }
+    }
+    bool anyMoved = false;
+    while (!frontier.empty()) {
+      tbb::parallel_for(std::size_t(0), frontier.size(), [&](std::size_t f) {
+        const Index i = frontier[f];
+        const int own = labels[i];
+        const double offset = distance(i, own);
+        target[i] = own;
+        if (!gives[std::size_t(own)] || !(offset > minOffset)) return;
+        double best = offset - margin;
+        int bestRegion = own;
+        for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+          const int r = labels[knn.neighbors[e]];
+          if (r < 0 || r == own || !takes[std::size_t(r)]) continue;
+          const double d = distance(i, r);
+          if (d <= reach && (d < best || (d == best && bestRegion != own && r < bestRegion)))
+            best = d, bestRegion = r;
+        }
+        target[i] = bestRegion;
+      });
+      std::vector<Index> moved;
+      for (const Index i : frontier)
+        if (target[i] != labels[i]) moved.push_back(i);
+      for (const Index i : moved) labels[i] = target[i];
+      anyMoved = anyMoved || !moved.empty();
+      std::vector<Index> next;
+      for (const Index i : moved) {
+        if (!queued[i]) queued[i] = 1, next.push_back(i);
+        for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+          const Index j = knn.neighbors[e];
+          if (labels[j] >= 0 && !queued[j]) queued[j] = 1, next.push_back(j);
+        }
+      }
+      for (const Index i : next) queued[i] = 0;
+      std::sort(next.begin(), next.end());
+      frontier = std::move(next);
+    }
+    if (!anyMoved) break;
+    for (std::vector<Index>& points : regions) points.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (labels[i] >= 0) regions[std::size_t(labels[i])].push_back(Index(i));
+  }
+
+  // The regions in their order, the emptied ones dropped.
+  Segmentation refined;
+  refined.labels.assign(n, -1);
+  for (std::vector<Index>& points : regions) {
+    if (points.empty()) continue;
+    for (const Index i : points) refined.labels[i] = int(refined.regions.size());
+    refined.regions.push_back(std::move(points));
+  }
+  return refined;
+}
+
+}  // namespace scalespace

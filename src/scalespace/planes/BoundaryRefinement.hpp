@@ -1,0 +1,58 @@
+#pragma once
+// Setting the boundary of a merged region (planes/RegionMerging.hpp) by distance to its plane
+// rather than by normals (a departure from Sec. 2.3.1: docs/THESIS_NOTES.md, boundary refinement).
+// A grown region is the set of points whose normal at t is within theta of its seed's, and its
+// boundary is where the normals turn. A merged union has no such normal: its plane (a staircase's
+// mean ramp) is not the plane of any of its pieces, so where it meets another surface its edge is
+// wherever the robust fit let the other surface's normal win. At t = 0.8 m the vertical side of
+// a 1.2 m-wide staircase takes the outer 0.2-0.3 m of every tread, points 0.1-0.3 m off that
+// side's plane and a few cm off the ramp's: the union loses its edges and the side's plane no
+// longer describes its points.
+#include <cstdint>
+#include <vector>
+
+#include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/core/RegionGrower.hpp"
+#include "scalespace/planes/RegionMerging.hpp"
+
+namespace scalespace {
+
+struct BoundaryRefinementOptions {
+  /// A point of region A next (in the k-NN graph) to a point of a merged region B moves to B when
+  /// it is nearer to B's least-squares plane than to A's and B's plane lies within
+  /// maxRelativeDistance * t of it (0: no refinement).
+  double maxRelativeDistance = 0.3;
+  /// ... by more than minRelativeGain * t and noiseFactor times the sensor noise sigma: two
+  /// regions of one surface (split by the step limit, a crease of less than theta, or the fit's
+  /// rounding) have planes a little apart, and with no margin one would take all of the other.
+  /// Noise must not shuffle the points along a crease between two planes equally near.
+  double minRelativeGain = 0.05;
+  /// Only a point farther than minRelativeOffset * t from its own region's plane moves: one that
+  /// its plane describes (within the merging's RMS bound, RegionMergeOptions::maxRelativeRms)
+  /// stays where it was grown.
+  double minRelativeOffset = 0.1;
+  double noiseFactor = 2.0;
+};
+
+/// OptionError naming the field unless every bound is finite and >= 0.
+void validate(const BoundaryRefinementOptions& options);
+
+/// The regions of `segmentation` (over `positions`, adjacency from `knn`) with the boundaries of
+/// its unions moved (`origins`, from mergeCoplanarRegions; empty: nothing moves). Unions take
+/// points; they and the large grown regions give them; a small grown region next to a union keeps
+/// its points (it was not merged, so it is a piece of another surface, a box's side under its
+/// top). In each of a few passes every region's plane is fitted to its points; then, in rounds,
+/// every point of a giving region next to a union takes the nearest plane among its own region's
+/// and its neighbouring unions' (with the bounds above), all points of a round deciding on the
+/// labels the round began with. A point only moves to a plane nearer than its own by a margin, so
+/// the rounds end; a region of fewer than 3 points has no plane (its points go to any union in
+/// reach).
+/// Unlabelled points stay unlabelled. Regions keep their order, emptied ones are dropped, point
+/// lists increasing. Deterministic, the same for any thread count.
+/// `noiseRms` is the cloud's sensor noise (pointNoiseRms).
+Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                                    Segmentation segmentation,
+                                    const std::vector<RegionOrigin>& origins, double t,
+                                    double noiseRms, const BoundaryRefinementOptions& options = {});
+
+}  // namespace scalespace

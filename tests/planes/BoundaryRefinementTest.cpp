@@ -1,0 +1,219 @@
+// Boundary refinement of merged regions (planes/BoundaryRefinement.hpp): a staircase's mean ramp
+// takes back the tread edges that a vertical side's region holds, and nothing else moves: not the
+// side's own points, not into a region that is no union, not out of a small region, not between
+// two regions of one plane.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "scalespace/core/Error.hpp"
+#include "scalespace/planes/BoundaryRefinement.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+constexpr double kSpacing = 0.03;
+constexpr double kSide = 1.2;  // the staircase spans x in [0, 1.2]; its side wall is x = 1.2
+
+// Points on a grid over the parallelogram corner + [0,1] u + [0,1] v, kSpacing apart, labelled
+// by `label(point)`.
+template <class Label>
+void addFace(std::vector<Vec3>& points, std::vector<int>& labels, const Vec3& corner, const Vec3& u,
+             const Vec3& v, Label&& label) {
+  const int nu = std::max(1, int(std::round(u.norm() / kSpacing)));
+  const int nv = std::max(1, int(std::round(v.norm() / kSpacing)));
+  for (int a = 0; a < nu; ++a)
+    for (int b = 0; b < nv; ++b) {
+      const Vec3 p = corner + (a + 0.5) / nu * u + (b + 0.5) / nv * v;
+      labels.push_back(label(p));
+      points.push_back(p);
+    }
+}
+
+Segmentation segmentationOf(const std::vector<int>& labels, int regionCount) {
+  Segmentation seg;
+  seg.labels = labels;
+  seg.regions.resize(std::size_t(regionCount));
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] >= 0) seg.regions[std::size_t(labels[i])].push_back(Index(i));
+  return seg;
+}
+
+// Six steps 0.3 deep and 0.18 high (region 0, the merged ramp) beside a vertical side wall at
+// x = 1.2 (region 1), as the robust fit at t = 0.8 leaves them: the side's region holds the
+// treads' and risers' outer `band` along x.
+struct Scene {
+  std::vector<Vec3> points;
+  Segmentation seg;
+};
+
+Scene staircaseBesideAWall(double band) {
+  Scene s;
+  std::vector<int> labels;
+  const auto stairLabel = [&](const Vec3& p) { return p.x() > kSide - band ? 1 : 0; };
+  for (int k = 0; k < 6; ++k) {
+    addFace(s.points, labels, Vec3(0, 0.3 * k, 0.18 * k), Vec3(kSide, 0, 0), Vec3(0, 0, 0.18),
+            stairLabel);
+    addFace(s.points, labels, Vec3(0, 0.3 * k, 0.18 * (k + 1)), Vec3(kSide, 0, 0), Vec3(0, 0.3, 0),
+            stairLabel);
+  }
+  addFace(s.points, labels, Vec3(kSide, 0, 0), Vec3(0, 1.8, 0), Vec3(0, 0, 1.08),
+          [](const Vec3&) { return 1; });
+  s.seg = segmentationOf(labels, 2);
+  return s;
+}
+
+using O = RegionOrigin;
+const std::vector<O> kRampMerged = {O::merged, O::large};  // the ramp a union, the wall alone
+
+Segmentation refine(const Scene& s, const std::vector<O>& origins, double t, double noise = 0,
+                    const BoundaryRefinementOptions& options = {}) {
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  Segmentation refined = refineRegionBoundaries(s.points, knn, s.seg, origins, t, noise, options);
+  // A partition of the same labelled points, labels and lists agreeing.
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < refined.regions.size(); ++r) {
+    total += refined.regions[r].size();
+    EXPECT_TRUE(std::is_sorted(refined.regions[r].begin(), refined.regions[r].end()));
+    for (const Index i : refined.regions[r]) EXPECT_EQ(refined.labels[i], int(r));
+  }
+  EXPECT_EQ(total, s.points.size());
+  return refined;
+}
+
+}  // namespace
+
+TEST(BoundaryRefinement, AMergedRampTakesBackTheTreadEdgesThatItsSideHeld) {
+  const Scene s = staircaseBesideAWall(0.25);
+  const Segmentation refined = refine(s, kRampMerged, 0.8);
+  std::size_t bandPoints = 0, moved = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const double off = kSide - s.points[i].x();
+    if (off == 0) {
+      EXPECT_EQ(refined.labels[i], 1) << "the wall's own points stay";
+    }
+    if (s.seg.labels[i] == 0) {
+      EXPECT_EQ(refined.labels[i], 0) << "the ramp keeps its points";
+    }
+    if (s.seg.labels[i] == 1 && off > 0) {
+      ++bandPoints;
+      moved += refined.labels[i] == 0;
+      // The ramp's plane is within 0.08 of every step point (its sawtooth); the margin is
+      // 0.05 t = 0.04: a point 0.15 or more off the wall is nearer the ramp by more than that.
+      if (off >= 0.15) {
+        EXPECT_EQ(refined.labels[i], 0) << "x " << s.points[i].x();
+      }
+      // Within 0.1 t = 0.08 of the wall (once refitted, its plane is x = 1.2) the wall's plane
+      // describes the point: it stays.
+      if (off < 0.079) {
+        EXPECT_EQ(refined.labels[i], 1) << "x " << s.points[i].x();
+      }
+    }
+  }
+  EXPECT_GT(bandPoints, 700u);
+  EXPECT_GT(double(moved), 0.55 * double(bandPoints)) << moved;
+}
+
+TEST(BoundaryRefinement, OnlyMergedRegionsTakePoints) {
+  const Scene s = staircaseBesideAWall(0.25);
+  // The wall as the union: the ramp's points are all nearer their own plane, nothing moves.
+  EXPECT_EQ(refine(s, {O::large, O::merged}, 0.8).labels, s.seg.labels);
+  EXPECT_EQ(refine(s, {O::large, O::large}, 0.8).labels, s.seg.labels);
+  EXPECT_EQ(refine(s, {}, 0.8).labels, s.seg.labels);
+  // A small grown region beside a union keeps its points: it is a piece of another surface.
+  EXPECT_EQ(refine(s, {O::merged, O::small}, 0.8).labels, s.seg.labels);
+  BoundaryRefinementOptions off;
+  off.maxRelativeDistance = 0;
+  EXPECT_EQ(refine(s, kRampMerged, 0.8, 0, off).labels, s.seg.labels);
+}
+
+TEST(BoundaryRefinement, TwoRegionsOfOnePlaneKeepTheirPoints) {
+  // One flat floor cut in two regions, the second fitted a little tilted (its points 1e-3 t off
+  // the first's plane at its far end): without a margin, and with every point allowed to move,
+  // one would take all of the other.
+  Scene s;
+  std::vector<int> labels;
+  addFace(s.points, labels, Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 1, 0),
+          [](const Vec3& p) { return p.x() < 1 ? 0 : 1; });
+  for (Vec3& p : s.points)
+    if (p.x() >= 1) p.z() = 1e-3 * (p.x() - 1);
+  s.seg = segmentationOf(labels, 2);
+  EXPECT_EQ(refine(s, {O::merged, O::merged}, 1.0).labels, s.seg.labels);
+  BoundaryRefinementOptions noMargin;
+  noMargin.minRelativeGain = 0;
+  noMargin.minRelativeOffset = 0;
+  EXPECT_NE(refine(s, {O::merged, O::merged}, 1.0, 0, noMargin).labels, s.seg.labels);
+}
+
+TEST(BoundaryRefinement, NoiseWithinTheMarginMovesNothingAndFarPlanesAreOutOfReach) {
+  const Scene s = staircaseBesideAWall(0.25);
+  // A margin of 2 sigma = 0.3 (sigma 0.15) exceeds every gain in the band.
+  EXPECT_EQ(refine(s, kRampMerged, 0.8, 0.15).labels, s.seg.labels);
+  // The ramp's plane beyond the reach (0.01 t = 0.008, below its sawtooth) of most band points.
+  BoundaryRefinementOptions shortReach;
+  shortReach.maxRelativeDistance = 0.01;
+  const Segmentation refined = refine(s, kRampMerged, 0.8, 0, shortReach);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) moved += refined.labels[i] != s.seg.labels[i];
+  EXPECT_LT(moved, 200u);
+}
+
+TEST(BoundaryRefinement, SameResultForAnyThreadCount) {
+  const Scene s = staircaseBesideAWall(0.25);
+  Segmentation one;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = refine(s, kRampMerged, 0.8);
+  }
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+  const Segmentation two = refine(s, kRampMerged, 0.8);
+  EXPECT_EQ(one.labels, two.labels);
+  EXPECT_EQ(one.regions, two.regions);
+}
+
+TEST(BoundaryRefinement, BadOptionsAndInputsNameWhatIsWrong) {
+  const Scene s = staircaseBesideAWall(0.25);
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  const auto message = [&](const BoundaryRefinementOptions& o, const std::vector<O>& origins,
+                           double t) {
+    try {
+      refineRegionBoundaries(s.points, knn, s.seg, origins, t, 0, o);
+    } catch (const OptionError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  BoundaryRefinementOptions o;
+  o.maxRelativeDistance = -1;
+  EXPECT_NE(message(o, kRampMerged, 0.8).find("maxRelativeDistance"), std::string::npos);
+  o = {};
+  o.minRelativeGain = std::nan("");
+  EXPECT_NE(message(o, kRampMerged, 0.8).find("minRelativeGain"), std::string::npos);
+  o = {};
+  o.noiseFactor = INFINITY;
+  EXPECT_NE(message(o, kRampMerged, 0.8).find("noiseFactor"), std::string::npos);
+  o = {};
+  o.minRelativeOffset = -0.1;
+  EXPECT_NE(message(o, kRampMerged, 0.8).find("minRelativeOffset"), std::string::npos);
+  EXPECT_NE(message({}, {O::merged}, 0.8).find("origin"), std::string::npos);
+  EXPECT_NE(message({}, kRampMerged, 0).find("scale"), std::string::npos);
+}
+
+TEST(BoundaryRefinement, AnEmptiedRegionIsDropped) {
+  // A two-point region (no plane; reported large, so that it gives) beside the ramp: both points
+  // join the ramp, the region goes.
+  Scene s = staircaseBesideAWall(0);
+  s.points.push_back(Vec3(0.6, 0.45, 0.36 + 1e-3));
+  s.points.push_back(Vec3(0.63, 0.45, 0.36 + 1e-3));
+  std::vector<int> labels = s.seg.labels;
+  labels.push_back(2);
+  labels.push_back(2);
+  s.seg = segmentationOf(labels, 3);
+  const Segmentation refined = refine(s, {O::merged, O::large, O::large}, 0.8);
+  EXPECT_EQ(refined.regions.size(), 2u);
+  EXPECT_EQ(refined.labels[s.points.size() - 1], 0);
+  EXPECT_EQ(refined.labels[s.points.size() - 2], 0);
+}
