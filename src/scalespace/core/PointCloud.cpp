@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 
@@ -134,6 +135,20 @@ void PointCloud::setNormals(const Vec3* normals, std::size_t count) {
     throw Error("PointCloud::setNormals: " + std::to_string(count) + " normals for " +
                 std::to_string(positions_.size()) + " points");
   copyShifted(normals, count, Vec3::Zero(), normals_);
+}
+
+PointCloud::PointCloud(Storage storage)
+    : positions_(std::move(storage.positions)), normals_(std::move(storage.normals)) {
+  positions_.clear();  // keeps the capacity: the point of taking the storage
+  normals_.clear();
+}
+
+PointCloud::Storage PointCloud::releaseStorage() {
+  Storage storage{std::move(positions_), std::move(normals_)};
+  *this = PointCloud();
+  storage.positions.clear();
+  storage.normals.clear();
+  return storage;
 }
 
 PointCloud::PointCloud(const PointCloud& other)

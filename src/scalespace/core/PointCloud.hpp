@@ -81,6 +81,22 @@ class PointCloud {
   PointCloud(PointCloud&&) noexcept = default;
   PointCloud& operator=(PointCloud&&) noexcept = default;
 
+  /// The memory of a cloud's positions and normals, without their contents. A caller that builds
+  /// clouds of similar sizes over and over (the Python bindings copy every call's arrays in) hands
+  /// one cloud's storage to the next, whose setAbsolutePositions / setNormals then fill memory the
+  /// process has already touched instead of allocating fresh blocks: glibc maps blocks of tens of
+  /// MB in for each allocation and out at each free, and the page faults cost more than the copy.
+  struct Storage {
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;
+    std::size_t bytes() const { return (positions.capacity() + normals.capacity()) * sizeof(Vec3); }
+  };
+  /// An empty cloud (no points, no normals) whose setters fill `storage` while it is large enough.
+  explicit PointCloud(Storage storage);
+  /// Empties the cloud (points, normals, columns, origin) and returns its positions' and normals'
+  /// memory for the next cloud.
+  Storage releaseStorage();
+
   std::size_t size() const { return positions_.size(); }
   bool empty() const { return positions_.empty(); }
 
