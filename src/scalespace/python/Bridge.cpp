@@ -198,8 +198,8 @@ Points asVectors(const py::handle& object, std::size_t rows, const char* name) {
   return p;
 }
 
-PointCloud makeCloud(const Points& points, const py::handle& normals) {
-  PointCloud cloud;
+PooledCloud makeCloud(const Points& points, const py::handle& normals) {
+  PooledCloud cloud = PooledCloud::fromPool();
   cloud.setAbsolutePositions(points.data, points.size);
   if (!normals.is_none()) {
     const Points n = asVectors(normals, points.size, "normals");

@@ -19,6 +19,7 @@
 
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
+#include "scalespace/python/InputPool.hpp"
 
 namespace scalespace::python {
 
@@ -53,8 +54,9 @@ Points asPoints(const py::handle& object, const char* name = "points");
 /// The same shape check for per-point vectors (normals: NaN allowed, as in files) of `rows` rows.
 Points asVectors(const py::handle& object, std::size_t rows, const char* name);
 
-/// A cloud from positions and optional normals (None: none).
-PointCloud makeCloud(const Points& points, const py::handle& normals);
+/// A cloud from positions and optional normals (None: none), copied into the pool's buffers
+/// (InputPool.hpp): memory the previous call already mapped in.
+PooledCloud makeCloud(const Points& points, const py::handle& normals);
 
 /// A 1-D integer array (point indices, labels) as `T`, with range checks against `limit` when
 /// given (index >= limit -> ValueError naming `name`).
