@@ -269,6 +269,47 @@ py::array columnToArray(AttributeColumn&& column, bool nativeType) {
   return toArray(std::move(column.values));
 }
 
+namespace {
+// Each double is read before its narrowed value is written, and value i is written at or below
+// double i, so the pass never overwrites a double it has not read. memcpy keeps the two views of
+// the bytes apart for the compiler (no type-punned pointers).
+template <class T>
+py::array narrowedInPlace(std::vector<double>&& values) {
+  static_assert(sizeof(T) <= sizeof(double), "narrowing only");
+  auto* owned = new std::vector<double>(std::move(values));
+  py::capsule free(owned, [](void* p) { delete static_cast<std::vector<double>*>(p); });
+  auto* bytes = reinterpret_cast<unsigned char*>(owned->data());
+  for (std::size_t i = 0; i < owned->size(); ++i) {
+    double v;
+    std::memcpy(&v, bytes + i * sizeof(double), sizeof(double));
+    const T narrowed = T(v);
+    std::memcpy(bytes + i * sizeof(T), &narrowed, sizeof(T));
+  }
+  return py::array_t<T>({py::ssize_t(owned->size())}, reinterpret_cast<const T*>(bytes), free);
+}
+}  // namespace
+
+py::array resultColumnToArray(AttributeColumn&& column) {
+  switch (column.type) {
+    case ScalarType::Int8:
+      return narrowedInPlace<std::int8_t>(std::move(column.values));
+    case ScalarType::UInt8:
+      return narrowedInPlace<std::uint8_t>(std::move(column.values));
+    case ScalarType::Int16:
+      return narrowedInPlace<std::int16_t>(std::move(column.values));
+    case ScalarType::UInt16:
+      return narrowedInPlace<std::uint16_t>(std::move(column.values));
+    case ScalarType::Int32:
+      return narrowedInPlace<std::int32_t>(std::move(column.values));
+    case ScalarType::UInt32:
+      return narrowedInPlace<std::uint32_t>(std::move(column.values));
+    case ScalarType::Float32:
+    case ScalarType::Float64:
+      break;
+  }
+  return toArray(std::move(column.values));
+}
+
 ScalarType scalarTypeOf(const py::dtype& dtype, const std::string& name) {
   const char kind = dtype.kind();
   const auto size = dtype.itemsize();

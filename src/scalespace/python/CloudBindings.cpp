@@ -127,14 +127,13 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
     return s;
   });
   warn(summary.warnings);
-  // The columns, moved out of the cloud (no copy), under the names `scalespace curvature` writes.
+  // The columns, moved out of the cloud (no copy; the integer ones narrowed in their own buffers),
+  // under the names `scalespace curvature` writes.
   const auto outputStart = std::chrono::steady_clock::now();
   py::dict out;
   for (const std::string& name : curvatureColumnNames()) {
     AttributeColumn* column = cloud.findAttribute(name);
-    if (!column) continue;
-    const bool integer = isIntegerType(column->type);
-    out[py::str(name)] = columnToArray(std::move(*column), integer);
+    if (column) out[py::str(name)] = resultColumnToArray(std::move(*column));
   }
   cloud.recycle();  // the input copies' buffers back to the pool, here to be timed
   const double outputSeconds = secondsSince(outputStart);
