@@ -145,3 +145,18 @@ TEST(PointCloud, StorageIsHandedOnWithoutItsContentsAndRefilledInPlace) {
   EXPECT_EQ(second.positions(), fresh.positions());
   EXPECT_EQ(second.normals(), normals);
 }
+
+TEST(PointCloud, GivenBoundsGiveTheSameCloudAsTheScan) {
+  // The Python bindings find the bounds while checking the points and pass them in.
+  const std::vector<Vec3> abs = {{652341.5, 5412345.25, 312.0}, {652342.5, 5412349.75, 300.0}};
+  PointCloud scanned, given;
+  scanned.setAbsolutePositions(abs.data(), abs.size());
+  given.setAbsolutePositions(abs.data(), abs.size(), abs[0].cwiseMin(abs[1]),
+                             abs[0].cwiseMax(abs[1]));
+  EXPECT_EQ(given.origin(), scanned.origin());
+  EXPECT_EQ(given.origin(), Vec3(652342.0, 5412348.0, 306.0));
+  EXPECT_EQ(given.positions(), scanned.positions());
+  given.setAbsolutePositions(abs.data(), 0, Vec3::Constant(1e6), Vec3::Constant(1e6));
+  EXPECT_TRUE(given.empty());
+  EXPECT_EQ(given.origin(), Vec3::Zero());
+}

@@ -106,6 +106,11 @@ class PointCloud {
   /// Same from `count` packed positions (x y z doubles), e.g. a NumPy array's buffer, which then
   /// needs no intermediate vector.
   void setAbsolutePositions(const Vec3* absolute, std::size_t count);
+  /// Same when the caller has already scanned the points (e.g. to check them) and passes the
+  /// bounds of the finite ones, `lo` and `hi` (ignored when count is 0): this saves the
+  /// overload above its own pass over the input. The cloud is the same, origin included.
+  void setAbsolutePositions(const Vec3* absolute, std::size_t count, const Vec3& lo,
+                            const Vec3& hi);
   /// Positions relative to origin(); what every algorithm works on.
   const std::vector<Vec3>& positions() const { return positions_; }
   std::vector<Vec3>& positions() { return positions_; }

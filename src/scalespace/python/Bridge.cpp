@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -173,21 +174,40 @@ Points asPoints(const py::handle& object, const char* name) {
   if (p.size == 0)
     throwValue(std::string(name) + ": the array holds no points (nothing to analyse)");
   // The readers' policy (io/CloudBuilder.hpp) and wording, with the row for the place in the file.
-  // The first unusable row, found in parallel blocks (a 1M-point check is a few ms alone).
-  const std::size_t i = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, p.size, std::size_t(1) << 15), p.size,
-      [&](const tbb::blocked_range<std::size_t>& r, std::size_t first) {
-        for (std::size_t j = r.begin(); j < std::min(r.end(), first); ++j)
-          if (!io_detail::isUsablePosition(p.data[j])) return j;
-        return first;
+  // The first unusable row, found in parallel blocks (a 1M-point check is a few ms alone), and in
+  // the same pass the bounds that the cloud's origin comes from (exact: min and max in any order).
+  struct Scan {
+    std::size_t first;  // the first unusable row, or p.size
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+  };
+  const Scan scan = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, p.size, std::size_t(1) << 15), Scan{p.size},
+      [&](const tbb::blocked_range<std::size_t>& r, Scan s) {
+        for (std::size_t j = r.begin(); j < std::min(r.end(), s.first); ++j) {
+          if (!io_detail::isUsablePosition(p.data[j])) {
+            s.first = j;
+            break;
+          }
+          s.lo = s.lo.cwiseMin(p.data[j]);
+          s.hi = s.hi.cwiseMax(p.data[j]);
+        }
+        return s;
       },
-      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+      [](Scan a, const Scan& b) {
+        a.first = std::min(a.first, b.first);
+        a.lo = a.lo.cwiseMin(b.lo);
+        a.hi = a.hi.cwiseMax(b.hi);
+        return a;
+      });
+  const std::size_t i = scan.first;
   if (i < p.size)
     throwValue(FileError(name, "row " + std::to_string(i),
                          "point " + std::to_string(i + 1) +
                              " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                          "remove such rows, e.g. points[np.isfinite(points).all(axis=1)]")
                    .what());
+  p.bounds = {scan.lo, scan.hi};
   return p;
 }
 
@@ -201,7 +221,11 @@ Points asVectors(const py::handle& object, std::size_t rows, const char* name) {
 
 PooledCloud makeCloud(const Points& points, const py::handle& normals) {
   PooledCloud cloud = PooledCloud::fromPool();
-  cloud.setAbsolutePositions(points.data, points.size);
+  if (points.bounds)
+    cloud.setAbsolutePositions(points.data, points.size, points.bounds->first,
+                               points.bounds->second);
+  else
+    cloud.setAbsolutePositions(points.data, points.size);
   if (!normals.is_none()) {
     const Points n = asVectors(normals, points.size, "normals");
     cloud.setNormals(n.data, n.size);

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scalespace/core/PointCloud.hpp"
@@ -44,6 +45,8 @@ struct Points {
   DoubleArray array;
   const Vec3* data = nullptr;
   std::size_t size = 0;
+  /// The rows' bounds, found by asPoints in its check's pass (one pass less for makeCloud).
+  std::optional<std::pair<Vec3, Vec3>> bounds;
 };
 
 /// Checks and converts an (N, 3) array of positions: a dtype that is not a number -> TypeError;
