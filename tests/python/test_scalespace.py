@@ -503,6 +503,20 @@ def test_input_buffers_are_reused_bit_for_bit_and_released():
     assert_same_columns(first, expected["geo"])
 
 
+def test_integer_columns_of_a_large_cloud_equal_the_cli(tmp_path):
+    # Enough points for the in-place narrowing's parallel ranges (past 32768 values, then
+    # doubling), on a radius that gives every neighbour count from a few to dozens.
+    p = sphere_points(150_000, 10)
+    ss.write(str(tmp_path / "s.ply"), p, p)
+    cli("curvature", tmp_path / "s.ply", "-o", tmp_path / "c.ply", "--scale", 0.02)
+    expected = columns(tmp_path / "c.ply")
+    got = ss.curvature(p, p, scale=0.02)
+    assert got["neighbors"].dtype == np.int32 and got["fit_valid"].dtype == np.uint8
+    assert len(np.unique(got["neighbors"])) > 20
+    for name in ("neighbors", "fit_valid"):
+        np.testing.assert_array_equal(got[name], expected[name], name)
+
+
 def test_concurrent_calls_take_their_own_buffers():
     clouds = [(sphere_points(20000, 8), sphere_points(20000, 8)),
               (np.array([1e5, -2e5, 10.0]) + sphere_points(15000, 9), None)]
