@@ -41,9 +41,4 @@ std::size_t releaseBuffers() {
   return storage.bytes();
 }
 
-std::size_t pooledBytes() {
-  std::lock_guard<std::mutex> lock(poolMutex);
-  return pooled.bytes();
-}
-
 }  // namespace scalespace::python

@@ -47,7 +47,4 @@ class PooledCloud : public PointCloud {
 /// Frees the pooled buffers; returns how many bytes they held.
 std::size_t releaseBuffers();
 
-/// The bytes the pool holds now.
-std::size_t pooledBytes();
-
 }  // namespace scalespace::python
