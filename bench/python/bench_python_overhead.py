@@ -2,7 +2,8 @@
 """The cost of calling scalespace from Python (issue 22): for 1M points, the wall time of
 scalespace.curvature() minus the library call's own time (computeCurvatureColumns, as its summary
 reports it), i.e. checking and passing the points in, the GIL release and worker thread, and the
-19 result columns out as NumPy arrays. Targets: < 5% of the C++ time, < 10 ms in and out.
+18 result columns out as NumPy arrays. Targets: < 5% of the C++ time, < 10 ms in and out. The
+first call also allocates the input buffers that the module keeps for the next ones.
 The peer: Open3D's o3d.utility.Vector3dVector on the same array (the conversion every Open3D
 call on NumPy points starts with), when python3-open3d is importable; skipped and said otherwise.
 
@@ -59,7 +60,7 @@ def main():
           f"overhead {1e3 * overheads[k]:.1f} ms = {100 * overheads[k] / libs[k]:.2f}% "
           f"(median run; all overheads ms: {', '.join(f'{1e3 * o:.1f}' for o in overheads)})")
     print(f"  of which: points and normals checked and copied in {1e3 * ins[k]:.1f} ms, "
-          f"columns out and the copies freed {1e3 * outs[k]:.1f} ms, "
+          f"columns out and the input buffers given back {1e3 * outs[k]:.1f} ms, "
           f"the rest (call, worker thread, summary) {1e3 * (overheads[k] - ins[k] - outs[k]):.1f} ms")
 
     # Points that are not float64 C-contiguous are converted once: the cost of that copy.

@@ -5,7 +5,9 @@ float64, else converted once) and returns NumPy arrays that own their memory. Lo
 the GIL, take ``progress=callable(fraction, stage)`` (return False to cancel: raises
 :class:`Cancelled`) and stop cleanly on Ctrl-C (KeyboardInterrupt). Bad arguments raise
 :class:`OptionError` (a ValueError) or ValueError/TypeError with the library's wording; bad files
-raise :class:`FileError` (an OSError).
+raise :class:`FileError` (an OSError). The inputs are copied into the library's arrays, whose
+memory the module keeps for the next call of a similar size (the last call's, up to 256 MB):
+:func:`release_buffers` frees it.
 
     import scalespace as ss
     cloud = ss.read("scan.ply")
@@ -40,6 +42,7 @@ from ._scalespace import (  # noqa: F401
     planes,
     read_mesh,
     read_planes,
+    release_buffers,
     render,
     retain_freed_memory,
 )
@@ -48,7 +51,7 @@ from . import _scalespace
 __all__ = [
     "Cloud", "read", "write", "estimate_normals", "curvature", "compute_stack", "open_stack",
     "Stack", "planes", "read_planes", "read_mesh", "Planes", "render", "lines", "features", "cylinders",
-    "Cylinders", "parametrize", "distortion", "Error", "retain_freed_memory",
+    "Cylinders", "parametrize", "distortion", "Error", "retain_freed_memory", "release_buffers",
     "OptionError", "FileError", "Cancelled", "__version__",
 ]
 

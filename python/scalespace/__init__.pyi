@@ -135,6 +135,12 @@ def retain_freed_memory() -> bool:
     changes the allocator of the whole process. Returns whether it applied."""
     ...
 
+def release_buffers() -> int:
+    """Free the memory kept for the next call's input copies (the last call's points and
+    normals, up to 256 MB, reused so that repeated calls skip page faults). Returns the bytes
+    freed; the next call allocates again."""
+    ...
+
 def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               scales: Optional[Sequence[float]] = ..., scale_count: int = ..., tmin: float = ...,
               tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,

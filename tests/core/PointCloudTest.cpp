@@ -112,3 +112,51 @@ TEST(PointCloud, LargeInputsCopyInBlocksWithTheSameOriginForAnyThreadCount) {
   EXPECT_EQ(cloud.absolutePosition(n - 1), abs[n - 1]);
   EXPECT_THROW(cloud.setNormals(normals.data(), n - 1), Error);
 }
+
+TEST(PointCloud, StorageIsHandedOnWithoutItsContentsAndRefilledInPlace) {
+  // The Python bindings hand one call's buffers to the next (python/InputPool.hpp): the next
+  // cloud must start empty and fill the same memory, with the same result as a fresh cloud.
+  const std::vector<Vec3> abs = {{652341.5, 5412345.25, 312.0}, {652342.5, 5412346.75, 313.0}};
+  const std::vector<Vec3> normals = {Vec3::UnitZ(), Vec3::UnitX()};
+  PointCloud first;
+  first.setAbsolutePositions(std::vector<Vec3>(100, Vec3(1, 2, 3)));
+  first.setNormals(std::vector<Vec3>(100, Vec3::UnitY()));
+  first.addAttribute("a", ScalarType::Float64);
+  PointCloud::Storage storage = first.releaseStorage();
+  EXPECT_TRUE(first.empty());
+  EXPECT_FALSE(first.hasNormals());
+  EXPECT_TRUE(first.attributes().empty());
+  EXPECT_TRUE(storage.positions.empty());
+  EXPECT_TRUE(storage.normals.empty());
+  EXPECT_EQ(storage.bytes(), 200 * sizeof(Vec3));
+  const Vec3* positionsMemory = storage.positions.data();
+  const Vec3* normalsMemory = storage.normals.data();
+
+  PointCloud second(std::move(storage));
+  EXPECT_TRUE(second.empty());
+  EXPECT_FALSE(second.hasNormals());  // a buffer without contents is not normals
+  second.setAbsolutePositions(abs.data(), abs.size());
+  second.setNormals(normals.data(), normals.size());
+  EXPECT_EQ(second.positions().data(), positionsMemory);  // filled in place
+  EXPECT_EQ(second.normals().data(), normalsMemory);
+  PointCloud fresh;
+  fresh.setAbsolutePositions(abs.data(), abs.size());
+  EXPECT_EQ(second.origin(), fresh.origin());
+  EXPECT_EQ(second.positions(), fresh.positions());
+  EXPECT_EQ(second.normals(), normals);
+}
+
+TEST(PointCloud, GivenBoundsGiveTheSameCloudAsTheScan) {
+  // The Python bindings find the bounds while checking the points and pass them in.
+  const std::vector<Vec3> abs = {{652341.5, 5412345.25, 312.0}, {652342.5, 5412349.75, 300.0}};
+  PointCloud scanned, given;
+  scanned.setAbsolutePositions(abs.data(), abs.size());
+  given.setAbsolutePositions(abs.data(), abs.size(), abs[0].cwiseMin(abs[1]),
+                             abs[0].cwiseMax(abs[1]));
+  EXPECT_EQ(given.origin(), scanned.origin());
+  EXPECT_EQ(given.origin(), Vec3(652342.0, 5412348.0, 306.0));
+  EXPECT_EQ(given.positions(), scanned.positions());
+  given.setAbsolutePositions(abs.data(), 0, Vec3::Constant(1e6), Vec3::Constant(1e6));
+  EXPECT_TRUE(given.empty());
+  EXPECT_EQ(given.origin(), Vec3::Zero());
+}

@@ -466,6 +466,84 @@ def test_two_threads_overlap_in_time():
     assert a[0] < b[-1] and b[0] < a[-1]
 
 
+# ------------------------------------------------------- the input buffers kept between calls
+def assert_same_columns(got, expected):
+    assert got.keys() == expected.keys()
+    for name in expected:
+        assert got[name].dtype == expected[name].dtype, name
+        np.testing.assert_array_equal(got[name], expected[name], name)
+
+
+def test_input_buffers_are_reused_bit_for_bit_and_released():
+    # Georeferenced points (recentred into the reused memory), a smaller and a larger cloud in
+    # between, and a call that estimates its normals: every repeat equals a call on fresh memory.
+    rng = np.random.default_rng(5)
+    geo = np.array([652000.0, 5412000.0, 300.0]) + 50 * sphere_points(6000, 4)
+    clouds = {"geo": (geo, sphere_points(6000, 4)), "small": (sphere_points(2000, 6), None),
+              "large": (sphere_points(9000, 7), sphere_points(9000, 7))}
+    expected = {}
+    for name, (points, normals) in clouds.items():
+        ss.release_buffers()
+        expected[name] = ss.curvature(points, normals, scale_k=15)
+    assert expected["geo"]["neighbors"].dtype == np.int32
+    assert expected["geo"]["fit_valid"].dtype == np.uint8
+    assert expected["geo"]["fit_valid"].sum() > 5900
+    for name in ["geo", "small", "geo", "large", "geo", "small"]:
+        points, normals = clouds[name]
+        assert_same_columns(ss.curvature(points, normals, scale_k=15), expected[name])
+    # The last call's buffers: its positions in the 9000 points' buffer, which it reused, and the
+    # normals it estimated.
+    held = ss.release_buffers()
+    assert held >= (9000 + 2000) * 24
+    assert ss.release_buffers() == 0
+    assert_same_columns(ss.curvature(*clouds["geo"], scale_k=15), expected["geo"])
+    assert ss.release_buffers() >= 2 * 6000 * 24
+    # Results never share the pool's memory: a later call leaves earlier results as they were.
+    first = ss.curvature(*clouds["geo"], scale_k=15)
+    ss.curvature(rng.normal(size=(6000, 3)), scale_k=15)
+    assert_same_columns(first, expected["geo"])
+
+
+def test_integer_columns_of_a_large_cloud_equal_the_cli(tmp_path):
+    # Enough points for the in-place narrowing's parallel ranges (past 32768 values, then
+    # doubling), on a radius that gives every neighbour count from a few to dozens.
+    p = sphere_points(150_000, 10)
+    ss.write(str(tmp_path / "s.ply"), p, p)
+    cli("curvature", tmp_path / "s.ply", "-o", tmp_path / "c.ply", "--scale", 0.02)
+    expected = columns(tmp_path / "c.ply")
+    got = ss.curvature(p, p, scale=0.02)
+    assert got["neighbors"].dtype == np.int32 and got["fit_valid"].dtype == np.uint8
+    assert len(np.unique(got["neighbors"])) > 20
+    for name in ("neighbors", "fit_valid"):
+        np.testing.assert_array_equal(got[name], expected[name], name)
+
+
+def test_concurrent_calls_take_their_own_buffers():
+    clouds = [(sphere_points(20000, 8), sphere_points(20000, 8)),
+              (np.array([1e5, -2e5, 10.0]) + sphere_points(15000, 9), None)]
+    expected = []
+    for points, normals in clouds:
+        ss.release_buffers()
+        expected.append(ss.curvature(points, normals, scale_k=12))
+    start = threading.Barrier(2)
+    failures = []
+
+    def run(k):
+        start.wait()
+        try:
+            for _ in range(4):
+                assert_same_columns(ss.curvature(*clouds[k], scale_k=12, threads=1), expected[k])
+        except AssertionError as e:  # raised in the thread: reported by the test below
+            failures.append(e)
+    threads = [threading.Thread(target=run, args=(k,)) for k in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not failures
+    assert ss.release_buffers() > 0
+
+
 # -------------------------------------------------------------------------- parametrization
 def test_parametrize_equals_the_cli(tmp_path):
     cli("generate", "bumpy-disk", "-n", 4000, "--noise", 0.001, "-o", tmp_path / "d.ply")

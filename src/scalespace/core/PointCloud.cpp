@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 
@@ -107,10 +108,17 @@ void copyShifted(const Vec3* from, std::size_t count, const Vec3& shift, std::ve
 
 void PointCloud::setAbsolutePositions(const Vec3* absolute, std::size_t count) {
   const Bounds b = finiteBounds(absolute, count);
-  const Vec3 lo = b.empty() ? Vec3::Zero() : b.lo, hi = b.empty() ? Vec3::Zero() : b.hi;
+  if (b.empty())
+    setAbsolutePositions(absolute, count, Vec3::Zero(), Vec3::Zero());
+  else
+    setAbsolutePositions(absolute, count, b.lo, b.hi);
+}
+
+void PointCloud::setAbsolutePositions(const Vec3* absolute, std::size_t count, const Vec3& lo,
+                                      const Vec3& hi) {
   // An integer origin keeps p - origin exact (both are multiples of ulp(p) and |p - o| <= |p|
   // whenever the cloud does not straddle far from its centre); small clouds keep origin 0.
-  const Vec3 centre = 0.5 * lo + 0.5 * hi;  // lo + hi would overflow near DBL_MAX
+  const Vec3 centre = count == 0 ? Vec3::Zero() : Vec3(0.5 * lo + 0.5 * hi);  // lo + hi: overflow
   origin_ = centre.cwiseAbs().maxCoeff() < 1e3 ? Vec3::Zero() : Vec3(centre.array().round());
   copyShifted(absolute, count, origin_, positions_);
   resizeColumns();
@@ -134,6 +142,20 @@ void PointCloud::setNormals(const Vec3* normals, std::size_t count) {
     throw Error("PointCloud::setNormals: " + std::to_string(count) + " normals for " +
                 std::to_string(positions_.size()) + " points");
   copyShifted(normals, count, Vec3::Zero(), normals_);
+}
+
+PointCloud::PointCloud(Storage storage)
+    : positions_(std::move(storage.positions)), normals_(std::move(storage.normals)) {
+  positions_.clear();  // keeps the capacity: the point of taking the storage
+  normals_.clear();
+}
+
+PointCloud::Storage PointCloud::releaseStorage() {
+  Storage storage{std::move(positions_), std::move(normals_)};
+  *this = PointCloud();
+  storage.positions.clear();
+  storage.normals.clear();
+  return storage;
 }
 
 PointCloud::PointCloud(const PointCloud& other)

@@ -81,6 +81,22 @@ class PointCloud {
   PointCloud(PointCloud&&) noexcept = default;
   PointCloud& operator=(PointCloud&&) noexcept = default;
 
+  /// The memory of a cloud's positions and normals, without their contents. A caller that builds
+  /// clouds of similar sizes over and over (the Python bindings copy every call's arrays in) hands
+  /// one cloud's storage to the next, whose setAbsolutePositions / setNormals then fill memory the
+  /// process has already touched instead of allocating fresh blocks: glibc maps blocks of tens of
+  /// MB in for each allocation and out at each free, and the page faults cost more than the copy.
+  struct Storage {
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;
+    std::size_t bytes() const { return (positions.capacity() + normals.capacity()) * sizeof(Vec3); }
+  };
+  /// An empty cloud (no points, no normals) whose setters fill `storage` while it is large enough.
+  explicit PointCloud(Storage storage);
+  /// Empties the cloud (points, normals, columns, origin) and returns its positions' and normals'
+  /// memory for the next cloud.
+  Storage releaseStorage();
+
   std::size_t size() const { return positions_.size(); }
   bool empty() const { return positions_.empty(); }
 
@@ -90,6 +106,11 @@ class PointCloud {
   /// Same from `count` packed positions (x y z doubles), e.g. a NumPy array's buffer, which then
   /// needs no intermediate vector.
   void setAbsolutePositions(const Vec3* absolute, std::size_t count);
+  /// Same when the caller has already scanned the points (e.g. to check them) and passes the
+  /// bounds of the finite ones, `lo` and `hi` (ignored when count is 0): this saves the
+  /// overload above its own pass over the input. The cloud is the same, origin included.
+  void setAbsolutePositions(const Vec3* absolute, std::size_t count, const Vec3& lo,
+                            const Vec3& hi);
   /// Positions relative to origin(); what every algorithm works on.
   const std::vector<Vec3>& positions() const { return positions_; }
   std::vector<Vec3>& positions() { return positions_; }

@@ -1,6 +1,7 @@
 #include "scalespace/python/Bridge.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
@@ -9,6 +10,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -173,21 +175,40 @@ Points asPoints(const py::handle& object, const char* name) {
   if (p.size == 0)
     throwValue(std::string(name) + ": the array holds no points (nothing to analyse)");
   // The readers' policy (io/CloudBuilder.hpp) and wording, with the row for the place in the file.
-  // The first unusable row, found in parallel blocks (a 1M-point check is a few ms alone).
-  const std::size_t i = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, p.size, std::size_t(1) << 15), p.size,
-      [&](const tbb::blocked_range<std::size_t>& r, std::size_t first) {
-        for (std::size_t j = r.begin(); j < std::min(r.end(), first); ++j)
-          if (!io_detail::isUsablePosition(p.data[j])) return j;
-        return first;
+  // The first unusable row, found in parallel blocks (a 1M-point check is a few ms alone), and in
+  // the same pass the bounds that the cloud's origin comes from (exact: min and max in any order).
+  struct Scan {
+    std::size_t first;  // the first unusable row, or p.size
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+  };
+  const Scan scan = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, p.size, std::size_t(1) << 15), Scan{p.size},
+      [&](const tbb::blocked_range<std::size_t>& r, Scan s) {
+        for (std::size_t j = r.begin(); j < std::min(r.end(), s.first); ++j) {
+          if (!io_detail::isUsablePosition(p.data[j])) {
+            s.first = j;
+            break;
+          }
+          s.lo = s.lo.cwiseMin(p.data[j]);
+          s.hi = s.hi.cwiseMax(p.data[j]);
+        }
+        return s;
       },
-      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+      [](Scan a, const Scan& b) {
+        a.first = std::min(a.first, b.first);
+        a.lo = a.lo.cwiseMin(b.lo);
+        a.hi = a.hi.cwiseMax(b.hi);
+        return a;
+      });
+  const std::size_t i = scan.first;
   if (i < p.size)
     throwValue(FileError(name, "row " + std::to_string(i),
                          "point " + std::to_string(i + 1) +
                              " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                          "remove such rows, e.g. points[np.isfinite(points).all(axis=1)]")
                    .what());
+  p.bounds = {scan.lo, scan.hi};
   return p;
 }
 
@@ -199,9 +220,13 @@ Points asVectors(const py::handle& object, std::size_t rows, const char* name) {
   return p;
 }
 
-PointCloud makeCloud(const Points& points, const py::handle& normals) {
-  PointCloud cloud;
-  cloud.setAbsolutePositions(points.data, points.size);
+PooledCloud makeCloud(const Points& points, const py::handle& normals) {
+  PooledCloud cloud = PooledCloud::fromPool();
+  if (points.bounds)
+    cloud.setAbsolutePositions(points.data, points.size, points.bounds->first,
+                               points.bounds->second);
+  else
+    cloud.setAbsolutePositions(points.data, points.size);
   if (!normals.is_none()) {
     const Points n = asVectors(normals, points.size, "normals");
     cloud.setNormals(n.data, n.size);
@@ -264,6 +289,68 @@ py::array columnToArray(AttributeColumn&& column, bool nativeType) {
       return typed<std::uint32_t>(column.values);
     case ScalarType::Float32:
       return typed<float>(column.values);
+    case ScalarType::Float64:
+      break;
+  }
+  return toArray(std::move(column.values));
+}
+
+namespace {
+// Value i is written at byte sizeof(T) * i, below double i (byte 8 * i): once double i is read,
+// nothing later reads the bytes its narrowed value overwrites. So a range of values [a, b) with
+// b <= a * 8 / sizeof(T) writes only over doubles below a, read by the ranges before it, and
+// reads none that it writes: its values can be narrowed in parallel. The ranges double in
+// length (int32) or grow eightfold (uint8); 1M values are a few parallel passes, memory-bound
+// like the copies in. memcpy keeps the two views of the bytes apart for the compiler (no
+// type-punned pointers).
+template <class T>
+void narrowInPlace(unsigned char* bytes, std::size_t n) {
+  static_assert(sizeof(T) < sizeof(double), "narrowing only");
+  const auto narrow = [bytes](std::size_t from, std::size_t to) {
+    for (std::size_t i = from; i < to; ++i) {
+      double v;
+      std::memcpy(&v, bytes + i * sizeof(double), sizeof(double));
+      const T narrowed = T(v);
+      std::memcpy(bytes + i * sizeof(T), &narrowed, sizeof(T));
+    }
+  };
+  constexpr std::size_t kGrain = std::size_t(1) << 15;
+  std::size_t a = std::min(n, kGrain);
+  narrow(0, a);
+  while (a < n) {
+    const std::size_t b = std::min(n, a * (sizeof(double) / sizeof(T)));
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(a, b, kGrain),
+        [&](const tbb::blocked_range<std::size_t>& r) { narrow(r.begin(), r.end()); });
+    a = b;
+  }
+}
+
+template <class T>
+py::array narrowedInPlace(std::vector<double>&& values) {
+  auto* owned = new std::vector<double>(std::move(values));
+  py::capsule free(owned, [](void* p) { delete static_cast<std::vector<double>*>(p); });
+  auto* bytes = reinterpret_cast<unsigned char*>(owned->data());
+  narrowInPlace<T>(bytes, owned->size());
+  return py::array_t<T>({py::ssize_t(owned->size())}, reinterpret_cast<const T*>(bytes), free);
+}
+}  // namespace
+
+py::array resultColumnToArray(AttributeColumn&& column) {
+  switch (column.type) {
+    case ScalarType::Int8:
+      return narrowedInPlace<std::int8_t>(std::move(column.values));
+    case ScalarType::UInt8:
+      return narrowedInPlace<std::uint8_t>(std::move(column.values));
+    case ScalarType::Int16:
+      return narrowedInPlace<std::int16_t>(std::move(column.values));
+    case ScalarType::UInt16:
+      return narrowedInPlace<std::uint16_t>(std::move(column.values));
+    case ScalarType::Int32:
+      return narrowedInPlace<std::int32_t>(std::move(column.values));
+    case ScalarType::UInt32:
+      return narrowedInPlace<std::uint32_t>(std::move(column.values));
+    case ScalarType::Float32:
     case ScalarType::Float64:
       break;
   }

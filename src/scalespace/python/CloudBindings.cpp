@@ -58,7 +58,7 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
                   const py::handle& attributes, bool ascii) {
   // An empty cloud is a valid file (the readers read it back), unlike an empty input to analyse.
   const bool empty = py::len(py::module_::import("numpy").attr("asarray")(points)) == 0;
-  PointCloud cloud;
+  PooledCloud cloud;
   std::size_t n = 0;
   if (!empty) {
     cloud = makeCloud(asPoints(points), normals);
@@ -86,7 +86,7 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
                     const py::handle& viewpoint, std::optional<int> threads, py::object progress) {
-  PointCloud cloud = makeCloud(asPoints(points), py::none());
+  PooledCloud cloud = makeCloud(asPoints(points), py::none());
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   Call call(std::move(progress), threads);
   std::vector<std::uint8_t> reliable =
@@ -108,9 +108,9 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
   options.scaleK = scaleK.value_or(0);
   validateCurvatureOptions(options);
   // The cost of the binding itself is timed apart (summary's input/output_seconds): checking and
-  // copying the arrays in, handing the columns out and freeing the copies.
+  // copying the arrays in, handing the columns out and giving the copies' buffers back.
   const auto inputStart = std::chrono::steady_clock::now();
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   const double inputSeconds = secondsSince(inputStart);
   if (std::size_t(options.scaleK) >= cloud.size())
     throw OptionError("scale_k " + std::to_string(options.scaleK) +
@@ -127,16 +127,15 @@ py::object curvaturePy(const py::handle& points, const py::handle& normals,
     return s;
   });
   warn(summary.warnings);
-  // The columns, moved out of the cloud (no copy), under the names `scalespace curvature` writes.
+  // The columns, moved out of the cloud (no copy; the integer ones narrowed in their own buffers),
+  // under the names `scalespace curvature` writes.
   const auto outputStart = std::chrono::steady_clock::now();
   py::dict out;
   for (const std::string& name : curvatureColumnNames()) {
     AttributeColumn* column = cloud.findAttribute(name);
-    if (!column) continue;
-    const bool integer = isIntegerType(column->type);
-    out[py::str(name)] = columnToArray(std::move(*column), integer);
+    if (column) out[py::str(name)] = resultColumnToArray(std::move(*column));
   }
-  cloud = PointCloud();  // the copies of the inputs, freed here to be timed
+  cloud.recycle();  // the input copies' buffers back to the pool, here to be timed
   const double outputSeconds = secondsSince(outputStart);
   if (!withSummary) return std::move(out);
   // What `scalespace curvature` writes in its JSON summary.
@@ -207,7 +206,7 @@ py::array_t<std::uint8_t> renderPy(const py::handle& points, const py::handle& n
   viewDirection(options.view, options.up);  // validate before the conversions
   options.pointRadius = pointRadius;
   options.shading = shading;
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   const std::size_t n = cloud.size();
   const int given = int(!colors.is_none()) + int(!labels.is_none()) + int(!values.is_none());
   if (given > 1) throw OptionError("give at most one of colors, labels and values");

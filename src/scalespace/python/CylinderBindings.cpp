@@ -155,7 +155,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.tube.minArcDegrees = minArc;
   options.tube.maxRelativeRms = maxRms;
   validateCylinderOptions(options);
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   CylinderDetection detection = call([&] {
     if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());

@@ -78,7 +78,7 @@ py::dict linesPy(const py::handle& points, const py::handle& normals, std::optio
   options.fit.robust = robust;
   options.scale = scale.value_or(1);
   validateCurvatureLineOptions(options);
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   std::vector<CurvatureLineSet> sets = call([&] {
     if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
@@ -147,7 +147,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   validateFeatureCurveOptions(options);
   if (meshSamples < 1 || meshSamples > 10000)
     throw OptionError("mesh_samples must be in [1, 10000]");
-  PointCloud cloud;
+  PooledCloud cloud;
   std::optional<TriangleMesh> mesh;
   std::vector<std::string> warnings;
   if (triangles.is_none()) {

@@ -29,8 +29,8 @@ py::array_t<double> uvArray(const std::vector<Vec2>& uv) {
 
 /// The positions and normals the library reads: the cloud's (relative to its origin), with
 /// normals estimated and oriented when none are given, as the CLI does.
-PointCloud cloudWithNormals(const Points& points, const py::handle& normals, Call& call) {
-  PointCloud cloud = makeCloud(points, normals);
+PooledCloud cloudWithNormals(const Points& points, const py::handle& normals, Call& call) {
+  PooledCloud cloud = makeCloud(points, normals);
   if (!cloud.hasNormals())
     call([&] { return estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress()); });
   return cloud;
@@ -50,7 +50,7 @@ py::dict parametrizePy(const py::handle& points, const py::handle& normals, int 
   validateFlatteningOptions(options.flattening);
   validateRelaxationOptions(options.relaxation);
   Call call(std::move(progress), threads);
-  const PointCloud cloud = cloudWithNormals(asPoints(points), normals, call);
+  const PooledCloud cloud = cloudWithNormals(asPoints(points), normals, call);
   const Parametrization p = call(
       [&] { return parametrize(cloud.positions(), cloud.normals(), options, call.progress()); });
   warn(p.warnings);
@@ -107,7 +107,7 @@ py::dict distortionPy(const py::handle& points, const py::handle& normals, const
   }
   const DomainMap domain = domainFromCoordinates(planeCoordinates, directions);
   Call call(std::move(progress), threads);
-  const PointCloud cloud = cloudWithNormals(p, normals, call);
+  const PooledCloud cloud = cloudWithNormals(p, normals, call);
   const DistortionResult result = call([&] {
     return measureDistortion(cloud.positions(), cloud.normals(), domain, options, call.progress());
   });

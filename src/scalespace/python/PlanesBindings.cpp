@@ -132,7 +132,7 @@ class Planes {
     o.maxDistanceFraction = distance;
     o.maxAngleDegrees = angle;
     validate(o);
-    PointCloud cloud = makeCloud(asPoints(points), normals);
+    PooledCloud cloud = makeCloud(asPoints(points), normals);
     if (cloud.size() != pointCount())
       throwValue("points: has " + std::to_string(cloud.size()) +
                  " points but the planes were computed on " + std::to_string(pointCount()));
@@ -186,7 +186,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   validateScaleSpaceOptions(stackOptions);
   validatePlaneDetectionOptions(options);
   if (output) checkPlaneResultDestination(*output);
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   std::vector<std::string> warnings;
   PlaneModel model = call([&] {

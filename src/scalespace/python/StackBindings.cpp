@@ -159,7 +159,7 @@ std::unique_ptr<Stack> computeStackPy(const py::handle& points, const py::handle
   validateScaleSpaceOptions(options);
   StackWriteOptions write;
   write.encoding = parseStackEncoding(encoding);
-  PointCloud cloud = makeCloud(asPoints(points), normals);
+  PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   std::vector<std::string> warnings;
   std::optional<ScaleStack> memory;
