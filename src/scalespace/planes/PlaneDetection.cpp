@@ -35,20 +35,35 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
                          const PlaneDetectionOptions& options, PlaneDetectionTimings& timings) {
   auto start = std::chrono::steady_clock::now();
   Segmentation seg = growRegions(knn, scale, options.growing);
-  if (options.merging.maxRelativeRms > 0) {
-    std::vector<RegionOrigin> origins;
+  std::vector<RegionOrigin> origins;
+  if (options.merging.maxRelativeRms > 0)
     seg = mergeCoplanarRegions(positions, knn, std::move(seg), scale.t,
                                std::pow(options.alphaFactor * scale.t, 2), noiseRms,
                                options.merging, &origins);
-    seg = refineRegionBoundaries(positions, knn, std::move(seg), origins, scale.t, noiseRms,
-                                 options.refinement);
-  }
   timings.segmentation += secondsSince(start);
   start = std::chrono::steady_clock::now();
   RegionLevel level;
   level.t = scale.t;
   level.regions = filterRegions(positions, seg, scale.t, filterOptionsOf(options));
   timings.filtering += secondsSince(start);
+  if (!origins.empty()) {
+    // Among the regions the filter kept, so that no point leaves a kept region for a union that
+    // the filter then drops.
+    start = std::chrono::steady_clock::now();
+    Segmentation kept;
+    kept.labels.assign(positions.size(), -1);
+    std::vector<RegionOrigin> keptOrigins;
+    for (std::vector<Index>& region : level.regions) {
+      if (region.empty()) continue;
+      keptOrigins.push_back(origins[std::size_t(seg.labels[region.front()])]);
+      for (const Index i : region) kept.labels[i] = int(kept.regions.size());
+      kept.regions.push_back(std::move(region));
+    }
+    kept = refineRegionBoundaries(positions, knn, std::move(kept), keptOrigins, scale.t, noiseRms,
+                                  options.refinement);
+    level.regions = std::move(kept.regions);
+    timings.segmentation += secondsSince(start);
+  }
   return level;
 }
 

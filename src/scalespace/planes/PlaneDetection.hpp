@@ -54,8 +54,8 @@ struct PlaneDetection {
 void validatePlaneDetectionOptions(const PlaneDetectionOptions& options);
 
 /// Sec. 2.3.1 for one scale: region growing, the coplanar merging (with options.merging, allowing
-/// for `noiseRms`, the cloud's pointNoiseRms), the boundary refinement (options.refinement, same
-/// noise), then the alpha-shape filter; adds the time spent
+/// for `noiseRms`, the cloud's pointNoiseRms), the alpha-shape filter, then the boundary
+/// refinement of the kept regions (options.refinement, same noise); adds the time spent
 /// to `timings` (segmentation, filtering).
 RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn,
                          const ScaleFeatures& scale, double noiseRms,
