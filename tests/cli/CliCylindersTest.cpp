@@ -126,8 +126,11 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("c.ply") + " --tmin 1 --tmax 0.5 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--tmax"), std::string::npos) << r.err;
-  r = run("cylinders " + path("c.ply") + " --scale -1 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
+  for (const char* scale : {"-1", "0"}) {
+    r = run("cylinders " + path("c.ply") + " --scale " + scale + " -q -o " + path("o"));
+    EXPECT_EQ(r.code, 2) << scale;
+    EXPECT_NE(r.err.find("--scale must be finite and > 0"), std::string::npos) << r.err;
+  }
   // A folder holding someone's files is never written into.
   fs::create_directories(path("mine"));
   std::ofstream(path("mine/notes.txt")) << "keep";

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -185,6 +186,24 @@ TEST_F(Cli, ExportCarriesTheInputAttributesOfTheStacksCloud) {
   EXPECT_EQ(r.code, 2) << r.err;
   r = run("export " + path("st.stack") + " --scale 1 -o " + path("x.ply") + " --drop-invalid");
   EXPECT_EQ(r.code, 2) << r.err;
+}
+
+TEST_F(Cli, CurvatureWarnsOfAScaleReachingTheDiagonalOnceAndBeforeTheWork) {
+  ASSERT_EQ(run("generate sphere -n 800 --seed 3 -q -o " + path("s.ply")).code, 0);
+  const Result r = run("curvature " + path("s.ply") + " -o " + path("c.ply") + " --scale 1e6");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::size_t warning = r.err.find("warning: the scale 1e+06 reaches the cloud's diagonal");
+  ASSERT_NE(warning, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("reaches the cloud's diagonal", r.err.find('\n', warning)),
+            std::string::npos)
+      << r.err;
+  EXPECT_LT(warning, r.err.find("done in"));
+  std::ifstream json(path("c.json"));
+  const std::string text((std::istreambuf_iterator<char>(json)), {});
+  EXPECT_NE(text.find("reaches the cloud's diagonal"), std::string::npos);
+  const Result fine = run("curvature " + path("s.ply") + " -o " + path("d.ply") + " --scale 0.3");
+  ASSERT_EQ(fine.code, 0) << fine.err;
+  EXPECT_EQ(fine.err.find("warning"), std::string::npos) << fine.err;
 }
 
 TEST_F(Cli, CurvatureEstimatesNormalsWhenMissingAndNeverOverwritesItsInput) {

@@ -64,3 +64,25 @@ TEST(CurvatureEstimation, IdenticalForOneAndTwoThreads) {
       ASSERT_EQ(a->values[i], b->values[i]) << name << " point " << i;  // bitwise
   }
 }
+
+TEST(CurvatureEstimation, AScaleReachingTheDiagonalIsWarnedOf) {
+  const auto c = sampleCloud(SurfaceShape::Saddle, Vec3::Zero(), 1.0, 500, 3);
+  const PointCloud cloud = cloudOf(*c);
+  const double diagonal = cloud.boundingBoxDiagonal();
+  CurvatureOptions o;
+  o.scale = 0.9 * diagonal;
+  EXPECT_TRUE(curvatureScaleWarnings(cloud, o).empty());
+  CurvatureSummary summary;
+  fitAllPoints(cloud, o, {}, &summary);
+  EXPECT_TRUE(summary.warnings.empty());
+  o.scale = 1e6;
+  const std::vector<std::string> warnings = curvatureScaleWarnings(cloud, o);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("whole cloud (500 points per fit)"), std::string::npos) << warnings[0];
+  fitAllPoints(cloud, o, {}, &summary);
+  ASSERT_FALSE(summary.warnings.empty());
+  EXPECT_EQ(summary.warnings[0], warnings[0]);
+  o.scale = 0;
+  o.scaleK = 16;  // a neighbour count is never the whole cloud's business
+  EXPECT_TRUE(curvatureScaleWarnings(cloud, o).empty());
+}

@@ -96,6 +96,13 @@ def test_curvature_equals_the_cli(data, tmp_path):
         np.testing.assert_array_equal(values.astype(expected[name].dtype), expected[name], name)
 
 
+def test_curvature_warns_of_a_scale_reaching_the_diagonal():
+    points = sphere_points(300)
+    normals = points / np.linalg.norm(points, axis=1, keepdims=True)
+    with pytest.warns(RuntimeWarning, match="reaches the cloud's diagonal"):  # the CLI's text
+        ss.curvature(points, normals, scale=1e6)
+
+
 def test_curvature_without_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)  # no normals: both estimate and orient them

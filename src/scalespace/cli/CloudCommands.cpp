@@ -327,6 +327,9 @@ void addCurvatureCommand(CLI::App& app) {
       AttributeColumn& col = cloud.addAttribute(inNames[c], ScalarType::Float32);
       for (std::size_t i = 0; i < cloud.size(); ++i) col.values[i] = inputNormals[i][c];
     }
+    // Shown before the work, which such a scale makes long; not again at the end.
+    const std::vector<std::string> early = curvatureScaleWarnings(cloud, options);
+    printWarnings(early);
     const CurvatureSummary summary = computeCurvatureColumns(cloud, options, progress);
     cloud.setNormals({});
     writeCloud(cloud, args->output, WriteOptions{args->ascii});
@@ -350,7 +353,10 @@ void addCurvatureCommand(CLI::App& app) {
                              {"threads", args->threads}}},
                            {"seconds", {{"fits", summary.seconds}, {"total", total}}},
                            {"warnings", summary.warnings}};
-    printWarnings(summary.warnings);
+    std::vector<std::string> late;
+    for (const std::string& w : summary.warnings)
+      if (std::find(early.begin(), early.end(), w) == early.end()) late.push_back(w);
+    printWarnings(late);
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);
     if (!args->quiet)

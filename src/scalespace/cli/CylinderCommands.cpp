@@ -130,9 +130,10 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tmax", args->cylinders.tMax, "largest scale (0: a tenth of the diagonal)")
       ->capture_default_str();
-  cmd->add_option("--scale", args->scale,
-                  "label the points with the components at the scale nearest to this (default: "
-                  "the most persistent component holding each point)");
+  const CLI::Option* scaleOption = cmd->add_option(
+      "--scale", args->scale,
+      "label the points with the components at the scale nearest to this (default: the most "
+      "persistent component holding each point)");
   cmd->add_option("--min-persistence", args->minPersistence,
                   "label only components living at least this many scale steps")
       ->capture_default_str();
@@ -151,11 +152,13 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
-  cmd->callback([args] {
+  cmd->callback([args, scaleOption] {
     const auto start = Clock::now();
     ThreadScope threads(args->threads);
     validateCylinderOptions(args->cylinders);
-    if (args->scale != 0 && !(args->scale > 0 && std::isfinite(args->scale)))
+    // Given, it must be a scale: 0 is no "unset" (it used to fall back to the persistence labels).
+    const bool atScale = scaleOption->count() > 0;
+    if (atScale && !(args->scale > 0 && std::isfinite(args->scale)))
       throw OptionError("--scale must be finite and > 0");
     if (args->minPersistence < 0) throw OptionError("--min-persistence must be >= 0");
     checkOutput(args->output, OutputKind::CylindersResult, {args->input.path});
@@ -166,7 +169,7 @@ void addCylindersCommand(CLI::App& app) {
 
     int level = -1;
     std::vector<int> labels;
-    if (args->scale > 0) {
+    if (atScale) {
       level = nearestCylinderLevel(detection, args->scale);
       labels = cylinderLabelsAtLevel(detection, level, args->minPersistence);
     } else {

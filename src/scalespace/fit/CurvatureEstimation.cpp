@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include "scalespace/core/Error.hpp"
@@ -40,6 +41,20 @@ void validateCurvatureOptions(const CurvatureOptions& options) {
                       std::to_string(kMaxNeighborCount) + "], got " +
                       std::to_string(options.scaleK));
   validateFitOptions(options.fit);
+}
+
+std::vector<std::string> curvatureScaleWarnings(const PointCloud& cloud,
+                                                const CurvatureOptions& options) {
+  const double diagonal = cloud.boundingBoxDiagonal();
+  if (!(options.scale > 0) || cloud.size() < 2 || !(options.scale >= diagonal)) return {};
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "the scale %g reaches the cloud's diagonal (%g): every neighbourhood is the whole "
+                "cloud (%zu points per fit), so every point gets nearly the same fit and the work "
+                "grows with the square of the points; a scale of a few point spacings to a "
+                "fraction of the diagonal describes the surface",
+                options.scale, diagonal, cloud.size());
+  return {text};
 }
 
 namespace {
@@ -112,7 +127,8 @@ void forEachFit(const PointCloud& cloud, const CurvatureOptions& options,
   counts.largestScale = *std::max_element(scales.begin(), scales.end());
   counts.meanNeighbors = fits.neighbors / double(n);
   counts.minNeighbors = options.fit.minNeighbors;
-  summary.warnings = invalidFitWarnings(cloud, counts);
+  summary.warnings = curvatureScaleWarnings(cloud, options);
+  for (std::string& w : invalidFitWarnings(cloud, counts)) summary.warnings.push_back(std::move(w));
   std::vector<double> median = scales;
   std::nth_element(median.begin(), median.begin() + median.size() / 2, median.end());
   summary.medianScale = median[median.size() / 2];

@@ -37,6 +37,13 @@ struct CurvatureSummary {
 /// [1, kMaxNeighborCount]) is given and minNeighbors >= 1; what every entry point checks first.
 void validateCurvatureOptions(const CurvatureOptions& options);
 
+/// A warning when options.scale reaches the cloud's bounding-box diagonal: every neighbourhood is
+/// then the whole cloud, each fit costs all N points (N^2 in all: hours for a million points) and
+/// every point gets nearly the same global fit. Empty otherwise. The summaries carry it; a caller
+/// can show it before the work starts.
+std::vector<std::string> curvatureScaleWarnings(const PointCloud& cloud,
+                                                const CurvatureOptions& options);
+
 /// Names of the columns written by computeCurvatureColumns, in order.
 const std::vector<std::string>& curvatureColumnNames();
 
