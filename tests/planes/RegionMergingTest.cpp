@@ -141,3 +141,43 @@ TEST(RegionMerging, SameRegionsForAnyThreadCountAndOptionsChecked) {
   std::vector<Vec3> fewer(s.points.begin(), s.points.end() - 1);
   EXPECT_THROW(mergeCoplanarRegions(fewer, knn, s.seg, 0.8, 2.56, 0), OptionError);
 }
+
+TEST(RegionMerging, AUnionJoinsALargeRegionThatDescribesItAsWellAsItsOwnPoints) {
+  // Ten steps: the lower seven one grown region (the fit gave them the ramp's normal: a sawtooth
+  // 2.1 m along, larger than (2t)^2 at t = 0.8), the upper three a tread and a riser each. The
+  // three steps merge into a union with the lower region's sawtooth, which then joins it.
+  Scene s;
+  for (int k = 0; k < 10; ++k) {
+    addFace(s.points, s.seg, Vec3(0, 0.3 * k, 0.18 * k), Vec3(1.2, 0, 0), Vec3(0, 0, 0.18), 0.03);
+    addFace(s.points, s.seg, Vec3(0, 0.3 * k, 0.18 * (k + 1)), Vec3(1.2, 0, 0), Vec3(0, 0.3, 0),
+            0.03);
+  }
+  const auto asOneRegion = [&](std::size_t firstRegions) {
+    Segmentation seg;
+    seg.labels.assign(s.points.size(), -1);
+    for (std::size_t r = 0; r < s.seg.regions.size(); ++r) {
+      const int label = r < firstRegions ? 0 : int(r - firstRegions + 1);
+      if (std::size_t(label) >= seg.regions.size()) seg.regions.resize(std::size_t(label) + 1);
+      for (const Index i : s.seg.regions[r]) seg.labels[i] = label;
+    }
+    for (std::size_t i = 0; i < seg.labels.size(); ++i)
+      seg.regions[std::size_t(seg.labels[i])].push_back(Index(i));
+    return seg;
+  };
+  Scene lowerGrown{s.points, asOneRegion(14)};
+  std::vector<RegionOrigin> origins;
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  const Segmentation merged =
+      mergeCoplanarRegions(s.points, knn, lowerGrown.seg, 0.8, std::pow(1.6, 2), 0, {}, &origins);
+  ASSERT_EQ(merged.regions.size(), 1u);
+  EXPECT_EQ(origins, std::vector<RegionOrigin>{RegionOrigin::merged});
+  EXPECT_EQ(regionCount(lowerGrown, 0.8), 1u);
+
+  // An exact plate does not take a union 1 cm off its plane (its own RMS is 0): the face of a box
+  // keeps out the bands along its edges.
+  Scene plate;
+  addFace(plate.points, plate.seg, Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(0, 2, 0), 0.05);
+  addFace(plate.points, plate.seg, Vec3(3, 0, 0.01), Vec3(0.45, 0, 0), Vec3(0, 1, 0), 0.05);
+  addFace(plate.points, plate.seg, Vec3(3.45, 0, 0.01), Vec3(0.45, 0, 0), Vec3(0, 1, 0), 0.05);
+  EXPECT_EQ(regionCount(plate, 0.8), 2u);
+}

@@ -18,6 +18,10 @@
 namespace scalespace {
 namespace {
 
+// A union joins a large region when its RMS to that region's plane is at most this many times the
+// region's own RMS (or the noise floor).
+constexpr double kJoinTolerance = 1.25;
+
 // First and second moments of a point set: enough for the least-squares plane of any union.
 struct Moments {
   double count = 0;
@@ -46,14 +50,16 @@ UnionPlane planeOf(const Moments& m) {
 
 using Box = std::array<Vec3, 8>;  // corners
 
-// The box around a grown region along its own plane's axes (through its centroid), and its
-// in-plane area.
-Box boxOf(const std::vector<Vec3>& positions, const std::vector<Index>& region, double& area) {
+// The box around a grown region along its own plane's axes (through its centroid), its in-plane
+// area, and that plane.
+Box boxOf(const std::vector<Vec3>& positions, const std::vector<Index>& region, double& area,
+          PlaneFit& plane) {
   Box box;
   box.fill(positions[region.front()]);
   area = 0;
+  plane = PlaneFit{};
   if (region.size() < 3) return box;  // a point or two: any corner is one of the points
-  const PlaneFit plane = fitPlane(positions, region);
+  plane = fitPlane(positions, region);
   const Vec3 axes[3] = {plane.axisU, plane.axisV, plane.normal};
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Index i : region) {
@@ -105,9 +111,10 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   std::vector<Moments> moments(regionCount);
   std::vector<std::vector<Box>> boxes(regionCount);
   std::vector<double> area(regionCount);
+  std::vector<PlaneFit> ownPlane(regionCount);
   std::vector<std::uint8_t> small(regionCount);
   tbb::parallel_for(std::size_t(0), regionCount, [&](std::size_t r) {
-    boxes[r] = {boxOf(positions, segmentation.regions[r], area[r])};
+    boxes[r] = {boxOf(positions, segmentation.regions[r], area[r], ownPlane[r])};
     small[r] = area[r] < smallArea;
     if (!small[r]) return;
     for (const Index i : segmentation.regions[r]) {
@@ -215,6 +222,58 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
     }
   }
   std::sort(kept.begin(), kept.end());
+
+  // A union that a large region next to it describes as well as its own points joins it: where
+  // the fit gives part of a staircase the ramp's normal (1M points, noise 5e-5 of the diagonal),
+  // region growing makes one large region of the lower steps, a sawtooth around the mean ramp,
+  // and the merging a union of the upper ones. Within the same bounds, against the large region's
+  // own plane (its points would make any union's RMS small), and only when the union's RMS to
+  // that plane is within the large region's own RMS (or the noise floor) and kJoinTolerance:
+  // the exact face of a box does not take a union of the bent normals along its edge, which
+  // carries points of the next face.
+  std::vector<int> keptOf(regionCount, -1);
+  for (std::size_t k = 0; k < kept.size(); ++k)
+    for (const Index m : kept[k].second) keptOf[m] = int(k);
+  std::vector<int> joinTo(kept.size(), -1);
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const auto& [survivor, parts] = kept[k];
+    if (parts.size() < 2) continue;
+    std::vector<Index> large;  // the large grown regions next to the union
+    for (const Index m : parts)
+      for (const Index i : segmentation.regions[m])
+        for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+          const int g = segmentation.labels[knn.neighbors[e]];
+          if (g >= 0 && !small[std::size_t(g)]) large.push_back(Index(g));
+        }
+    std::sort(large.begin(), large.end());
+    large.erase(std::unique(large.begin(), large.end()), large.end());
+    const Moments& m = moments[survivor];
+    const Vec3 mean = m.sum / m.count;
+    const Mat3 covariance = m.outer / m.count - mean * mean.transpose();
+    double best = std::numeric_limits<double>::infinity();
+    for (const Index g : large) {
+      const PlaneFit& plane = ownPlane[g];
+      if (!plane.valid) continue;
+      const double offset = plane.normal.dot(mean - plane.centroid);
+      const double rms =
+          std::sqrt(std::max(0.0, plane.normal.dot(covariance * plane.normal) + offset * offset));
+      const double describes = kJoinTolerance * std::max(plane.rms, 2 * noiseRms);
+      bool within = rms <= maxRms && rms <= describes && rms < best;
+      for (const Box& box : boxes[survivor])
+        for (const Vec3& corner : box)
+          within = within && std::abs(plane.normal.dot(corner - plane.centroid)) <= maxDeviation;
+      if (within) best = rms, joinTo[k] = keptOf[g];
+    }
+  }
+  for (std::size_t k = 0; k < kept.size(); ++k)
+    if (joinTo[k] >= 0) {
+      auto& into = kept[std::size_t(joinTo[k])].second;
+      into.insert(into.end(), kept[k].second.begin(), kept[k].second.end());
+      kept[k].second.clear();
+    }
+  kept.erase(
+      std::remove_if(kept.begin(), kept.end(), [](const auto& e) { return e.second.empty(); }),
+      kept.end());
 
   // The merged regions, in the order of their first grown region.
   Segmentation merged;

@@ -46,11 +46,14 @@ void validate(const RegionMergeOptions& options);
 /// of small grown regions: the in-plane area of each one's box is below `smallArea`, the area
 /// that the filter asks of a region at this scale. Only pieces that the filter would drop are
 /// joined; a region that stands alone is left as grown (a wall does not take its windows, nor a
-/// roof its tiles: they are faces at the scales where they are regions). Regions of the result are
-/// ordered by their first grown region, point lists increasing, labels updated. Sequential and
-/// deterministic (same result for any thread count).
-/// `noiseRms` is the cloud's sensor noise (pointNoiseRms). When `origins` is given, it receives
-/// each resulting region's origin, or is left empty where nothing could merge at this scale.
+/// roof its tiles: they are faces at the scales where they are regions). A union (not a single
+/// small region) then joins a large region next to it whose own plane describes it within the
+/// same bounds and as well as the large region's own points (RMS within 1.25 times theirs, or
+/// twice the noise): a staircase whose lower steps grew as one region is one ramp. Regions of the
+/// result are ordered by their first grown region, point lists increasing, labels updated.
+/// Sequential and deterministic (same result for any thread count). `noiseRms` is the cloud's
+/// sensor noise (pointNoiseRms). When `origins` is given, it receives each resulting region's
+/// origin, or is left empty where nothing could merge at this scale.
 Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnGraph& knn,
                                   Segmentation segmentation, double t, double smallArea,
                                   double noiseRms, const RegionMergeOptions& options = {},
