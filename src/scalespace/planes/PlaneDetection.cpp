@@ -46,9 +46,10 @@ RegionLevel segmentScale(const std::vector<Vec3>& positions, const KnnGraph& knn
   level.t = scale.t;
   level.regions = filterRegions(positions, seg, scale.t, filterOptionsOf(options));
   timings.filtering += secondsSince(start);
-  if (!origins.empty()) {
+  if (options.refinement.maxRelativeDistance > 0 &&
+      std::find(origins.begin(), origins.end(), RegionOrigin::merged) != origins.end()) {
     // Among the regions the filter kept, so that no point leaves a kept region for a union that
-    // the filter then drops.
+    // the filter then drops (and only where there is a union: no relabelling copy otherwise).
     start = std::chrono::steady_clock::now();
     Segmentation kept;
     kept.labels.assign(positions.size(), -1);
