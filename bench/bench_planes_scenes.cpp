@@ -25,7 +25,8 @@
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
 //                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
 //                            [--merge-width F] [--refine-distance F] [--refine-gain F]
-//                            [--refine-offset F] (PlaneDetectionOptions; default: the library's)
+//                            [--refine-offset F] [--planar-noise F]
+//                            (PlaneDetectionOptions; default: the library's)
 //                            [--no-robust] (the plain APSS stack)
 // --diagnose also prints, per group and level, the region holding most of the group; per level
 // the tile tops found and where their points went; the faces of the largest component along its
@@ -371,7 +372,7 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
   // the flagged ones (PlaneComponent::planar false) are counted apart; the thesis' graph
   // (--max-rms 0) reports every component.
   double worstRms = 0, largestRms = 0;
-  std::size_t overRms = 0, overRmsAboveNoise = 0, largest = 0, flagged = 0;
+  std::size_t overRms = 0, overRmsAboveNoise = 0, overRmsUnmarked = 0, largest = 0, flagged = 0;
   const double sigma = noise * cloud.boundingBoxDiagonal();
   for (const PlaneComponent& c : model.components) {
     const double t = model.scales[std::size_t(c.representativeLevel)];
@@ -386,6 +387,7 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
     overRms += rel > kMaxRmsOverT;
     // Noise alone gives rms/t = sigma/t: above 5 % for t < 20 sigma, whatever the plane.
     overRmsAboveNoise += rel > kMaxRmsOverT && t >= sigma / kMaxRmsOverT;
+    overRmsUnmarked += rel > kMaxRmsOverT && !c.noiseLimited;
     if (c.pointCount > largest) largest = c.pointCount, largestRms = rel;
   }
   for (const auto& set : setsOfLabels(labelsByPersistence(model, minPersistence)))
@@ -395,15 +397,37 @@ void runOurs(const PointCloud& cloud, const Truth& truth, const char* scene, dou
            overRms, model.components.size(), largest, largestRms, result.totalSeconds);
   std::printf(
       "#   t_min %.4g (3 t_min %.4g), t_max %.4g; planar components with rms/t > 5 %%: %zu, %zu "
-      "of them at t >= 20 sigma; flagged non-planar: %zu; noise: estimated %.3g, true sigma %.3g; "
+      "of them at t >= 20 sigma, %zu not marked noise_limited; flagged non-planar: %zu; noise: "
+      "estimated %.3g, true sigma %.3g; "
       "time: stack %.2f s, knn %.2f s, segmentation %.2f s, filtering %.2f s "
       "(both during the stack; %.2f s after it), graph %.3f s, components %.2f s\n",
-      tMin, kWidthInTMin * tMin, model.scales.back(), overRms, overRmsAboveNoise, flagged,
-      detection.noiseRms, sigma, result.stackSeconds, result.knnSeconds,
+      tMin, kWidthInTMin * tMin, model.scales.back(), overRms, overRmsAboveNoise, overRmsUnmarked,
+      flagged, detection.noiseRms, sigma, result.stackSeconds, result.knnSeconds,
       detection.timings.segmentation, detection.timings.filtering, result.segmentationWaitSeconds,
       detection.timings.graph, detection.timings.components);
   if (!diagnostics) return;
   diagnose(cloud, detection, model, truth);
+  std::printf(
+      "# planar components with rms/t > 5 %% at t >= 20 sigma: id, level, t, rms/sigma, "
+      "points, the faces holding most of them (label: share)\n");
+  for (const PlaneComponent& c : model.components) {
+    const double t = model.scales[std::size_t(c.representativeLevel)];
+    if (!c.plane.valid || (model.planaritySplit && !c.planar)) continue;
+    if (c.plane.rms / t <= kMaxRmsOverT || t < sigma / kMaxRmsOverT) continue;
+    std::map<int, std::size_t> faces;
+    const std::vector<Index>& pts = componentPointsAt(detection.graph, c.id, c.representativeLevel);
+    for (Index i : pts) ++faces[truth.face[i]];
+    std::vector<std::pair<std::size_t, int>> sorted;
+    for (const auto& [f, k] : faces) sorted.push_back({k, f});
+    std::sort(sorted.rbegin(), sorted.rend());
+    std::printf("#   %d l %d t %.4g rms/t %.3f rms/sigma %.2f n %zu:", c.id, c.representativeLevel,
+                t, c.plane.rms / t, c.plane.rms / sigma, pts.size());
+    for (std::size_t k = 0; k < std::min<std::size_t>(4, sorted.size()); ++k)
+      std::printf(" %d(g%d): %.2f", sorted[k].second,
+                  truth.faces[std::size_t(sorted[k].second)].group,
+                  double(sorted[k].first) / double(pts.size()));
+    std::printf("\n");
+  }
   std::printf("# as regions of any scale:\n");
   printMissedFaces(truth, regionBest, tMin);
   std::printf("# as components of persistence >= %d at their representative level:\n",
@@ -473,6 +497,8 @@ int main(int argc, char** argv) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--refine-distance" && hasValue) {
       detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
+    } else if (a == "--planar-noise" && hasValue) {
+      detection.planarity.noiseFactor = std::atof(argv[++i]);
     } else if (a == "--refine-gain" && hasValue) {
       detection.refinement.minRelativeGain = std::atof(argv[++i]);
     } else if (a == "--refine-offset" && hasValue) {

@@ -2,6 +2,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <random>
 #include <set>
@@ -10,6 +12,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/planes/PlaneDetection.hpp"
+#include "scalespace/planes/PlaneExport.hpp"
 #include "scalespace/planes/PlaneQueries.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
@@ -195,6 +198,73 @@ TEST(RegionPlanarity, NonPlanarRegionsSplitTheirChainAndAreFlagged) {
   EXPECT_FALSE(makePlaneModel(chained).planaritySplit);  // Sec. 2.4.1's labels, no preference
   EXPECT_THROW(buildPlaneDetection(pts, levels, -1.0, options, {}), OptionError);
   EXPECT_EQ(chained.components[0].persistence, 1);
+}
+
+// A noisy flat patch at a scale below 20 sigma is planar by the noise bound only: noise_limited.
+// The same patch at a coarse scale is planar within 5% of t, and a cap is neither.
+TEST(PlaneComponents, APlanePlanarOnlyByTheNoiseBoundIsMarkedNoiseLimited) {
+  const double sigma = 0.01;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<Vec3> pts;
+  std::vector<Index> fine, coarse, cap;
+  for (int i = 0; i < 3000; ++i) {
+    const double x = u(rng), y = u(rng);
+    switch (i % 3) {
+      case 0:
+        fine.push_back(Index(pts.size())), pts.emplace_back(x, y, noise(rng));
+        break;
+      case 1:
+        coarse.push_back(Index(pts.size())), pts.emplace_back(x + 3, y, noise(rng));
+        break;
+      default:
+        cap.push_back(Index(pts.size()));
+        pts.emplace_back(x - 0.5 + 6, y - 0.5,
+                         std::sqrt(1.0 - (x - 0.5) * (x - 0.5) - (y - 0.5) * (y - 0.5)));
+    }
+  }
+  // Disjoint regions: three one-level components. 5% of t: 0.005 < sigma at t = 0.1 (fine, cap);
+  // 0.02 > sigma at t = 0.4 (coarse).
+  std::vector<RegionLevel> levels(2);
+  levels[0].t = 0.1;
+  levels[0].regions = {fine, cap};
+  levels[1].t = 0.4;
+  levels[1].regions = {coarse};
+  PlaneDetectionOptions options;
+  options.outlines = false;
+  const PlaneDetection d = buildPlaneDetection(pts, levels, sigma, options, {});
+  ASSERT_EQ(d.components.size(), 3u);
+  // Components by their first point: the fine patch's is 0, the coarse one's 1, the cap's 2.
+  std::map<Index, const PlaneComponent*> byFirst;
+  for (const PlaneComponent& c : d.components)
+    byFirst[componentPointsAt(d.graph, c.id, c.representativeLevel).front()] = &c;
+  const PlaneComponent &fineC = *byFirst.at(0), &coarseC = *byFirst.at(1), &capC = *byFirst.at(2);
+  EXPECT_NEAR(fineC.plane.rms, sigma, 0.1 * sigma);
+  EXPECT_TRUE(fineC.planar);
+  EXPECT_TRUE(fineC.noiseLimited);
+  EXPECT_TRUE(coarseC.planar);
+  EXPECT_FALSE(coarseC.noiseLimited);
+  EXPECT_FALSE(capC.planar);
+  EXPECT_FALSE(capC.noiseLimited);
+  // The mark is written and read back (components.json), and is a column of components.csv.
+  const auto dir = std::filesystem::temp_directory_path() / "scalespace_noise_limited";
+  std::filesystem::remove_all(dir);
+  writePlaneModel(makePlaneModel(d), Vec3::Zero(), "in.ply", dir.string());
+  const PlaneModel back = readPlaneModel(dir.string());
+  for (const PlaneComponent& c : d.components)
+    EXPECT_EQ(back.components.at(std::size_t(c.id)).noiseLimited, c.noiseLimited);
+  std::ifstream csv(dir / "components.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",planar,noise_limited"), std::string::npos);
+  std::filesystem::remove_all(dir);
+  // Without the noise bound the fine patch is not planar, hence not noise-limited either.
+  const PlaneDetection strict = buildPlaneDetection(pts, levels, 0.0, options, {});
+  for (const PlaneComponent& c : strict.components) {
+    EXPECT_FALSE(c.noiseLimited);
+    EXPECT_EQ(c.planar, c.representativeScale == 0.4);
+  }
 }
 
 // The graph's distance to the k-th neighbour is knnRadii's (brute force), so the stack can take

@@ -125,7 +125,8 @@ def test_planes_and_segments_equal_the_cli(data, tmp_path):
     stored = ss.read_planes(str(tmp_path / "planes"))
     assert len(stored.components["id"]) == len(planes.components["id"]) > 5
     np.testing.assert_array_equal(stored.membership, planes.membership)
-    for key in ("birth_level", "death_level", "persistence", "point_count", "planar"):
+    for key in ("birth_level", "death_level", "persistence", "point_count", "planar",
+                "noise_limited"):
         np.testing.assert_array_equal(stored.components[key], planes.components[key], key)
     for key in ("normal", "offset", "area", "birth_scale"):
         np.testing.assert_allclose(stored.components[key], planes.components[key], rtol=1e-9,

@@ -378,18 +378,26 @@ void addPlanesCommand(CLI::App& app) {
                    model.components.size(), result.stackSeconds, t.segmentation, t.filtering,
                    args->stack.empty() ? " (during the stack)" : "", t.graph, t.components);
     }
-    std::size_t curved = 0;
-    for (const PlaneComponent& c : model.components) curved += !c.planar;
+    std::size_t curved = 0, noiseLimited = 0;
+    for (const PlaneComponent& c : model.components) {
+      curved += !c.planar;
+      noiseLimited += c.noiseLimited;
+    }
+    const double maxRms = args->detection.planarity.maxRelativeRms > 0
+                              ? args->detection.planarity.maxRelativeRms
+                              : ComponentOptions{}.maxRelativeRms;
     if (curved && !args->quiet)
       std::fprintf(stderr,
                    "%zu of the components are not described by a plane (RMS > %g of their scale "
                    "and > %g x the noise, %.3g): components.json marks them \"planar\": false; "
                    "segment --min-persistence prefers the planar ones\n",
-                   curved,
-                   args->detection.planarity.maxRelativeRms > 0
-                       ? args->detection.planarity.maxRelativeRms
-                       : ComponentOptions{}.maxRelativeRms,
-                   args->detection.planarity.noiseFactor, result.detection.noiseRms);
+                   curved, maxRms, args->detection.planarity.noiseFactor,
+                   result.detection.noiseRms);
+    if (noiseLimited && !args->quiet)
+      std::fprintf(stderr,
+                   "%zu planar components have an RMS above %g of their scale, within the noise "
+                   "only (fine scales): components.json marks them \"noise_limited\": true\n",
+                   noiseLimited, maxRms);
     reportDone("planes", start, args->quiet);
   });
 }

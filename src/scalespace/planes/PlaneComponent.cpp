@@ -65,10 +65,11 @@ std::vector<PlaneComponent> extractComponents(const RegionGraph& graph,
     if (c.plane.valid) rms.push_back(c.plane.rms);
   double noise = options.noiseRms;
   if (noise < 0) noise = rms.empty() ? 0.0 : lowerMedian(std::move(rms));
-  for (PlaneComponent& c : out)
-    c.planar =
-        c.plane.valid && c.plane.rms <= std::max(options.maxRelativeRms * c.representativeScale,
-                                                 options.noiseFactor * noise);
+  for (PlaneComponent& c : out) {
+    const double scaleBound = options.maxRelativeRms * c.representativeScale;
+    c.planar = c.plane.valid && c.plane.rms <= std::max(scaleBound, options.noiseFactor * noise);
+    c.noiseLimited = c.planar && c.plane.rms > scaleBound;
+  }
   return out;
 }
 

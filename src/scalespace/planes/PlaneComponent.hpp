@@ -26,6 +26,11 @@ struct PlaneComponent {
   /// (each step keeping Jaccard > 0.5, Sec. 2.3.2); the planarity split
   /// (planes/RegionPlanarity.hpp) ends the chain there and starts a flagged one.
   bool planar = true;
+  /// Planar only by the noise bound: rms > maxRelativeRms times the representative scale but
+  /// within noiseFactor times the noise. Below 40 sigma the noise alone can exceed 5% of t, so
+  /// the plane is as good as the points allow but not confirmed to 5% of its scale; a user who
+  /// needs that drops these (false whenever planar is false).
+  bool noiseLimited = false;
   double area = 0.0;  // alpha shape (radius alphaFactor * t) at the representative level
   std::vector<std::vector<Vec3>> outlines;  // boundary loops of that alpha shape, in 3D
 };

@@ -47,6 +47,7 @@ void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std:
     j["rms"] = c.plane.rms;
     j["representative_scale"] = c.representativeScale;
     j["planar"] = c.planar;
+    j["noise_limited"] = c.noiseLimited;
     j["area"] = c.area;
     j["plane_valid"] = c.plane.valid;
     list.push_back(std::move(j));
@@ -58,14 +59,15 @@ void writeComponentsJson(const PlaneModel& model, const Vec3& origin, const std:
 void writeComponentsCsv(const PlaneModel& model, const Vec3& origin, const std::string& path) {
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "id,birth_level,birth_scale,death_level,death_scale,persistence,nx,ny,nz,offset,rms,"
-           "area,point_count,representative_scale,planar\n";
+           "area,point_count,representative_scale,planar,noise_limited\n";
     out << std::setprecision(17);
     for (const PlaneComponent& c : model.components)
       out << c.id << ',' << c.birthLevel << ',' << c.birthScale << ',' << c.deathLevel << ','
           << c.deathScale << ',' << c.persistence << ',' << c.plane.normal.x() << ','
           << c.plane.normal.y() << ',' << c.plane.normal.z() << ',' << absoluteOffset(c, origin)
           << ',' << c.plane.rms << ',' << c.area << ',' << c.pointCount << ','
-          << c.representativeScale << ',' << (c.planar ? 1 : 0) << '\n';
+          << c.representativeScale << ',' << (c.planar ? 1 : 0) << ',' << (c.noiseLimited ? 1 : 0)
+          << '\n';
   });
 }
 
@@ -273,6 +275,7 @@ PlaneModel readPlaneModel(const std::string& directory, std::string* input) {
       c.plane.valid = j.value("plane_valid", true);
       c.area = j.at("area").get<double>();
       c.planar = j.value("planar", true);  // absent from results written before it existed
+      c.noiseLimited = c.planar && j.value("noise_limited", false);
       if (c.id != int(model.components.size())) throw std::runtime_error("ids must be 0, 1, ...");
       // The levels index the scales and membership.bin's levels (the queries, `segment`).
       if (c.birthLevel < 0 || c.birthLevel > c.representativeLevel ||

@@ -33,7 +33,7 @@ class Planes {
     std::vector<double> birth(n), death(n), scale(n), offset(n), rms(n), area(n);
     std::vector<std::uint64_t> points(n);
     std::vector<double> normal(3 * n);
-    std::vector<std::uint8_t> planar(n);
+    std::vector<std::uint8_t> planar(n), noiseLimited(n);
     for (std::size_t c = 0; c < n; ++c) {
       const PlaneComponent& p = model_.components[c];
       id[c] = p.id;
@@ -50,6 +50,7 @@ class Planes {
       rms[c] = p.plane.rms;
       area[c] = p.area;
       planar[c] = p.planar;
+      noiseLimited[c] = p.noiseLimited;
     }
     // The fields of components.csv, with the plane n . x = offset in absolute coordinates.
     py::dict d;
@@ -67,6 +68,7 @@ class Planes {
     d["rms"] = toArray(std::move(rms));
     d["area"] = toArray(std::move(area));
     d["planar"] = toArray(std::move(planar));
+    d["noise_limited"] = toArray(std::move(noiseLimited));
     return d;
   }
 
@@ -225,10 +227,11 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
           "scales", [](const Planes& p) { return toArray(std::vector<double>(p.model().scales)); })
       .def_property_readonly("point_count", &Planes::pointCount)
       .def_property_readonly("input", &Planes::input, "the cloud file recorded with the result")
-      .def_property_readonly("components", &Planes::components,
-                             "dict of (C,) arrays: id, birth/death level and scale, persistence, "
-                             "representative level and scale, point_count, normal (C, 3), offset "
-                             "(plane normal . x = offset, absolute), rms, area, planar")
+      .def_property_readonly(
+          "components", &Planes::components,
+          "dict of (C,) arrays: id, birth/death level and scale, persistence, "
+          "representative level and scale, point_count, normal (C, 3), offset "
+          "(plane normal . x = offset, absolute), rms, area, planar, noise_limited")
       .def_property_readonly("membership", &Planes::membership,
                              "(levels, N) int32: the component holding each point at each level")
       .def(

@@ -46,7 +46,8 @@ const std::vector<std::string>& PlanesLayer::componentFields() {
                                                   "offset",
                                                   "rms",
                                                   "area",
-                                                  "planar"};
+                                                  "planar",
+                                                  "noise_limited"};
   return fields;
 }
 
@@ -172,10 +173,10 @@ ViewerResponse PlanesLayer::handle(const std::string& endpoint,
       // Offsets are served absolute, as components.json has them: n . p = offset for file
       // coordinates p.
       const double offset = c.plane.offset + n.dot(cloud_->origin());
-      for (double v :
-           {double(c.id), double(c.birthLevel), double(c.deathLevel), c.birthScale, c.deathScale,
-            double(c.persistence), double(c.representativeLevel), double(c.pointCount), n.x(),
-            n.y(), n.z(), offset, c.plane.rms, c.area, c.planar ? 1.0 : 0.0})
+      for (double v : {double(c.id), double(c.birthLevel), double(c.deathLevel), c.birthScale,
+                       c.deathScale, double(c.persistence), double(c.representativeLevel),
+                       double(c.pointCount), n.x(), n.y(), n.z(), offset, c.plane.rms, c.area,
+                       c.planar ? 1.0 : 0.0, c.noiseLimited ? 1.0 : 0.0})
         appendFloat64(out, v);
     }
     return binaryResponse(std::move(out));
