@@ -275,17 +275,21 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
       }
       const auto& pts = regions[bestRegion];
       std::size_t inParallel = 0;
-      for (Index i : pts) inParallel += truth.group[i] == int(g) && parallel(i);
+      std::vector<Index> outside;
+      for (Index i : pts) {
+        inParallel += truth.group[i] == int(g) && parallel(i);
+        if (truth.group[i] != int(g)) outside.push_back(i);
+      }
       std::printf(
           "#   l %2d t %.4g: region %zu pts (comp %d), holds %.2f of the group (%zu/%zu of its "
           "faces parallel to the largest, %zu/%zu of the others), %.2f of it in the group, IoU "
-          "%.2f; %s\n",
+          "%.2f; %s; outside the group: %s\n",
           l, model.scales[std::size_t(l)], pts.size(),
           graph.componentOf[std::size_t(l)][bestRegion],
           double(bestCommon) / double(truth.groupSize[g]), inParallel, parallelSize,
           bestCommon - inParallel, truth.groupSize[g] - parallelSize,
           double(bestCommon) / double(pts.size()), iou(bestCommon, pts.size(), truth.groupSize[g]),
-          composition(pts, truth).c_str());
+          composition(pts, truth).c_str(), composition(outside, truth).c_str());
     }
   }
   if (!truth.tileTops.empty()) {

@@ -119,14 +119,63 @@ TEST(BoundaryRefinement, AMergedRampTakesBackTheTreadEdgesThatItsSideHeld) {
 
 TEST(BoundaryRefinement, OnlyMergedRegionsTakePoints) {
   const Scene s = staircaseBesideAWall(0.25);
-  // The wall as the union: the ramp's points are all nearer their own plane, nothing moves.
-  EXPECT_EQ(refine(s, {O::large, O::merged}, 0.8).labels, s.seg.labels);
+  // The wall as the union: the ramp's points are all nearer their own plane and stay. (The band
+  // the union holds may go back to the large ramp: AUnionGivesBackThePointsOfALargeRegionsPlane.)
+  const Segmentation wallUnion = refine(s, {O::large, O::merged}, 0.8);
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (s.seg.labels[i] == 0) {
+      EXPECT_EQ(wallUnion.labels[i], 0);
+    }
+  BoundaryRefinementOptions noReturn;
+  noReturn.largeRegionTolerance = 0;
+  EXPECT_EQ(refine(s, {O::large, O::merged}, 0.8, 0, noReturn).labels, s.seg.labels);
   EXPECT_EQ(refine(s, {O::large, O::large}, 0.8).labels, s.seg.labels);
   EXPECT_EQ(refine(s, {}, 0.8).labels, s.seg.labels);
   // A small grown region beside a union keeps its points: it is a piece of another surface.
   EXPECT_EQ(refine(s, {O::merged, O::small}, 0.8).labels, s.seg.labels);
   BoundaryRefinementOptions off;
   off.maxRelativeDistance = 0;
+  EXPECT_EQ(refine(s, kRampMerged, 0.8, 0, off).labels, s.seg.labels);
+}
+
+TEST(BoundaryRefinement, AUnionGivesBackThePointsOfALargeRegionsPlane) {
+  // The ramp (a union) holds the wall's points within 0.15 of its plane, as pieces grown by
+  // normals along the crease leave them. Those farther than 0.1 t = 0.08 from the ramp's plane lie
+  // on the wall's: they go back to it; the nearer ones, which the ramp's plane describes, stay.
+  Scene s = staircaseBesideAWall(0);
+  const Vec3 rampNormal = Vec3(0, -0.18, 0.3).normalized();    // rise 0.18 per 0.3 tread
+  const double rampOffset = rampNormal.dot(Vec3(0, 0, 0.09));  // through mid-risers and treads
+  const auto rampDistance = [&](const Vec3& p) { return std::abs(rampNormal.dot(p) - rampOffset); };
+  std::vector<int> labels = s.seg.labels;
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (s.points[i].x() == kSide && rampDistance(s.points[i]) < 0.15) labels[i] = 0;
+  s.seg = segmentationOf(labels, 2);
+  const Segmentation refined = refine(s, kRampMerged, 0.8);
+  std::size_t band = 0, back = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    if (s.points[i].x() != kSide) {
+      EXPECT_EQ(refined.labels[i], 0) << "a step point stays in the ramp";
+      continue;
+    }
+    if (labels[i] != 0) {
+      EXPECT_EQ(refined.labels[i], 1) << "the wall keeps its points";
+      continue;
+    }
+    ++band;
+    back += refined.labels[i] == 1;
+    // The ramp's least-squares plane (refitted as the band leaves) lies within 1-2 cm of the one
+    // above.
+    if (rampDistance(s.points[i]) > 0.11) {
+      EXPECT_EQ(refined.labels[i], 1) << i;
+    }
+    if (rampDistance(s.points[i]) < 0.05) {
+      EXPECT_EQ(refined.labels[i], 0) << i;
+    }
+  }
+  EXPECT_GT(band, 100u);
+  EXPECT_GT(back, band / 4);
+  BoundaryRefinementOptions off;
+  off.largeRegionTolerance = 0;
   EXPECT_EQ(refine(s, kRampMerged, 0.8, 0, off).labels, s.seg.labels);
 }
 
@@ -198,6 +247,9 @@ TEST(BoundaryRefinement, BadOptionsAndInputsNameWhatIsWrong) {
   o = {};
   o.minRelativeOffset = -0.1;
   EXPECT_NE(message(o, kRampMerged, 0.8).find("minRelativeOffset"), std::string::npos);
+  o = {};
+  o.largeRegionTolerance = -1;
+  EXPECT_NE(message(o, kRampMerged, 0.8).find("largeRegionTolerance"), std::string::npos);
   EXPECT_NE(message({}, {O::merged}, 0.8).find("origin"), std::string::npos);
   EXPECT_NE(message({}, kRampMerged, 0).find("scale"), std::string::npos);
 }

@@ -12,6 +12,9 @@
 namespace scalespace {
 namespace {
 constexpr int kPasses = 3;  // plane fits: the first, then two refits
+// A large region's tolerance never goes below this share of t: an exact face (RMS 0, no noise)
+// still takes back points lying on its plane up to rounding.
+constexpr double kMinRelativeTolerance = 1e-3;
 }  // namespace
 
 void validate(const BoundaryRefinementOptions& options) {
@@ -23,6 +26,8 @@ void validate(const BoundaryRefinementOptions& options) {
     throw OptionError("BoundaryRefinementOptions::minRelativeOffset must be finite and >= 0");
   if (!(options.noiseFactor >= 0) || !std::isfinite(options.noiseFactor))
     throw OptionError("BoundaryRefinementOptions::noiseFactor must be finite and >= 0");
+  if (!(options.largeRegionTolerance >= 0) || !std::isfinite(options.largeRegionTolerance))
+    throw OptionError("BoundaryRefinementOptions::largeRegionTolerance must be finite and >= 0");
 }
 
 Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const KnnGraph& knn,
@@ -42,11 +47,18 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
   // Unions take points; they and the regions large enough to stand alone give them. A small
   // grown region next to a union keeps its points: it was not merged, so it is a piece of
   // another surface (a box's side under its top), not an overhang of one.
-  std::vector<std::uint8_t> takes(regionCount, 0), gives(regionCount, 0);
+  std::vector<std::uint8_t> takes(regionCount, 0), gives(regionCount, 0), large(regionCount, 0);
   for (std::size_t r = 0; r < origins.size(); ++r) {
     takes[r] = origins[r] == RegionOrigin::merged;
     gives[r] = origins[r] != RegionOrigin::small;
+    large[r] = origins[r] == RegionOrigin::large && options.largeRegionTolerance > 0;
   }
+  // Whether a point of region `own` may move to region `r`: any giver's to a union, a union's
+  // back to a large grown region (within that region's tolerance, below).
+  const auto receives = [&](int own, int r) {
+    return r != own &&
+           (takes[std::size_t(r)] || (takes[std::size_t(own)] && large[std::size_t(r)]));
+  };
   const double reach = options.maxRelativeDistance * t;
   const double margin = std::max(options.minRelativeGain * t, options.noiseFactor * noiseRms);
   const double minOffset = options.minRelativeOffset * t;
@@ -57,6 +69,7 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
   std::vector<int>& labels = segmentation.labels;
   std::vector<std::vector<Index>> regions = std::move(segmentation.regions);
   std::vector<PlaneFit> planes(regionCount);
+  std::vector<double> tolerance(regionCount, 0.0);  // a large region's reach (the union's: reach)
   const auto distance = [&](Index i, int r) {
     const PlaneFit& plane = planes[std::size_t(r)];
     return plane.valid ? std::abs(plane.normal.dot(positions[i]) - plane.offset)
@@ -68,8 +81,12 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
     // The planes, fixed through a pass's rounds so that a move only ever lowers a point's distance
     // to its region's plane (by more than the margin) and the rounds end; refitted between passes,
     // since the points a region gave away had tilted and shifted its plane.
-    tbb::parallel_for(std::size_t(0), regionCount,
-                      [&](std::size_t r) { planes[r] = fitPlane(positions, regions[r]); });
+    tbb::parallel_for(std::size_t(0), regionCount, [&](std::size_t r) {
+      planes[r] = fitPlane(positions, regions[r]);
+      tolerance[r] =
+          options.largeRegionTolerance *
+          std::max({planes[r].rms, options.noiseFactor * noiseRms, kMinRelativeTolerance * t});
+    });
     // The points to look at: the labelled points next to a target's point in the first round,
     // then the moved points' neighbours and the moved points themselves.
     std::vector<Index> frontier;
@@ -77,7 +94,7 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
       if (labels[i] < 0 || !gives[std::size_t(labels[i])]) continue;
       for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
         const int r = labels[knn.neighbors[e]];
-        if (r >= 0 && r != labels[i] && takes[std::size_t(r)]) {
+        if (r >= 0 && receives(labels[i], r)) {
           frontier.push_back(Index(i));
           break;
         }
@@ -95,9 +112,10 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
         int bestRegion = own;
         for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
           const int r = labels[knn.neighbors[e]];
-          if (r < 0 || r == own || !takes[std::size_t(r)]) continue;
+          if (r < 0 || !receives(own, r)) continue;
           const double d = distance(i, r);
-          if (d <= reach && (d < best || (d == best && bestRegion != own && r < bestRegion)))
+          const double within = takes[std::size_t(r)] ? reach : tolerance[std::size_t(r)];
+          if (d <= within && (d < best || (d == best && bestRegion != own && r < bestRegion)))
             best = d, bestRegion = r;
         }
         target[i] = bestRegion;

@@ -32,6 +32,13 @@ struct BoundaryRefinementOptions {
   /// stays where it was grown.
   double minRelativeOffset = 0.1;
   double noiseFactor = 2.0;
+  /// A point of a union (farther than minRelativeOffset * t from its plane) goes back to a
+  /// neighbouring large grown region whose plane lies within largeRegionTolerance times that
+  /// region's own RMS (or noiseFactor times the noise) of it: the union's pieces were grown by
+  /// normals, so near a crease they hold points of the surface across it (the top of a
+  /// staircase's side under its sawtooth edge), which lie on that surface's plane. 0: unions
+  /// only take.
+  double largeRegionTolerance = 1.25;
 };
 
 /// OptionError naming the field unless every bound is finite and >= 0.
