@@ -6,8 +6,13 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
+//                  [--bound-per-scale] [--bridge-threshold X] [--bridge-min-scales N]
+//                  [--label-bridges]
 //                  [--per-curve] (per model: each ground-truth curve's share labelled and
-//                  pieces, and how far from the sharp edges the false positives lie)
+//                  pieces, and how far from the sharp edges the false positives lie; for ours,
+//                  why a missed curve is missed: per scale the line vertices near it, their
+//                  |kappa1| t against the salient bound, the salient vertices kept; the share of
+//                  its points passing the vote threshold and the minimum count of scales)
 //                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
@@ -382,6 +387,9 @@ PointCloud noisyCopy(const PointCloud& clean, double sigma) {
 }
 
 bool printPerCurve = false;  // --per-curve
+FeatureCurveOptions ourOptions;
+// --per-curve: ours' last result, for the reasons a curve is missed.
+std::unique_ptr<FeatureCurveResult> lastOurs;
 
 struct Model {
   std::string name;
@@ -474,6 +482,71 @@ struct Scores {
   double curveDice = 0, curveHausdorff = NAN, curveRecall = 0, seconds = 0;
 };
 
+// Why ours misses a curve: per scale, the share of its points with a salient vertex of that scale
+// within e; the share whose votes pass v = voteThreshold V_max, the minimum count of scales, both;
+// quantiles of |vote| / V_max over its points.
+void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<Index>& points) {
+  const std::size_t n = points.size();
+  std::vector<std::size_t> near(32, 0);
+  const auto index = makeSpatialIndex(r.salientPositions);
+  std::vector<Neighbor> found;
+  std::size_t passVote = 0, passScales = 0, passBoth = 0;
+  std::vector<double> ratio;
+  const double threshold = ourOptions.voteThreshold * r.maxVote;
+  for (const Index p : points) {
+    index->radiusSearch(m.clean.positions()[p], m.spacing, found);
+    std::uint32_t mask = 0;
+    for (const Neighbor& nb : found) mask |= 1u << r.salientScales[nb.index];
+    for (int s = 0; s < 32; ++s) near[std::size_t(s)] += (mask >> s) & 1u;
+    const bool v = std::abs(r.votes[p]) > threshold;
+    const bool c = __builtin_popcount(r.voterScales[p]) >= ourOptions.minVotingScales;
+    passVote += v, passScales += c, passBoth += v && c;
+    ratio.push_back(std::abs(r.votes[p]) / r.maxVote);
+  }
+  std::sort(ratio.begin(), ratio.end());
+  // Per scale: line vertices near the curve, the largest |kappa1| t within e of each point.
+  for (std::size_t s = 0; s < r.lineSets.size(); ++s) {
+    const double t = r.scales[s].scale;
+    std::vector<Vec3> pos;
+    std::vector<double> k;
+    for (const CurvatureLine& line : r.lineSets[s].lines)
+      for (const CurvatureLineVertex& v : line.vertices) {
+        pos.push_back(v.position);
+        k.push_back(std::abs(v.kappa1) * t);
+      }
+    if (pos.empty()) continue;
+    const auto li = makeSpatialIndex(pos);
+    std::vector<double> best;
+    std::size_t any = 0, pass = 0;
+    const double bound = std::max((1 - ourOptions.salientThreshold) * r.scales[s].salientBound * t,
+                                  r.salientCurvatureFloor);
+    for (const Index p : points) {
+      li->radiusSearch(m.clean.positions()[p], m.spacing, found);
+      double b = 0;
+      for (const Neighbor& nb : found) b = std::max(b, k[nb.index]);
+      any += !found.empty();
+      pass += b > bound;
+      best.push_back(b);
+    }
+    std::sort(best.begin(), best.end());
+    std::printf(
+        "#     scale %zu (t %.2f e): line vertex within e %.0f%%, max |k1|t q50 %.2f q90 %.2f; "
+        "bound %.2f (0.5 K t %.2f, floor %.2f) passed by %.0f%%\n",
+        s, t / m.spacing, 100.0 * double(any) / double(n), best[n / 2],
+        best[std::min(n - 1, n * 9 / 10)], bound,
+        (1 - ourOptions.salientThreshold) * r.scales[s].salientBound * t, r.salientCurvatureFloor,
+        100.0 * double(pass) / double(n));
+  }
+  std::printf("#     salient within e per scale:");
+  for (std::size_t s = 0; s < r.scales.size(); ++s)
+    std::printf(" %.0f%%", 100.0 * double(near[s]) / double(n));
+  std::printf(
+      "; |v| > %.2f Vmax %.0f%%, >= %d scales %.0f%%, both %.0f%%; |v|/Vmax q50 %.3f q90 %.3f\n",
+      ourOptions.voteThreshold, 100.0 * double(passVote) / double(n), ourOptions.minVotingScales,
+      100.0 * double(passScales) / double(n), 100.0 * double(passBoth) / double(n), ratio[n / 2],
+      ratio[std::min(n - 1, n * 9 / 10)]);
+}
+
 // Per curve: each ground-truth curve against the detected curve holding most of its points.
 void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
   const std::vector<std::vector<Index>> truth = groups(m.gt, m.edges.curves),
@@ -503,6 +576,9 @@ void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedC
           "#   curve %zu: %zu points, %.0f%% labelled, best match %.0f%%, %zu pieces >= 5%%\n", g,
           truth[g].size(), 100.0 * double(labelled) / double(truth[g].size()),
           100.0 * double(common[g]) / double(truth[g].size()), pieces);
+      if (lastOurs && &lastOurs->curveId != &detected && lastOurs->curveId == detected &&
+          double(common[g]) < kCurveCovered * double(truth[g].size()))
+        explainMiss(m, *lastOurs, truth[g]);
     }
     if (match[g] < 0) continue;
     const std::vector<Index>& d = found[std::size_t(match[g])];
@@ -562,13 +638,13 @@ struct Detection {
 
 // Ours with the library's defaults unless --salient / --vote-threshold / --min-curvature /
 // --vote-radius say otherwise (to measure a setting against the same ground truth).
-FeatureCurveOptions ourOptions;
 
 Detection runOurs(const PointCloud& cloud) {
-  const FeatureCurveResult result = detectFeatureCurves(cloud, ourOptions);
+  FeatureCurveResult result = detectFeatureCurves(cloud, ourOptions);
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
+  if (printPerCurve) lastOurs = std::make_unique<FeatureCurveResult>(std::move(result));
   return d;
 }
 
@@ -803,6 +879,14 @@ int main(int argc, char** argv) {
       ourOptions.voteRadiusFactor = std::atof(argv[++i]);
     } else if (a == "--join-gap" && hasValue) {
       ourOptions.joinGap = std::atof(argv[++i]);
+    } else if (a == "--bridge-threshold" && hasValue) {
+      ourOptions.bridgeThreshold = std::atof(argv[++i]);
+    } else if (a == "--bridge-min-scales" && hasValue) {
+      ourOptions.bridgeMinVotingScales = std::atoi(argv[++i]);
+    } else if (a == "--bound-per-scale") {
+      ourOptions.salientBoundFromFinest = false;
+    } else if (a == "--label-bridges") {
+      ourOptions.labelBridges = true;
     } else if (a == "--per-curve") {
       printPerCurve = true;
     } else if (a == "--no-peers") {

@@ -244,6 +244,8 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_flag("--all-salient{false}", args->features.ridgeOnly,
                 "vote with every salient vertex, not only the most curved across nearby lines "
                 "(the thesis)");
+  cmd->add_flag("--salient-per-scale{false}", args->features.salientBoundFromFinest,
+                "take K at each scale (the thesis), not the finest scale's K t over t");
   cmd->add_option("--join-gap", args->features.joinGap,
                   "curves of one sign within this x e of each other are one curve (0 keeps the "
                   "pieces)")
@@ -352,6 +354,7 @@ void addFeaturesCommand(CLI::App& app) {
                                   {{"scale_count", options.scaleCount},
                                    {"salient_threshold", options.salientThreshold},
                                    {"salient_percentile", options.salientPercentile},
+                                   {"salient_bound_from_finest", options.salientBoundFromFinest},
                                    {"vote_threshold", options.voteThreshold},
                                    {"min_salient_curvature", options.minSalientCurvature},
                                    {"noise_salient_factor", options.noiseSalientFactor},

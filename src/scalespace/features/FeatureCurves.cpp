@@ -285,6 +285,9 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     summary.scale = lineOptions.scale;
     summary.salientBound = quantile(lines.seedKappa1, options.salientPercentile);
     summary.lines = lines.lines.size();
+    if (options.salientBoundFromFinest && s > 0)
+      summary.salientBound =
+          result.scales.front().salientBound * result.scales.front().scale / lineOptions.scale;
     const double bound = std::max((1 - options.salientThreshold) * summary.salientBound,
                                   result.salientCurvatureFloor / lineOptions.scale);
     std::vector<const CurvatureLineVertex*> candidates;
@@ -338,19 +341,36 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
 
   // 4. Regions of same-sign votes above v = voteThreshold * V_max, seeded by decreasing |vote|.
   const double threshold = options.voteThreshold * result.maxVote;
-  std::vector<std::uint8_t> eligible(n, 0);
+  const double growThreshold =
+      std::min(options.bridgeThreshold, options.voteThreshold) * result.maxVote;
+  const int growScales = std::min(options.bridgeMinVotingScales, options.minVotingScales);
+  std::vector<std::uint8_t> eligible(n, 0), seedable(n, 0);
   result.convexity.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (result.maxVote > 0 && std::abs(result.votes[i]) > threshold &&
-        __builtin_popcount(voters[i]) >= options.minVotingScales) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(result.maxVote > 0)) continue;
+    const double a = std::abs(result.votes[i]);
+    const int scales = __builtin_popcount(voters[i]);
+    seedable[i] = a > threshold && scales >= options.minVotingScales;
+    if (seedable[i] || (a > growThreshold && scales >= growScales)) {
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
+  }
   std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
-    return eligible[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
+    return seedable[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
   });
   Segmentation seg =
       growRegionsFromSeeds(targetGraph, std::move(seeds), eligible, SameSign{result.convexity});
+  if (!options.labelBridges)  // the bridges joined pieces; they are no curve points themselves
+    for (auto& region : seg.regions) {
+      region.erase(std::remove_if(region.begin(), region.end(),
+                                  [&](Index p) {
+                                    if (seedable[p]) return false;
+                                    seg.labels[p] = -1;
+                                    return true;
+                                  }),
+                   region.end());
+    }
   // Specks below the minimum extent are dropped; the others keep their order (by decreasing
   // strongest vote) and are renumbered.
   std::vector<int> renumber(seg.regions.size(), -1);
@@ -388,11 +408,10 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     kept = std::move(merged);
   }
   result.curveId = std::move(seg.labels);
-  for (std::size_t i = 0; i < n; ++i)
-    if (result.curveId[i] >= 0) {
-      result.curveId[i] = renumber[std::size_t(result.curveId[i])];
-      if (result.curveId[i] < 0) result.convexity[i] = 0;
-    }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (result.curveId[i] >= 0) result.curveId[i] = renumber[std::size_t(result.curveId[i])];
+    if (result.curveId[i] < 0) result.convexity[i] = 0;  // dropped, or in no region
+  }
   result.curves.resize(kept.size());
   tbb::parallel_for(std::size_t(0), kept.size(), [&](std::size_t c) {
     FeatureCurve& curve = result.curves[c];
@@ -401,6 +420,10 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     for (const Index p : curve.points) curve.scaleMask |= voters[p];
     curve.length = bandLength(targets, curve.points, 2 * e);
   });
+  result.voterScales = std::move(voters);
+  result.salientPositions = std::move(salient);
+  result.salientScales = std::move(salientScale);
+  result.salientSigns = std::move(salientSign);
   if (progress && !progress(1, "feature curves")) throw Cancelled();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
