@@ -6,8 +6,7 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale] [--bridge-threshold X] [--bridge-min-scales N]
-//                  [--label-bridges]
+//                  [--bound-per-scale]
 //                  [--per-curve] (per model: each ground-truth curve's share labelled and
 //                  pieces, and how far from the sharp edges the false positives lie; for ours,
 //                  why a missed curve is missed: per scale the line vertices near it, their
@@ -879,14 +878,8 @@ int main(int argc, char** argv) {
       ourOptions.voteRadiusFactor = std::atof(argv[++i]);
     } else if (a == "--join-gap" && hasValue) {
       ourOptions.joinGap = std::atof(argv[++i]);
-    } else if (a == "--bridge-threshold" && hasValue) {
-      ourOptions.bridgeThreshold = std::atof(argv[++i]);
-    } else if (a == "--bridge-min-scales" && hasValue) {
-      ourOptions.bridgeMinVotingScales = std::atoi(argv[++i]);
     } else if (a == "--bound-per-scale") {
       ourOptions.salientBoundFromFinest = false;
-    } else if (a == "--label-bridges") {
-      ourOptions.labelBridges = true;
     } else if (a == "--per-curve") {
       printPerCurve = true;
     } else if (a == "--no-peers") {

@@ -193,6 +193,14 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
         np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
                                       labelled[name], name)
     assert len(features["curves"]) == features["curve_id"].max() + 1
+    cli("features", data / "house.ply", "-o", tmp_path / "g.ply", "--salient-per-scale")
+    thesis_k = ss.features(cloud.points, cloud.normals, salient_per_scale=True)
+    written = ss.read(str(tmp_path / "g.ply")).attributes["feature_votes"]
+    np.testing.assert_array_equal(thesis_k["feature_votes"].astype(written.dtype), written)
+    bounds = [s["salient_bound"] for s in thesis_k["scales"]]
+    carried = [s["salient_bound"] * s["scale"] for s in features["scales"]]
+    np.testing.assert_allclose(carried, carried[0], rtol=1e-12)  # K t of the finest scale
+    assert not np.allclose(bounds, features["scales"][0]["salient_bound"])
 
 
 @pytest.fixture(scope="module")

@@ -341,36 +341,19 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
 
   // 4. Regions of same-sign votes above v = voteThreshold * V_max, seeded by decreasing |vote|.
   const double threshold = options.voteThreshold * result.maxVote;
-  const double growThreshold =
-      std::min(options.bridgeThreshold, options.voteThreshold) * result.maxVote;
-  const int growScales = std::min(options.bridgeMinVotingScales, options.minVotingScales);
-  std::vector<std::uint8_t> eligible(n, 0), seedable(n, 0);
+  std::vector<std::uint8_t> eligible(n, 0);
   result.convexity.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(result.maxVote > 0)) continue;
-    const double a = std::abs(result.votes[i]);
-    const int scales = __builtin_popcount(voters[i]);
-    seedable[i] = a > threshold && scales >= options.minVotingScales;
-    if (seedable[i] || (a > growThreshold && scales >= growScales)) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (result.maxVote > 0 && std::abs(result.votes[i]) > threshold &&
+        __builtin_popcount(voters[i]) >= options.minVotingScales) {
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
-  }
   std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
-    return seedable[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
+    return eligible[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
   });
   Segmentation seg =
       growRegionsFromSeeds(targetGraph, std::move(seeds), eligible, SameSign{result.convexity});
-  if (!options.labelBridges)  // the bridges joined pieces; they are no curve points themselves
-    for (auto& region : seg.regions) {
-      region.erase(std::remove_if(region.begin(), region.end(),
-                                  [&](Index p) {
-                                    if (seedable[p]) return false;
-                                    seg.labels[p] = -1;
-                                    return true;
-                                  }),
-                   region.end());
-    }
   // Specks below the minimum extent are dropped; the others keep their order (by decreasing
   // strongest vote) and are renumbered.
   std::vector<int> renumber(seg.regions.size(), -1);

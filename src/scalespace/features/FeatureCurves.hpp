@@ -72,16 +72,6 @@ struct FeatureCurveOptions {
   /// of its noisy clouds instead of 52% (MCC 0.589 instead of 0.269) and the clean ones as well
   /// (MCC 0.748 instead of 0.739).
   int minVotingScales = 3;
-  /// (Not in the thesis) bridges: regions grow from the points passing voteThreshold and
-  /// minVotingScales through points of the same sign whose votes exceed bridgeThreshold * V_max
-  /// from at least bridgeMinVotingScales scales, but only the former are labelled: two pieces of a
-  /// crease that a stretch of weaker votes joins are one curve, and the labelled band stays as
-  /// wide. Equal to the label rules (or bridgeThreshold >= voteThreshold): no bridges.
-  double bridgeThreshold = 0.05;
-  int bridgeMinVotingScales = 3;
-  /// (Not in the thesis) label the bridges too (hysteresis thresholding): more of each crease,
-  /// but a wider band beside the strong ones.
-  bool labelBridges = false;
   /// Curves whose points span less than this times e (bounding-box diagonal) are dropped; 0
   /// keeps every region (the thesis).
   double minCurveExtent = 1;

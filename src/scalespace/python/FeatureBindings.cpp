@@ -129,8 +129,9 @@ TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
 py::dict featuresPy(const py::handle& points, const py::handle& normals, int scales, double spacing,
                     double voteThreshold, int minScales, double minCurvature, double noiseCurvature,
                     double salientThreshold, double minExtent, double joinGap, bool allSalient,
-                    double beta, double gamma, bool withLines, const py::handle& triangles,
-                    std::size_t meshSamples, std::optional<int> threads, py::object progress) {
+                    bool salientPerScale, double beta, double gamma, bool withLines,
+                    const py::handle& triangles, std::size_t meshSamples,
+                    std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -142,6 +143,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   options.minCurveExtent = minExtent;
   options.joinGap = joinGap;
   options.ridgeOnly = !allSalient;
+  options.salientBoundFromFinest = !salientPerScale;
   options.lines.beta = beta;
   options.lines.gamma = gamma;
   validateFeatureCurveOptions(options);
@@ -230,18 +232,19 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
   m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3,
         "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0, "salient_threshold"_a = 0.5,
-        "min_extent"_a = 1.0, "join_gap"_a = 1.5, "all_salient"_a = false, "beta"_a = 0.5,
-        "gamma"_a = 0.5, "with_lines"_a = false, "triangles"_a = py::none(), "mesh_samples"_a = 100,
-        "threads"_a = py::none(), "progress"_a = py::none(),
+        "min_extent"_a = 1.0, "join_gap"_a = 1.5, "all_salient"_a = false,
+        "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5, "with_lines"_a = false,
+        "triangles"_a = py::none(), "mesh_samples"_a = 100, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
 
 Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
 (e), max_vote, noise_rms (sigma read from the points), salient_curvature_floor (max(min_curvature,
 noise_curvature * sigma / e): the |k1| t a salient vertex needs), curves (per curve: points, length, convexity, the scales that voted), scales (per
 scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
-traced (as lines() returns them). all_salient=True, min_scales=1, min_curvature=0,
-noise_curvature=0, join_gap=0 restore the
-thesis' rules. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
+traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
+scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
+join_gap=0, salient_per_scale=True restore the thesis' rules. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
 mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
   m.def(
       "read_mesh",
