@@ -198,6 +198,27 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
     if (print)
       std::printf("    strand %d  IoU %.3f %s%s\n", k, j, j >= 0.8 ? "found" : "MISSED",
                   which < m.sets.size() ? (" (" + m.sets[which].where + ")").c_str() : "");
+    if (print && j < 0.8) {
+      // Where a missed strand is: the sets holding at least 10% of it (its points in the set /
+      // the set's size), and which pipe or strand the rest of each set is on.
+      const std::vector<Index>& target = strands[std::size_t(k)];
+      for (const Detected& d : m.sets) {
+        std::vector<Index> common;
+        std::set_intersection(target.begin(), target.end(), d.points.begin(), d.points.end(),
+                              std::back_inserter(common));
+        if (10 * common.size() < target.size()) continue;
+        std::size_t otherStrands = 0, otherPipes = 0;
+        for (const Index i : d.points) {
+          if (pipe[i] == 5 && int(part[i]) != k) ++otherStrands;
+          if (pipe[i] != 5) ++otherPipes;
+        }
+        std::printf(
+            "      %zu of its %zu points in a set of %zu (%s): %zu on other strands, %zu "
+            "elsewhere\n",
+            common.size(), target.size(), d.points.size(), d.where.c_str(), otherStrands,
+            otherPipes);
+      }
+    }
   }
   for (const Detected& d : m.sets) {
     std::size_t onPlanes = 0;
