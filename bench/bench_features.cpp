@@ -6,12 +6,19 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale]
+//                  [--bound-per-scale] [--random-seed-order] [--max-turn DEG] [--collision X]
+//                  [--beta X] [--border-offset X] [--curvature-gap X] (CurvatureLineOptions:
+//                  curvedSeedsFirst off, maxTurnDegrees, collisionFraction, beta, borderOffset,
+//                  minCurvatureGap)
 //                  [--per-curve] (per model: each ground-truth curve's share labelled and
 //                  pieces, and how far from the sharp edges the false positives lie; for ours,
 //                  why a missed curve is missed: per scale the line vertices near it, their
 //                  |kappa1| t against the salient bound, the salient vertices kept; the share of
-//                  its points passing the vote threshold and the minimum count of scales)
+//                  its points passing the vote threshold and the minimum count of scales;
+//                  where the lines near it stop: per scale its runs of >= 3 line vertices within
+//                  e and how each ended, the stop reasons of the ends of the lines within e, the
+//                  seeds within e and why those that started no line did not, the field at its
+//                  points with no line vertex within e; how far the nearest other curve runs)
 //                  (FeatureCurveOptions of ours; the library's defaults otherwise)
 //
 // Models: CAD meshes read from DIR (fandisk, blade, anchor, rotor, joint, part, anchor_dense,
@@ -53,6 +60,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -75,7 +83,9 @@
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/features/FeatureCurves.hpp"
+#include "scalespace/fit/FitPoints.hpp"
 #include "scalespace/io/MeshFormat.hpp"
+#include "scalespace/scales/PoissonDiskSampler.hpp"
 
 using namespace scalespace;
 using Clock = std::chrono::steady_clock;
@@ -389,6 +399,7 @@ bool printPerCurve = false;  // --per-curve
 FeatureCurveOptions ourOptions;
 // --per-curve: ours' last result, for the reasons a curve is missed.
 std::unique_ptr<FeatureCurveResult> lastOurs;
+const PointCloud* lastCloud = nullptr;  // the cloud ours ran on
 
 struct Model {
   std::string name;
@@ -503,6 +514,29 @@ void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<
     ratio.push_back(std::abs(r.votes[p]) / r.maxVote);
   }
   std::sort(ratio.begin(), ratio.end());
+  {  // How close another curve runs (thin features: at scales above their width the APSS
+     // merges their two creases into one ridge between them): the median over this curve's points
+     // of the distance to the nearest feature point of another curve.
+    const int g = m.gt[points[0]];
+    std::vector<Index> others;
+    for (std::size_t i = 0; i < m.gt.size(); ++i)
+      if (m.gt[i] >= 0 && m.gt[i] != g) others.push_back(Index(i));
+    double otherMedian = 10;
+    if (!others.empty()) {
+      const auto oi = indexOf(others, m.clean.positions());
+      std::vector<double> d;
+      for (const Index p : points) {
+        oi->radiusSearch(m.clean.positions()[p], 10 * m.spacing, found);
+        double b = 10 * m.spacing;
+        for (const Neighbor& nb : found) b = std::min(b, std::sqrt(nb.distSq));
+        d.push_back(b);
+      }
+      std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+      otherMedian = d[d.size() / 2] / m.spacing;
+    }
+    std::printf("#     another curve's feature points at (median) %.2f e (10: none within 10 e)\n",
+                otherMedian);
+  }
   // Per scale: line vertices near the curve, the largest |kappa1| t within e of each point.
   for (std::size_t s = 0; s < r.lineSets.size(); ++s) {
     const double t = r.scales[s].scale;
@@ -528,6 +562,174 @@ void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<
       best.push_back(b);
     }
     std::sort(best.begin(), best.end());
+    // Where the lines near the curve stop and why: the open ends (first / last vertex) of the
+    // lines with a vertex within e of the curve, by stop reason, split by whether the end itself
+    // lies within e of the curve; and the seeds (the tracer's Poisson disk, redrawn) within e.
+    std::vector<std::size_t> lineOf, touching;
+    for (std::size_t l = 0; l < r.lineSets[s].lines.size(); ++l)
+      for (std::size_t v = 0; v < r.lineSets[s].lines[l].vertices.size(); ++v) lineOf.push_back(l);
+    std::vector<std::uint8_t> nearLine(r.lineSets[s].lines.size(), 0);
+    for (const Index p : points) {
+      li->radiusSearch(m.clean.positions()[p], m.spacing, found);
+      for (const Neighbor& nb : found) nearLine[lineOf[nb.index]] = 1;
+    }
+    const auto ci = indexOf(points, m.clean.positions());
+    std::size_t endsOn[16] = {}, endsOff[16] = {};
+    std::size_t nearLines = 0;
+    for (std::size_t l = 0; l < nearLine.size(); ++l) {
+      if (!nearLine[l]) continue;
+      ++nearLines;
+      const CurvatureLine& line = r.lineSets[s].lines[l];
+      if (line.closed) continue;
+      const LineStop why[2] = {line.stopBackward, line.stopForward};
+      const Vec3 at[2] = {line.vertices.front().position, line.vertices.back().position};
+      for (int k = 0; k < 2; ++k) {
+        ci->radiusSearch(at[k], m.spacing, found);
+        (found.empty() ? endsOff : endsOn)[int(why[k])]++;
+      }
+    }
+    // Runs along the curve: >= 3 consecutive vertices of one line within e of it; how each run
+    // ends (the line's stop, or the line leaving the curve).
+    std::size_t runEnds[16] = {}, runLeft = 0, runs = 0, runVertices = 0;
+    for (const CurvatureLine& line : r.lineSets[s].lines) {
+      const std::size_t nv = line.vertices.size();
+      std::vector<std::uint8_t> on(nv, 0);
+      for (std::size_t v = 0; v < nv; ++v) {
+        ci->radiusSearch(line.vertices[v].position, m.spacing, found);
+        on[v] = !found.empty();
+      }
+      for (std::size_t a = 0; a < nv;) {
+        if (!on[a]) {
+          ++a;
+          continue;
+        }
+        std::size_t b = a;
+        while (b + 1 < nv && on[b + 1]) ++b;
+        if (b - a + 1 >= 3) {
+          ++runs;
+          runVertices += b - a + 1;
+          if (a == 0 && !line.closed)
+            ++runEnds[int(line.stopBackward)];
+          else if (a > 0)
+            ++runLeft;
+          if (b == nv - 1 && !line.closed)
+            ++runEnds[int(line.stopForward)];
+          else if (b < nv - 1)
+            ++runLeft;
+        }
+        a = b + 1;
+      }
+    }
+    std::printf("#     scale %zu: %zu runs along the curve (%zu vertices), their ends: left it %zu",
+                s, runs, runVertices, runLeft);
+    for (int k = 0; k <= int(LineStop::MaxSteps); ++k)
+      if (runEnds[k]) std::printf(" %s %zu", lineStopName(LineStop(k)), runEnds[k]);
+    std::printf("\n");
+    // Seeds within e of the curve (the tracer's Poisson disk, redrawn) and why those that started
+    // no line did not: refit there.
+    std::size_t seedsNear = 0, seedsStarted = 0, seedInvalid = 0, seedUmbilic = 0;
+    if (lastCloud) {
+      const CurvatureLineOptions& lo = ourOptions.lines;
+      const std::vector<Index> sampleIds =
+          lineSamples(lastCloud->positions(), lo.alpha, t, lo.seed);
+      const std::vector<Index> seeds =
+          poissonDiskSample(lastCloud->positions(), sampleIds, 2 * lo.beta * t, lo.seed + 1);
+      std::vector<std::uint8_t> started(lastCloud->size(), 0);
+      for (const CurvatureLine& line : r.lineSets[s].lines) started[line.seed] = 1;
+      std::vector<Vec3> missed;
+      for (const Index q : seeds) {
+        ci->radiusSearch(lastCloud->positions()[q], m.spacing, found);
+        if (found.empty()) continue;
+        ++seedsNear;
+        seedsStarted += started[q];
+        if (!started[q]) missed.push_back(lastCloud->positions()[q]);
+      }
+      std::vector<Vec3> sp(sampleIds.size()), sn(sampleIds.size());
+      for (std::size_t i = 0; i < sampleIds.size(); ++i) {
+        sp[i] = lastCloud->positions()[sampleIds[i]];
+        sn[i] = lastCloud->normals()[sampleIds[i]];
+      }
+      const auto si = makeSpatialIndex(sp);
+      const std::vector<double> ts{t};
+      FitPointsOptions fo;
+      fo.fit = lo.fit;
+      for (const LocalFit& f : fitPoints(SurfaceSamples{sp, sn, *si}, FitQueries{missed, ts}, fo)) {
+        if (!f.valid) {
+          ++seedInvalid;
+          continue;
+        }
+        const double a1 = std::max(std::abs(f.kMax), std::abs(f.kMin)),
+                     a2 = std::min(std::abs(f.kMax), std::abs(f.kMin));
+        seedUmbilic += (a1 - a2) * t < lo.minAnisotropy || a2 > (1 - lo.minCurvatureGap) * a1;
+      }
+    }
+    // The field on the curve's points that have no line vertex within e: the fit there (valid,
+    // near-umbilic) and the angle of v_min to the curve (its points' principal axis within 2 e).
+    std::size_t uncovered = 0, unInvalid = 0, unUmbilic = 0, unAlong = 0;
+    if (lastCloud) {
+      const CurvatureLineOptions& lo = ourOptions.lines;
+      const std::vector<Index> sampleIds =
+          lineSamples(lastCloud->positions(), lo.alpha, t, lo.seed);
+      std::vector<Vec3> sp(sampleIds.size()), sn(sampleIds.size());
+      for (std::size_t i = 0; i < sampleIds.size(); ++i) {
+        sp[i] = lastCloud->positions()[sampleIds[i]];
+        sn[i] = lastCloud->normals()[sampleIds[i]];
+      }
+      const auto si = makeSpatialIndex(sp);
+      std::vector<Vec3> queries, axes;
+      for (const Index p : points) {
+        li->radiusSearch(m.clean.positions()[p], m.spacing, found);
+        if (!found.empty()) continue;
+        queries.push_back(lastCloud->positions()[p]);
+        ci->radiusSearch(m.clean.positions()[p], 2 * m.spacing, found);
+        Vec3 mean = Vec3::Zero();
+        for (const Neighbor& nb : found) mean += m.clean.positions()[points[nb.index]];
+        mean /= double(found.size());
+        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+        for (const Neighbor& nb : found) {
+          const Vec3 d = m.clean.positions()[points[nb.index]] - mean;
+          cov += d * d.transpose();
+        }
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+        axes.push_back(eig.eigenvectors().col(2));
+      }
+      const std::vector<double> ts{t};
+      FitPointsOptions fo;
+      fo.fit = lo.fit;
+      const auto fits = fitPoints(SurfaceSamples{sp, sn, *si}, FitQueries{queries, ts}, fo);
+      uncovered = fits.size();
+      for (std::size_t q = 0; q < fits.size(); ++q) {
+        const LocalFit& f = fits[q];
+        if (!f.valid) {
+          ++unInvalid;
+          continue;
+        }
+        const bool maxFirst = std::abs(f.kMax) >= std::abs(f.kMin);
+        const double a1 = std::abs(maxFirst ? f.kMax : f.kMin),
+                     a2 = std::abs(maxFirst ? f.kMin : f.kMax);
+        if ((a1 - a2) * t < lo.minAnisotropy || a2 > (1 - lo.minCurvatureGap) * a1) {
+          ++unUmbilic;
+          continue;
+        }
+        const Vec3 dir = maxFirst ? f.dirMin : f.dirMax;
+        unAlong += std::abs(dir.dot(axes[q])) > std::cos(30 * kPi / 180);
+      }
+    }
+    std::printf(
+        "#     scale %zu: %zu curve points without a line vertex within e: %zu invalid, "
+        "%zu umbilic, %zu with v_min within 30 deg of the curve\n",
+        s, uncovered, unInvalid, unUmbilic, unAlong);
+    std::printf(
+        "#     scale %zu: %zu lines within e, seeds within e %zu (%zu started a line; of "
+        "the rest %zu invalid, %zu umbilic, the others at a border or on a line); their "
+        "ends within e of the curve:",
+        s, nearLines, seedsNear, seedsStarted, seedInvalid, seedUmbilic);
+    for (int k = 0; k <= int(LineStop::MaxSteps); ++k)
+      if (endsOn[k]) std::printf(" %s %zu", lineStopName(LineStop(k)), endsOn[k]);
+    std::printf("; elsewhere:");
+    for (int k = 0; k <= int(LineStop::MaxSteps); ++k)
+      if (endsOff[k]) std::printf(" %s %zu", lineStopName(LineStop(k)), endsOff[k]);
+    std::printf("\n");
     std::printf(
         "#     scale %zu (t %.2f e): line vertex within e %.0f%%, max |k1|t q50 %.2f q90 %.2f; "
         "bound %.2f (0.5 K t %.2f, floor %.2f) passed by %.0f%%\n",
@@ -643,7 +845,10 @@ Detection runOurs(const PointCloud& cloud) {
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
-  if (printPerCurve) lastOurs = std::make_unique<FeatureCurveResult>(std::move(result));
+  if (printPerCurve) {
+    lastOurs = std::make_unique<FeatureCurveResult>(std::move(result));
+    lastCloud = &cloud;
+  }
   return d;
 }
 
@@ -876,6 +1081,18 @@ int main(int argc, char** argv) {
       ourOptions.minVotingScales = std::atoi(argv[++i]);
     } else if (a == "--vote-radius" && hasValue) {
       ourOptions.voteRadiusFactor = std::atof(argv[++i]);
+    } else if (a == "--random-seed-order") {
+      ourOptions.lines.curvedSeedsFirst = false;
+    } else if (a == "--max-turn" && hasValue) {
+      ourOptions.lines.maxTurnDegrees = std::atof(argv[++i]);
+    } else if (a == "--collision" && hasValue) {
+      ourOptions.lines.collisionFraction = std::atof(argv[++i]);
+    } else if (a == "--beta" && hasValue) {
+      ourOptions.lines.beta = std::atof(argv[++i]);
+    } else if (a == "--border-offset" && hasValue) {
+      ourOptions.lines.borderOffset = std::atof(argv[++i]);
+    } else if (a == "--curvature-gap" && hasValue) {
+      ourOptions.lines.minCurvatureGap = std::atof(argv[++i]);
     } else if (a == "--join-gap" && hasValue) {
       ourOptions.joinGap = std::atof(argv[++i]);
     } else if (a == "--bound-per-scale") {

@@ -302,3 +302,30 @@ TEST(CurvatureLines, InvalidOptionsAndInputsAreRefused) {
   empty.setNormals({});
   EXPECT_EQ(traceCurvatureLines(empty, atScale(0.1)).lines.size(), 0u);
 }
+
+TEST(CurvatureLines, TheLineOnACreaseIsTracedFirst) {
+  // A 90-degree wedge: its crease is the y axis (x = z = 0), which the APSS rounds over about
+  // 0.3 t (|kappa1| t about 3 at 0.13 t from the axis, 2 at 0.27 t, 1 at 0.45 t). With
+  // curvedSeedsFirst the most curved seed starts the first line: on the crease and along it. In
+  // the random order the first line is a random seed's (here 0.5-1 t beside the crease).
+  const PointCloud cloud = wedge(90, 60000);
+  const double t = 0.06;
+  CurvatureLineOptions options = atScale(t);
+  for (const bool curvedFirst : {true, false}) {
+    options.curvedSeedsFirst = curvedFirst;
+    const CurvatureLineSet set = traceCurvatureLines(cloud, options);
+    ASSERT_GE(set.lines.size(), 10u);
+    double farthest = 0, turned = 0;
+    for (const auto& v : set.lines.front().vertices) {
+      farthest = std::max(farthest, std::hypot(v.position.x(), v.position.z()));
+      turned = std::max(turned, angleDegrees(v.tangent, Vec3::UnitY()));
+    }
+    if (curvedFirst) {
+      EXPECT_LT(farthest, 0.25 * t);
+      EXPECT_LT(turned, 20.0);
+      EXPECT_GT(std::abs(set.lines.front().vertices[1].kappa1) * t, 2.5);
+    } else {
+      EXPECT_GT(farthest, 0.25 * t);  // the known answer of the random order, for contrast
+    }
+  }
+}

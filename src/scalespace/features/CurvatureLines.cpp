@@ -213,7 +213,8 @@ class LineTracer {
     fitOptions_.fit = options.fit;
   }
 
-  void trace(const std::vector<Index>& seeds, const std::vector<Vec3>& seedPositions,
+  /// `seedFits`: the fit at each seed position (the seeds' order).
+  void trace(const std::vector<Index>& seeds, const std::vector<LocalFit>& seedFits,
              std::size_t poolSize, const std::function<void(double)>& progress) {
     std::size_t next = 0;
     std::vector<std::size_t> active;  // ways, by increasing id
@@ -222,7 +223,7 @@ class LineTracer {
       const std::size_t want = poolSize > active.size() / 2 ? poolSize - active.size() / 2 : 0;
       if (want > 0 && next < seeds.size()) {
         const std::size_t end = std::min(seeds.size(), next + want);
-        startLines(seeds, seedPositions, next, end, active);
+        startLines(seeds, seedFits, next, end, active);
         next = end;
       }
       if (!active.empty()) step(active);
@@ -248,16 +249,20 @@ class LineTracer {
     return fitPoints(samples_, FitQueries{queries, scales_}, fitOptions_);
   }
 
+ public:
+  /// The fits at the seeds (counted in CurvatureLineSet::fits).
+  std::vector<LocalFit> fitSeeds(const std::vector<Vec3>& seedPositions) {
+    return fit(seedPositions);
+  }
+
+ private:
   /// Starts a line at each projected seed of [first, end) with a minimal direction, inside the
   /// data and away from the lines drawn so far (those started just before it included).
-  void startLines(const std::vector<Index>& seeds, const std::vector<Vec3>& seedPositions,
+  void startLines(const std::vector<Index>& seeds, const std::vector<LocalFit>& seedFits,
                   std::size_t first, std::size_t end, std::vector<std::size_t>& active) {
-    const std::vector<Vec3> queries(seedPositions.begin() + std::ptrdiff_t(first),
-                                    seedPositions.begin() + std::ptrdiff_t(end));
-    const std::vector<LocalFit> fits = fit(queries);
     std::vector<Neighbor> found;
-    for (std::size_t s = 0; s < fits.size(); ++s) {
-      const LocalFit& f = fits[s];
+    for (std::size_t s = 0; s < end - first; ++s) {
+      const LocalFit& f = seedFits[first + s];
       if (!f.valid) {
         ++result_.stops[std::size_t(LineStop::InvalidFit)];
         continue;
@@ -491,7 +496,32 @@ CurvatureLineSet traceCurvatureLines(const PointCloud& cloud, const CurvatureLin
   std::vector<Vec3> seedPositions(seeds.size());
   for (std::size_t s = 0; s < seeds.size(); ++s) seedPositions[s] = cloud.positions()[seeds[s]];
   LineTracer tracer(options, samples, result);
-  tracer.trace(seeds, seedPositions, pool,
+  std::vector<LocalFit> seedFits = tracer.fitSeeds(seedPositions);
+  if (options.curvedSeedsFirst) {
+    // The most curved seeds first (|kappa1| t, decreasing; seeds without a minimal direction
+    // last), in the random order among equals: lines on creases and ridges are traced before
+    // the lines beside them can block their seeds or cut them (docs/THESIS_NOTES.md).
+    std::vector<double> key(seeds.size(), -1);
+    for (std::size_t s = 0; s < seeds.size(); ++s) {
+      const LocalFit& f = seedFits[s];
+      if (!f.valid) continue;
+      const MinimalDirection m = minimalDirection(f);
+      if (!nearUmbilic(m, t, options)) key[s] = std::abs(m.kappa1) * t;
+    }
+    std::vector<std::size_t> order(seeds.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return key[a] > key[b]; });
+    std::vector<Index> sortedSeeds(seeds.size());
+    std::vector<LocalFit> sortedFits(seeds.size());
+    for (std::size_t s = 0; s < order.size(); ++s) {
+      sortedSeeds[s] = seeds[order[s]];
+      sortedFits[s] = std::move(seedFits[order[s]]);
+    }
+    seeds.swap(sortedSeeds);
+    seedFits.swap(sortedFits);
+  }
+  tracer.trace(seeds, seedFits, pool,
                [&](double fraction) { check(fraction, "tracing curvature lines"); });
   check(1, "tracing curvature lines");
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -67,6 +67,10 @@ struct CurvatureLineOptions {
   /// Stop a way within collisionFraction * delta of another line's vertex (lines of one scale
   /// stay apart; a seed next to an existing line makes no line).
   double collisionFraction = 0.5;
+  /// (Not in the thesis) trace the seeds in decreasing |kappa1| t (the random order among
+  /// equals) rather than in the random order: the lines on creases and ridges start first, so the
+  /// lines beside them neither block their seeds nor cut them. false: the random order.
+  bool curvedSeedsFirst = true;
   /// Most steps per way.
   int maxSteps = 2000;
   std::uint64_t seed = 1;
