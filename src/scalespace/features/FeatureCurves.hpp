@@ -41,11 +41,8 @@ struct FeatureCurveOptions {
   /// (Not in the thesis, docs/THESIS_NOTES.md "Salient filter") K of every scale is that of the
   /// finest scale in units of 1 / t: K_s = K_0 t_0 / t_s. The thesis takes K per scale; at the
   /// coarse scales the bands of strong edges widen and smooth curved parts (|kappa1| t = t / R)
-  /// raise K t (fandisk 0.75 -> 1.09 over [e, 3e] for 0.5 K t), so a weaker crease is salient at
-  /// the fine scales only and fails minVotingScales. bench_features, 11 models: clean MCC 0.818
-  /// instead of 0.814, Dice 0.831 instead of 0.821, per-curve recall 0.82 instead of 0.79; noisy
-  /// 0.738 / 0.763 / 0.78 instead of 0.741 / 0.766 / 0.78 (rotor loses 0.04 MCC). false: the
-  /// thesis.
+  /// raise K t, so a weaker crease is salient at the fine scales only and fails minVotingScales
+  /// (figures: bench/README.md, bench_features). false: the thesis.
   bool salientBoundFromFinest = true;
   /// (Not in the thesis) a salient vertex also has |kappa1| t >= minSalientCurvature: curved on
   /// the scale of the support, whatever K is. Sensor noise gives every vertex of a flat face some
