@@ -6,10 +6,11 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale] [--random-seed-order] [--max-turn DEG] [--collision X]
-//                  [--beta X] [--border-offset X] [--curvature-gap X] (CurvatureLineOptions:
-//                  curvedSeedsFirst off, maxTurnDegrees, collisionFraction, beta, borderOffset,
-//                  minCurvatureGap)
+//                  [--bound-per-scale] [--random-seed-order] [--centreline-reach X]
+//                  [--band-half-width X] [--centreline-linearity X]
+//                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
+//                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
+//                  collisionFraction, beta, borderOffset, minCurvatureGap)
 //                  [--per-curve] (per model: each ground-truth curve's share labelled and
 //                  pieces, and how far from the sharp edges the false positives lie; for ours,
 //                  why a missed curve is missed: per scale the line vertices near it, their
@@ -1004,6 +1005,30 @@ void runMethods(const Model& m, const PointCloud& cloud, bool peers, std::vector
   Clock::time_point start = Clock::now();
   const Detection ours = runOurs(cloud);
   add("ours", ours, secondsSince(start));
+  if (printPerCurve && lastOurs) {
+    // How far ours' salient vertices lie from the sharp edges, per scale, in units of e: the APSS
+    // rounds an edge, so its vertices lie inside a convex edge (outside a concave one).
+    const FeatureCurveResult& r = *lastOurs;
+    for (std::size_t sc = 0; sc < r.scales.size(); ++sc) {
+      std::vector<double> d;
+      for (std::size_t k = 0; k < r.salientPositions.size(); ++k) {
+        if (r.salientScales[k] != sc) continue;
+        double best = 1e300;
+        for (const SharpEdge& e : m.edges.sharp)
+          best = std::min(
+              best, segmentDistance(r.salientPositions[k], m.mesh.vertices[e.a] - m.clean.origin(),
+                                    m.mesh.vertices[e.b] - m.clean.origin()));
+        d.push_back(best / m.spacing);
+      }
+      std::sort(d.begin(), d.end());
+      auto q = [&](double f) { return d.empty() ? 0.0 : d[std::size_t(f * (d.size() - 1))]; };
+      std::size_t far = std::count_if(d.begin(), d.end(), [](double x) { return x > 0.5; });
+      std::printf(
+          "#   salient vertices at scale %zu: %zu, distance to the nearest sharp edge / e: "
+          "q25 %.2f q50 %.2f q75 %.2f q90 %.2f, beyond 0.5 e %zu\n",
+          sc, d.size(), q(.25), q(.5), q(.75), q(.9), far);
+    }
+  }
   if (!peers) return;
 
   start = Clock::now();
@@ -1095,6 +1120,12 @@ int main(int argc, char** argv) {
       ourOptions.lines.minCurvatureGap = std::atof(argv[++i]);
     } else if (a == "--join-gap" && hasValue) {
       ourOptions.joinGap = std::atof(argv[++i]);
+    } else if (a == "--centreline-reach" && hasValue) {
+      ourOptions.centrelineReach = std::atof(argv[++i]);
+    } else if (a == "--band-half-width" && hasValue) {
+      ourOptions.bandHalfWidth = std::atof(argv[++i]);
+    } else if (a == "--centreline-linearity" && hasValue) {
+      ourOptions.centrelineLinearity = std::atof(argv[++i]);
     } else if (a == "--bound-per-scale") {
       ourOptions.salientBoundFromFinest = false;
     } else if (a == "--per-curve") {

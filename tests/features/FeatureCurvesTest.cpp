@@ -145,6 +145,48 @@ TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
   EXPECT_EQ(largest.scaleMask, 0x1Fu) << "every scale voted";
 }
 
+// The vote balls of single salient vertices, each a little off the edge (and inside the cube: the
+// APSS rounds it), label a band wider than the vote radius e; trimming the band to the centreline
+// fitted to the vertices of all scales keeps it within e of the edges and the edges labelled.
+TEST(FeatureCurves, TheBandIsTrimmedToTheCentrelineOfTheVotes) {
+  RectangleSampler s;
+  addBox(s, 8000, true);
+  const PointCloud cloud = s.cloud();
+  FeatureCurveOptions untrimmed;
+  untrimmed.centrelineReach = 0;
+  const FeatureCurveResult wide = detectFeatureCurves(cloud, untrimmed);
+  const FeatureCurveResult trimmed = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  const double e = trimmed.spacing;
+  // Labelled points beyond 1.1 e of every edge, and away from the corners (where the vertices of
+  // three edges do not lie along a line and the points keep their labels).
+  auto beyond = [&](const FeatureCurveResult& r) {
+    std::size_t count = 0, labelled = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      if (r.curveId[i] < 0) continue;
+      const Vec3& p = cloud.positions()[i];
+      double nearest = 1e9;
+      for (const Edge& edge : cubeEdges())
+        nearest = std::min(nearest, segmentDistance(p, edge.a, edge.b));
+      const Vec3 corner = p.array().round().matrix();
+      if ((p - corner).norm() < 3 * e) continue;
+      ++labelled;
+      count += nearest > 1.1 * e;
+    }
+    return double(count) / double(std::max<std::size_t>(labelled, 1));
+  };
+  const double wideShare = beyond(wide), trimmedShare = beyond(trimmed);
+  EXPECT_GT(wideShare, 0.02);
+  EXPECT_LT(trimmedShare, 0.25 * wideShare) << wideShare;
+  for (const Edge& edge : cubeEdges())
+    EXPECT_GT(labelsAlong(cloud.positions(), trimmed, edge, 0.7 * e, +1).fraction, 0.95)
+        << edge.a.transpose() << " -> " << edge.b.transpose();
+  // Only points leave the band.
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (trimmed.curveId[i] >= 0) {
+      ASSERT_GE(wide.curveId[i], 0);
+    }
+}
+
 TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
   RectangleSampler s;
   addBoxOnGround(s);
@@ -307,6 +349,9 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   refused([](auto& o) { o.salientPercentile = 2; }, "FeatureCurveOptions::salientPercentile");
   refused([](auto& o) { o.voteThreshold = 1; }, "FeatureCurveOptions::voteThreshold");
   refused([](auto& o) { o.graphNeighbors = 0; }, "FeatureCurveOptions::graphNeighbors");
+  refused([](auto& o) { o.centrelineReach = -1; }, "FeatureCurveOptions::centrelineReach");
+  refused([](auto& o) { o.bandHalfWidth = 0; }, "FeatureCurveOptions::bandHalfWidth");
+  refused([](auto& o) { o.centrelineLinearity = 2; }, "FeatureCurveOptions::centrelineLinearity");
   // One scale cannot give the default 3 voting scales: the message names both fields and values.
   refused([](auto& o) { o.scaleCount = 1; },
           "FeatureCurveOptions::minVotingScales must be in [1, FeatureCurveOptions::scaleCount = "

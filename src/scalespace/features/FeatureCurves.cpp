@@ -4,6 +4,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -103,6 +104,54 @@ std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLine
   return keep;
 }
 
+/// Per eligible target: stays eligible unless it lies farther than `halfWidth` from the centreline
+/// of its curve, a line fitted (weighted PCA) to the salient vertices of its sign within `reach`.
+/// Each vertex lies a little off the crease (across it, and inside the solid: the APSS rounds the
+/// edge), so the union of the vote balls is a band wider than the vote radius; the many vertices of
+/// several scales within `reach` average to the crease. Where they do not lie along a line (largest
+/// eigenvalue under `linearity` of the trace: corners, blobs) the point keeps its label.
+void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>& salient,
+                      const std::vector<std::int8_t>& salientSign, const SpatialIndex& index,
+                      double reach, double halfWidth, double linearity,
+                      std::vector<std::uint8_t>& eligible, std::vector<std::int8_t>& sign) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, targets.size(), 1024), [&](const auto& r) {
+    std::vector<Neighbor> found;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      if (!eligible[i]) continue;
+      index.radiusSearch(targets[i], reach, found);
+      // In vertex order: the same sums for any thread count.
+      std::sort(found.begin(), found.end(),
+                [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
+      double total = 0;
+      Vec3 mean = Vec3::Zero();
+      for (const Neighbor& nb : found) {
+        if (salientSign[nb.index] != sign[i]) continue;
+        const double w = 1 - nb.distSq / (reach * reach);
+        total += w * w;
+        mean += w * w * salient[nb.index];
+      }
+      if (!(total > 0)) continue;
+      mean /= total;
+      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+      for (const Neighbor& nb : found) {
+        if (salientSign[nb.index] != sign[i]) continue;
+        const double w = 1 - nb.distSq / (reach * reach);
+        const Vec3 d = salient[nb.index] - mean;
+        covariance += w * w * d * d.transpose();
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+      const double trace = eigen.eigenvalues().sum();
+      if (!(trace > 0) || eigen.eigenvalues()(2) < linearity * trace) continue;
+      const Vec3 direction = eigen.eigenvectors().col(2);
+      const Vec3 offset = targets[i] - mean;
+      if ((offset - offset.dot(direction) * direction).squaredNorm() > halfWidth * halfWidth) {
+        eligible[i] = 0;
+        sign[i] = 0;
+      }
+    }
+  });
+}
+
 // Curves of the same sign whose points come within `gap` of each other, as groups of curve indices
 // (each group increasing, groups ordered by their first curve).
 std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& positions,
@@ -182,6 +231,13 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
   require(o.minVotingScales >= 1 && o.minVotingScales <= o.scaleCount,
           "FeatureCurveOptions::minVotingScales must be in [1, FeatureCurveOptions::scaleCount = " +
               std::to_string(o.scaleCount) + "], got " + std::to_string(o.minVotingScales));
+  require(std::isfinite(o.centrelineReach) && o.centrelineReach >= 0,
+          "FeatureCurveOptions::centrelineReach must be finite and >= 0 (0 = off)");
+  require(std::isfinite(o.bandHalfWidth) && o.bandHalfWidth > 0,
+          "FeatureCurveOptions::bandHalfWidth must be finite and > 0");
+  require(std::isfinite(o.centrelineLinearity) && o.centrelineLinearity >= 0 &&
+              o.centrelineLinearity <= 1,
+          "FeatureCurveOptions::centrelineLinearity must be in [0, 1]");
   require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
           "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
   require(o.graphNeighbors >= 1 && std::size_t(o.graphNeighbors) <= kMaxNeighborCount,
@@ -349,6 +405,10 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
+  if (options.centrelineReach > 0 && !salient.empty())
+    trimToCentreline(targets, salient, salientSign, *makeSpatialIndex(salient),
+                     options.centrelineReach * e, options.bandHalfWidth * e,
+                     options.centrelineLinearity, eligible, result.convexity);
   std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
     return eligible[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
   });

@@ -10,6 +10,8 @@
 //      with weight (1 - (d/e)^2)^2, signed by kappa1 (convex +, concave -);
 //   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
 //      exceed v = voteThreshold * V_max in magnitude, between points of the same sign;
+//   4b. (not in the thesis) points farther than bandHalfWidth * e from the centreline fitted to the
+//      salient vertices within centrelineReach * e leave the band before the regions grow;
 //   5. (not in the thesis) regions smaller than minCurveExtent * e across are dropped: specks of
 //      one to a few points where a line grazed a corner; then regions of the same sign within
 //      joinGap * e of each other are joined (the gaps where lines stop at corners).
@@ -69,6 +71,18 @@ struct FeatureCurveOptions {
   /// of its noisy clouds instead of 52% (MCC 0.589 instead of 0.269) and the clean ones as well
   /// (MCC 0.748 instead of 0.739).
   int minVotingScales = 3;
+  /// (Not in the thesis) a point stays in a curve only when it lies within bandHalfWidth * e of
+  /// the curve's centreline there: a line fitted to the salient vertices (of the point's sign)
+  /// within centrelineReach * e. The vote balls of single vertices, each a little off the crease,
+  /// make a band wider than the vote radius; the vertices of all scales over 3 e average to the
+  /// crease. The centreline runs on the APSS, inside a convex edge (outside a concave one) by 0.3
+  /// to 0.5 e at these scales, so a point e from the edge lies about 0.8 e from it
+  /// (docs/THESIS_NOTES.md, "Feature band"). 0 turns it off (the thesis).
+  double centrelineReach = 3;
+  double bandHalfWidth = 0.8;
+  /// Where the vertices within reach do not lie along a line (the largest eigenvalue of their
+  /// covariance under this share of its trace: corners) the point is kept.
+  double centrelineLinearity = 0.8;
   /// Curves whose points span less than this times e (bounding-box diagonal) are dropped; 0
   /// keeps every region (the thesis).
   double minCurveExtent = 1;
