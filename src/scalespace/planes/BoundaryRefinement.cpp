@@ -8,6 +8,7 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/PointSetPlane.hpp"
+#include "scalespace/planes/PlaneDescribes.hpp"
 
 namespace scalespace {
 namespace {
@@ -83,9 +84,9 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
     // since the points a region gave away had tilted and shifted its plane.
     tbb::parallel_for(std::size_t(0), regionCount, [&](std::size_t r) {
       planes[r] = fitPlane(positions, regions[r]);
-      tolerance[r] =
-          options.largeRegionTolerance *
-          std::max({planes[r].rms, options.noiseFactor * noiseRms, kMinRelativeTolerance * t});
+      tolerance[r] = planeDescribesBound(
+          planes[r].rms, std::max(options.noiseFactor * noiseRms, kMinRelativeTolerance * t),
+          options.largeRegionTolerance);
     });
     // The points to look at: the labelled points next to a target's point in the first round,
     // then the moved points' neighbours and the moved points themselves.

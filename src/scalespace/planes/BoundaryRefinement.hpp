@@ -13,6 +13,7 @@
 
 #include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/RegionGrower.hpp"
+#include "scalespace/planes/PlaneDescribes.hpp"
 #include "scalespace/planes/RegionMerging.hpp"
 
 namespace scalespace {
@@ -36,9 +37,9 @@ struct BoundaryRefinementOptions {
   /// neighbouring large grown region whose plane lies within largeRegionTolerance times that
   /// region's own RMS (or noiseFactor times the noise) of it: the union's pieces were grown by
   /// normals, so near a crease they hold points of the surface across it (the top of a
-  /// staircase's side under its sawtooth edge), which lie on that surface's plane. 0: unions
-  /// only take.
-  double largeRegionTolerance = 1.25;
+  /// staircase's side under its sawtooth edge), which lie on that surface's plane. The same
+  /// rule as the merging's join (planes/PlaneDescribes.hpp). 0: unions only take.
+  double largeRegionTolerance = kPlaneDescribesTolerance;
 };
 
 /// OptionError naming the field unless every bound is finite and >= 0.

@@ -14,13 +14,10 @@
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/PointSetPlane.hpp"
+#include "scalespace/planes/PlaneDescribes.hpp"
 
 namespace scalespace {
 namespace {
-
-// A union joins a large region when its RMS to that region's plane is at most this many times the
-// region's own RMS (or the noise floor).
-constexpr double kJoinTolerance = 1.25;
 
 // First and second moments of a point set: enough for the least-squares plane of any union.
 struct Moments {
@@ -228,9 +225,9 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   // region growing makes one large region of the lower steps, a sawtooth around the mean ramp,
   // and the merging a union of the upper ones. Within the same bounds, against the large region's
   // own plane (its points would make any union's RMS small), and only when the union's RMS to
-  // that plane is within the large region's own RMS (or the noise floor) and kJoinTolerance:
-  // the exact face of a box does not take a union of the bent normals along its edge, which
-  // carries points of the next face.
+  // that plane is within the large region's own RMS (or the noise floor) and
+  // kPlaneDescribesTolerance: the exact face of a box does not take a union of the bent normals
+  // along its edge, which carries points of the next face.
   std::vector<int> keptOf(regionCount, -1);
   for (std::size_t k = 0; k < kept.size(); ++k)
     for (const Index m : kept[k].second) keptOf[m] = int(k);
@@ -257,7 +254,7 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
       const double offset = plane.normal.dot(mean - plane.centroid);
       const double rms =
           std::sqrt(std::max(0.0, plane.normal.dot(covariance * plane.normal) + offset * offset));
-      const double describes = kJoinTolerance * std::max(plane.rms, 2 * noiseRms);
+      const double describes = planeDescribesBound(plane.rms, 2 * noiseRms);
       bool within = rms <= maxRms && rms <= describes && rms < best;
       for (const Box& box : boxes[survivor])
         for (const Vec3& corner : box)
