@@ -1130,6 +1130,7 @@ int main(int argc, char** argv) {
       ourOptions.salientBoundFromFinest = false;
     } else if (a == "--per-curve") {
       printPerCurve = true;
+      ourOptions.keepVotingDetail = true;
     } else if (a == "--no-peers") {
       peers = false;
     } else {

@@ -100,13 +100,15 @@ def render(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
 def lines(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scale: Optional[float] = ...,
           scales: Optional[int] = ..., tmin: float = ..., tmax: float = ..., beta: float = ...,
           gamma: float = ..., alpha: float = ..., robust: bool = ..., max_steps: int = ...,
-          threads: Optional[int] = ..., progress: Progress = ...) -> Dict[str, np.ndarray]: ...
+          curved_seeds_first: bool = ..., threads: Optional[int] = ..., progress: Progress = ...) -> Dict[str, np.ndarray]: ...
 def read_mesh(path: str) -> Tuple[np.ndarray, np.ndarray]: ...
 def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
              spacing: float = ..., vote_threshold: float = ..., min_scales: int = ...,
              min_curvature: float = ..., noise_curvature: float = ...,
              salient_threshold: float = ..., min_extent: float = ..., join_gap: float = ...,
-             all_salient: bool = ..., beta: float = ..., gamma: float = ...,
+             centreline_reach: float = ..., band_half_width: float = ...,
+             all_salient: bool = ..., salient_per_scale: bool = ..., beta: float = ..., gamma: float = ...,
+             curved_seeds_first: bool = ...,
              with_lines: bool = ..., triangles: Optional[ArrayLike] = ...,
              mesh_samples: int = ..., threads: Optional[int] = ...,
              progress: Progress = ...) -> Dict[str, object]: ...

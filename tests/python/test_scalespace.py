@@ -201,6 +201,23 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
     carried = [s["salient_bound"] * s["scale"] for s in features["scales"]]
     np.testing.assert_allclose(carried, carried[0], rtol=1e-12)  # K t of the finest scale
     assert not np.allclose(bounds, features["scales"][0]["salient_bound"])
+    cli("features", data / "house.ply", "-o", tmp_path / "w.ply", "--centreline-reach", 0)
+    wide = ss.features(cloud.points, cloud.normals, centreline_reach=0)
+    written = ss.read(str(tmp_path / "w.ply")).attributes["curve_id"]
+    np.testing.assert_array_equal(wide["curve_id"].astype(written.dtype), written)
+    # The trimmed band only loses points.
+    assert np.all(wide["curve_id"][features["curve_id"] >= 0] >= 0)
+    assert (wide["curve_id"] >= 0).sum() > (features["curve_id"] >= 0).sum()
+    # The seeds' order: the random one of Sec. 3.3 through both, and it changes the lines.
+    cli("lines", data / "house.ply", "-o", tmp_path / "r.ply", "--scale", 0.6,
+        "--random-seed-order")
+    random = ss.lines(cloud.points, cloud.normals, scale=0.6, curved_seeds_first=False)
+    written = ss.read(str(tmp_path / "r.ply"))
+    np.testing.assert_allclose(random["vertices"], written.points, rtol=0, atol=1e-9)
+    assert random["vertices"].shape != lines["vertices"].shape or not np.array_equal(
+        random["vertices"], lines["vertices"])
+    summary = json.loads((tmp_path / "r.json").read_text())
+    assert summary["parameters"]["curved_seeds_first"] is False
 
 
 @pytest.fixture(scope="module")

@@ -65,6 +65,13 @@ nlohmann::json stopCounts(const CurvatureLineSet& set) {
   return stops;
 }
 
+// The seeds' order (CurvatureLineOptions::curvedSeedsFirst), one flag for lines and features.
+void addSeedOrderFlag(CLI::App& cmd, CurvatureLineOptions& lines) {
+  cmd.add_flag("--random-seed-order{false}", lines.curvedSeedsFirst,
+               "trace the seeds in the sampler's random order (Sec. 3.3) instead of the most "
+               "curved first");
+}
+
 // ------------------------------------------------------------------------------------- lines
 void addLinesCommand(CLI::App& app) {
   struct Args {
@@ -100,6 +107,7 @@ void addLinesCommand(CLI::App& app) {
   cmd->add_option("--max-steps", args->lines.maxSteps, "most steps each way")
       ->capture_default_str();
   cmd->add_flag("--robust", args->robust, "robust re-weighting (RIMLS) in the fits");
+  addSeedOrderFlag(*cmd, args->lines);
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
@@ -185,6 +193,7 @@ void addLinesCommand(CLI::App& app) {
                                    {"alpha", options.alpha},
                                    {"robust", options.fit.robust},
                                    {"max_steps", options.maxSteps},
+                                   {"curved_seeds_first", options.curvedSeedsFirst},
                                    {"threads", args->threads}}},
                                  {"scales", perScale},
                                  {"seconds", total}};
@@ -250,9 +259,17 @@ void addFeaturesCommand(CLI::App& app) {
                   "curves of one sign within this x e of each other are one curve (0 keeps the "
                   "pieces)")
       ->capture_default_str();
+  cmd->add_option("--centreline-reach", args->features.centrelineReach,
+                  "keep a curve's points near the centreline fitted to the salient vertices within "
+                  "this x e (0 = the thesis' band: every point the votes reach)")
+      ->capture_default_str();
+  cmd->add_option("--band-half-width", args->features.bandHalfWidth,
+                  "the points kept lie within this x e of the centreline")
+      ->capture_default_str();
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e (0 keeps all)")
       ->capture_default_str();
+  addSeedOrderFlag(*cmd, args->features.lines);
   cmd->add_option("--mesh-samples", args->samplesPerVertex,
                   "mesh inputs: sample this many points per vertex by area (Sec. 3.4.1: 100)")
       ->capture_default_str();
@@ -362,6 +379,10 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"ridge_only", options.ridgeOnly},
                                    {"min_curve_extent", options.minCurveExtent},
                                    {"join_gap", options.joinGap},
+                                   {"centreline_reach", options.centrelineReach},
+                                   {"band_half_width", options.bandHalfWidth},
+                                   {"centreline_linearity", options.centrelineLinearity},
+                                   {"curved_seeds_first", options.lines.curvedSeedsFirst},
                                    {"threads", args->threads}}},
                                  {"scales", scales},
                                  {"curves", curves},

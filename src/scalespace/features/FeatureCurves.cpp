@@ -463,10 +463,12 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     for (const Index p : curve.points) curve.scaleMask |= voters[p];
     curve.length = bandLength(targets, curve.points, 2 * e);
   });
-  result.voterScales = std::move(voters);
-  result.salientPositions = std::move(salient);
-  result.salientScales = std::move(salientScale);
-  result.salientSigns = std::move(salientSign);
+  if (options.keepVotingDetail) {
+    result.voterScales = std::move(voters);
+    result.salientPositions = std::move(salient);
+    result.salientScales = std::move(salientScale);
+    result.salientSigns = std::move(salientSign);
+  }
   if (progress && !progress(1, "feature curves")) throw Cancelled();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

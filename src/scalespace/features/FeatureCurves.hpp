@@ -75,11 +75,12 @@ struct FeatureCurveOptions {
   /// the curve's centreline there: a line fitted to the salient vertices (of the point's sign)
   /// within centrelineReach * e. The vote balls of single vertices, each a little off the crease,
   /// make a band wider than the vote radius; the vertices of all scales over 3 e average to the
-  /// crease. The centreline runs on the APSS, inside a convex edge (outside a concave one) by 0.3
-  /// to 0.5 e at these scales, so a point e from the edge lies about 0.8 e from it
-  /// (docs/THESIS_NOTES.md, "Feature band"). 0 turns it off (the thesis).
+  /// crease. The centreline runs on the APSS, inside a convex edge (outside a concave one) by 0.2
+  /// to 0.4 e at these scales, so a point e from the edge lies about 0.8-0.9 e from it; 0.9 keeps
+  /// more of short edges that lie next to others (docs/THESIS_NOTES.md, "Feature band"). 0 turns
+  /// it off (the thesis).
   double centrelineReach = 3;
-  double bandHalfWidth = 0.8;
+  double bandHalfWidth = 0.9;
   /// Where the vertices within reach do not lie along a line (the largest eigenvalue of their
   /// covariance under this share of its trace: corners) the point is kept.
   double centrelineLinearity = 0.8;
@@ -93,6 +94,10 @@ struct FeatureCurveOptions {
   double joinGap = 1.5;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
+  /// Also return the salient vertices and, per target point, the scales that voted for it
+  /// (FeatureCurveResult::voterScales, salient*): for diagnosing a missed curve. Off, they are
+  /// freed with the rest of the work; they grow with the points.
+  bool keepVotingDetail = false;
 };
 
 struct FeatureCurve {
@@ -116,9 +121,10 @@ struct FeatureCurveResult {
   double salientCurvatureFloor = 0;
   std::vector<FeatureCurveScale> scales;
   std::vector<double> votes;  // per target point
-  /// Per target point: bit s set when a salient vertex of scale s voted for it.
+  /// Only with FeatureCurveOptions::keepVotingDetail (else empty): per target point, bit s set
+  /// when a salient vertex of scale s voted for it; the salient vertices that voted: position (the
+  /// cloud's frame), scale index, sign of kappa1.
   std::vector<std::uint32_t> voterScales;
-  /// The salient vertices that voted: position (the cloud's frame), scale index, sign of kappa1.
   std::vector<Vec3> salientPositions;
   std::vector<std::uint8_t> salientScales;
   std::vector<std::int8_t> salientSigns;

@@ -64,8 +64,8 @@ py::dict linesToDict(const std::vector<CurvatureLineSet>& sets, const Vec3& orig
 
 py::dict linesPy(const py::handle& points, const py::handle& normals, std::optional<double> scale,
                  std::optional<int> scales, double tmin, double tmax, double beta, double gamma,
-                 double alpha, bool robust, int maxSteps, std::optional<int> threads,
-                 py::object progress) {
+                 double alpha, bool robust, int maxSteps, bool curvedSeedsFirst,
+                 std::optional<int> threads, py::object progress) {
   if (scale.value_or(0) <= 0 && scales.value_or(0) <= 0)
     throw OptionError("give the scale: scale=T, or scales=M for M scales");
   if (scale && scales) throw OptionError("give scale or scales, not both");
@@ -75,6 +75,7 @@ py::dict linesPy(const py::handle& points, const py::handle& normals, std::optio
   options.gamma = gamma;
   options.alpha = alpha;
   options.maxSteps = maxSteps;
+  options.curvedSeedsFirst = curvedSeedsFirst;
   options.fit.robust = robust;
   options.scale = scale.value_or(1);
   validateCurvatureLineOptions(options);
@@ -128,9 +129,10 @@ TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
 
 py::dict featuresPy(const py::handle& points, const py::handle& normals, int scales, double spacing,
                     double voteThreshold, int minScales, double minCurvature, double noiseCurvature,
-                    double salientThreshold, double minExtent, double joinGap, bool allSalient,
-                    bool salientPerScale, double beta, double gamma, bool withLines,
-                    const py::handle& triangles, std::size_t meshSamples,
+                    double salientThreshold, double minExtent, double joinGap,
+                    double centrelineReach, double bandHalfWidth, bool allSalient,
+                    bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
+                    bool withLines, const py::handle& triangles, std::size_t meshSamples,
                     std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
@@ -142,10 +144,13 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   options.salientThreshold = salientThreshold;
   options.minCurveExtent = minExtent;
   options.joinGap = joinGap;
+  options.centrelineReach = centrelineReach;
+  options.bandHalfWidth = bandHalfWidth;
   options.ridgeOnly = !allSalient;
   options.salientBoundFromFinest = !salientPerScale;
   options.lines.beta = beta;
   options.lines.gamma = gamma;
+  options.lines.curvedSeedsFirst = curvedSeedsFirst;
   validateFeatureCurveOptions(options);
   if (meshSamples < 1 || meshSamples > 10000)
     throw OptionError("mesh_samples must be in [1, 10000]");
@@ -221,19 +226,21 @@ void bindFeatures(py::module_& m) {
   m.def("lines", &linesPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scales"_a = py::none(), "tmin"_a = 0.0, "tmax"_a = 0.0,
         "beta"_a = 0.5, "gamma"_a = 0.5, "alpha"_a = 0.1, "robust"_a = false, "max_steps"_a = 2000,
-        "threads"_a = py::none(), "progress"_a = py::none(),
+        "curved_seeds_first"_a = true, "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Minimal-curvature lines on the APSS (Sec. 3.3), as `scalespace lines`.
 
 Give scale=T, or scales=M (log-spaced from tmin, default the mean 16-NN distance, to tmax,
 default a tenth of the diagonal). beta: seeds' Poisson-disk radius / t; gamma: step / t;
-alpha: pyramid radius / t. Returns a dict: vertices (V, 3) absolute, normal, tangent (V, 3),
+alpha: pyramid radius / t. curved_seeds_first=False traces the seeds in the sampler's random
+order (Sec. 3.3) instead of the most curved first. Returns a dict: vertices (V, 3) absolute, normal, tangent (V, 3),
 line_id, scale, k1, k2, k_gap, nu (V,), offsets (L + 1,: line l is
 vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it started from).)doc");
   m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3,
         "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0, "salient_threshold"_a = 0.5,
-        "min_extent"_a = 1.0, "join_gap"_a = 1.5, "all_salient"_a = false,
-        "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5, "with_lines"_a = false,
+        "min_extent"_a = 1.0, "join_gap"_a = 1.5, "centreline_reach"_a = 3.0,
+        "band_half_width"_a = 0.9, "all_salient"_a = false, "salient_per_scale"_a = false,
+        "beta"_a = 0.5, "gamma"_a = 0.5, "curved_seeds_first"_a = true, "with_lines"_a = false,
         "triangles"_a = py::none(), "mesh_samples"_a = 100, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
@@ -244,7 +251,10 @@ noise_curvature * sigma / e): the |k1| t a salient vertex needs), curves (per cu
 scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
 traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
 scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
-join_gap=0, salient_per_scale=True restore the thesis' rules. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
+join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False restore the
+thesis' rules. centreline_reach,
+band_half_width: a curve keeps the points within band_half_width x e of the centreline fitted to
+the salient vertices within centreline_reach x e. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
 mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
   m.def(
       "read_mesh",
