@@ -5,6 +5,8 @@
 //
 //   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--scan full|one-sided]
 //                   [--scales M (ours: 8)] [--tmin T (ours: automatic)] [--seed S]
+//                   [--curved-seeds-first] (ours: CurvatureLineOptions::curvedSeedsFirst on,
+//                   the features' seed order; the cylinders' default is the random order)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -261,10 +263,13 @@ int main(int argc, char** argv) {
       ours.scaleCount = std::stoi(argv[++i]);
     else if (a == "--tmin" && i + 1 < argc)
       ours.tMin = std::stod(argv[++i]);
+    else if (a == "--curved-seeds-first")
+      ours.lines.curvedSeedsFirst = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
-                   "[--scan full|one-sided] [--scales M] [--seed S]\n");
+                   "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
+                   "[--curved-seeds-first]\n");
       return 2;
     }
   }

@@ -6,7 +6,7 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale] [--random-seed-order] [--centreline-reach X]
+//                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
 //                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
@@ -1126,6 +1126,8 @@ int main(int argc, char** argv) {
       ourOptions.bandHalfWidth = std::atof(argv[++i]);
     } else if (a == "--centreline-linearity" && hasValue) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
+    } else if (a == "--robust-fit") {
+      ourOptions.lines.fit.robust = true;
     } else if (a == "--bound-per-scale") {
       ourOptions.salientBoundFromFinest = false;
     } else if (a == "--per-curve") {

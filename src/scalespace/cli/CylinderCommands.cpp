@@ -235,6 +235,7 @@ void addCylindersCommand(CLI::App& app) {
           {"max_mean_variation", o.filter.maxMeanVariation},
           {"min_arc_degrees", o.tube.minArcDegrees},
           {"max_relative_rms", o.tube.maxRelativeRms},
+          {"curved_seeds_first", o.lines.curvedSeedsFirst},
           {"threads", args->threads}}},
         {"levels", levels},
         {"components", componentsJson(detection, cloud.origin())},
