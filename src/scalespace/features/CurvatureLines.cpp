@@ -213,6 +213,12 @@ class LineTracer {
     fitOptions_.fit = options.fit;
   }
 
+  /// The fits at the seeds (counted in CurvatureLineSet::fits): all of them before tracing, so
+  /// that the seeds can be ordered by their curvature (CurvatureLineOptions::curvedSeedsFirst).
+  std::vector<LocalFit> fitSeeds(const std::vector<Vec3>& seedPositions) {
+    return fit(seedPositions);
+  }
+
   /// `seedFits`: the fit at each seed position (the seeds' order).
   void trace(const std::vector<Index>& seeds, const std::vector<LocalFit>& seedFits,
              std::size_t poolSize, const std::function<void(double)>& progress) {
@@ -249,13 +255,6 @@ class LineTracer {
     return fitPoints(samples_, FitQueries{queries, scales_}, fitOptions_);
   }
 
- public:
-  /// The fits at the seeds (counted in CurvatureLineSet::fits).
-  std::vector<LocalFit> fitSeeds(const std::vector<Vec3>& seedPositions) {
-    return fit(seedPositions);
-  }
-
- private:
   /// Starts a line at each projected seed of [first, end) with a minimal direction, inside the
   /// data and away from the lines drawn so far (those started just before it included).
   void startLines(const std::vector<Index>& seeds, const std::vector<LocalFit>& seedFits,
