@@ -6,7 +6,8 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--centreline-reach X]
+//                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--mesh-normals]
+//                  (the clean clouds keep the mesh's interpolated normals) [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
 //                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
@@ -397,6 +398,7 @@ PointCloud noisyCopy(const PointCloud& clean, double sigma) {
 }
 
 bool printPerCurve = false;  // --per-curve
+bool meshNormals = false;    // --mesh-normals
 FeatureCurveOptions ourOptions;
 // --per-curve: ours' last result, for the reasons a curve is missed.
 std::unique_ptr<FeatureCurveResult> lastOurs;
@@ -419,8 +421,23 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.name = std::move(name);
   m.mesh = std::move(mesh);
   m.clean = sampleMesh(m.mesh, points, kSampleSeed);
-  m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
-  estimateOrientedNormals(m.clean);
+  if (printPerCurve || !meshNormals) {
+    const std::vector<Vec3> truth = m.clean.normals();
+    m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
+    estimateOrientedNormals(m.clean);
+    if (printPerCurve) {
+      // Where the estimated orientation disagrees with the mesh's (outward where the mesh is
+      // closed and consistently oriented; on an open mesh either side): a thin part whose two
+      // sides are within the 10 neighbours of the estimate flips in patches.
+      std::size_t flipped = 0;
+      for (std::size_t i = 0; i < truth.size(); ++i)
+        flipped += truth[i].dot(m.clean.normals()[i]) < 0;
+      const double share = double(flipped) / double(std::max<std::size_t>(1, truth.size()));
+      std::printf("# %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
+                  m.name.c_str(), 100 * std::min(share, 1 - share));
+    }
+    if (meshNormals) m.clean.setNormals(truth);
+  }
   m.diagonal = m.clean.boundingBoxDiagonal();
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
   m.edges = findSharpEdges(m.mesh, angle);
@@ -1126,6 +1143,8 @@ int main(int argc, char** argv) {
       ourOptions.bandHalfWidth = std::atof(argv[++i]);
     } else if (a == "--centreline-linearity" && hasValue) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
+    } else if (a == "--mesh-normals") {
+      meshNormals = true;
     } else if (a == "--robust-fit") {
       ourOptions.lines.fit.robust = true;
     } else if (a == "--bound-per-scale") {

@@ -21,7 +21,7 @@ constexpr Index kNone = std::numeric_limits<Index>::max();
 bool usable(const Vec3& n) { return n.allFinite() && n.squaredNorm() > 0.0; }
 
 struct Edge {
-  float cost;  // 1 - |n_a . n_b| [Hoppe 1992]
+  float cost;  // 1 - |n_a . n_b| [Hoppe 1992] + the across-sheet term (edgeCost)
   Index a, b;  // a < b; a == kNone marks an empty slot
   bool operator<(const Edge& o) const {
     if (cost != o.cost) return cost < o.cost;
@@ -30,6 +30,22 @@ struct Edge {
   }
   bool operator==(const Edge& o) const { return a == o.a && b == o.b; }
 };
+
+/// Hoppe's 1 - |cos(n_a, n_b)|, plus acrossWeight |cos(n_a, d)| |cos(n_b, d)|, d = p_b - p_a: two
+/// parallel sheets facing each other (the two sides of a thin part) have parallel normals, so
+/// Hoppe's cost is 0 across them, and the propagation, which keeps n_b . n_a > 0, orients both
+/// sides alike where one must face the other way. Their offset runs along both normals; between
+/// neighbours of one sheet it lies in the tangent planes (the term is about 0), and across a crease
+/// along at most one of the two normals.
+double edgeCost(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb,
+                double acrossWeight) {
+  const double scale = na.norm() * nb.norm();
+  const double c = std::min(1.0, std::abs(na.dot(nb)) / scale);
+  const Vec3 d = pb - pa;
+  const double d2 = d.squaredNorm();
+  if (!(acrossWeight > 0) || !(d2 > 0)) return 1.0 - c;
+  return 1.0 - c + acrossWeight * std::abs(na.dot(d)) * std::abs(nb.dot(d)) / (d2 * scale);
+}
 
 void checkCancel(const ProgressCallback& progress, double fraction, const char* stage) {
   if (progress && !progress(fraction, stage)) throw Cancelled();
@@ -115,11 +131,11 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
                               break;
                             }
                             if (slot == k) break;
-                            const double c = std::abs(oriented[i].dot(oriented[j])) /
-                                             (oriented[i].norm() * oriented[j].norm());
-                            edges[i * k + slot++] = Edge{float(1.0 - std::min(1.0, c)),
-                                                         Index(std::min<std::size_t>(i, j)),
-                                                         Index(std::max<std::size_t>(i, j))};
+                            const double cost = edgeCost(points[i], oriented[i], points[j],
+                                                         oriented[j], options.acrossWeight);
+                            edges[i * k + slot++] =
+                                Edge{float(cost), Index(std::min<std::size_t>(i, j)),
+                                     Index(std::max<std::size_t>(i, j))};
                           }
                         }
                         tracker.advance(range.size());
@@ -128,7 +144,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   }
   // Empty slots sort last with a cost above any real one.
   tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t e) {
-    if (edges[e].a == kNone) edges[e].cost = 2.0f;
+    if (edges[e].a == kNone) edges[e].cost = std::numeric_limits<float>::infinity();
   });
   checkCancel(progress, 0.0, "orientation sort");
   tbb::parallel_sort(edges.begin(), edges.end());
@@ -247,6 +263,10 @@ NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vect
     throw OptionError("NormalOrientationOptions::k must be in [1, " +
                       std::to_string(kMaxNeighborCount) + "] (default 10), got " +
                       std::to_string(options.k));
+  if (!std::isfinite(options.acrossWeight) || options.acrossWeight < 0)
+    throw OptionError(
+        "NormalOrientationOptions::acrossWeight must be finite and >= 0 (0: Hoppe's "
+        "cost alone)");
   if (index.size() != points.size())
     throw OptionError("orientNormals: the index holds " + std::to_string(index.size()) +
                       " points but " + std::to_string(points.size()) + " were given");
