@@ -29,8 +29,8 @@ def read(path: str, *, drop_invalid: bool = ..., sample: int = ..., seed: int = 
 def write(path: str, points: Union[Cloud, ArrayLike], normals: Optional[ArrayLike] = ...,
           attributes: Optional[Mapping[str, ArrayLike]] = ..., *, ascii: bool = ...) -> None: ...
 def estimate_normals(points: ArrayLike, *, k: int = ..., orient: str = ...,
-                     viewpoint: Optional[Sequence[float]] = ..., threads: Optional[int] = ...,
-                     progress: Progress = ...) -> Tuple[np.ndarray, np.ndarray]: ...
+                     viewpoint: Optional[Sequence[float]] = ..., across_weight: float = ...,
+                     threads: Optional[int] = ..., progress: Progress = ...) -> Tuple[np.ndarray, np.ndarray]: ...
 def curvature(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               scale: Optional[float] = ..., scale_k: Optional[int] = ..., estimator: str = ...,
               mls: bool = ..., robust: bool = ..., k: int = ..., summary: bool = ...,

@@ -113,6 +113,20 @@ def test_curvature_without_normals_equals_the_cli(data, tmp_path):
         np.testing.assert_array_equal(got[name].astype(expected[name].dtype), expected[name], name)
 
 
+def test_estimate_normals_equals_the_cli(data, tmp_path):
+    points = ss.read(str(data / "house.ply")).points
+    ss.write(str(tmp_path / "bare.ply"), points)
+    for weight in (1, 0):  # the default, and Hoppe's cost alone
+        cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight)
+        expected = columns(tmp_path / "n.ply")
+        normals, reliable = ss.estimate_normals(points, across_weight=weight)
+        for c, name in enumerate(("nx", "ny", "nz")):
+            np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
+        np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)
+    with pytest.raises(ValueError, match="acrossWeight"):
+        ss.estimate_normals(points, across_weight=-1)
+
+
 def test_planes_and_segments_equal_the_cli(data, tmp_path):
     cli("planes", data / "house.ply", "-o", tmp_path / "planes", "--scales", 10)
     cli("segment", tmp_path / "planes", "--min-persistence", 2, "-o", tmp_path / "p.ply")

@@ -173,6 +173,7 @@ void addGenerateCommand(CLI::App& app) {
 struct NormalArgs {
   std::size_t k = 10;
   std::vector<std::string> orient{"mst"};
+  double acrossWeight = NormalOrientationOptions{}.acrossWeight;
 };
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
@@ -182,6 +183,10 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                  "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z) or "
                  "'viewpoint X Y Z' (towards a scanner position, in file coordinates)")
       ->expected(1, 4);
+  cmd.add_option("--across-weight", a.acrossWeight,
+                 "mst: extra cost of a graph edge across a thin part (offset along both normals), "
+                 "so that its two sides are oriented apart; 0 = Hoppe's cost alone")
+      ->capture_default_str();
 }
 
 NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointCloud& cloud) {
@@ -192,6 +197,7 @@ NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointClou
   }
   NormalOrientationOptions o;
   o.k = a.k;
+  o.acrossWeight = a.acrossWeight;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {
     o.method = OrientationMethod::MinimumSpanningTree;
   } else if (a.orient.size() == 4 && a.orient[0] == "viewpoint") {

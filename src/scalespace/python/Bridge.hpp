@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/python/InputPool.hpp"
@@ -139,10 +140,10 @@ class Call {
 /// Estimates (PCA over k neighbours) and orients normals in place, as `scalespace normals` and
 /// the commands that need normals do: orient "mst" or "viewpoint" (then `viewpoint`, absolute
 /// coordinates, is required). Returns the per-point reliability of the orientation. Needs no GIL.
-std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k = 10,
-                                            const std::string& orient = "mst",
-                                            const std::optional<Vec3>& viewpoint = std::nullopt,
-                                            const ProgressCallback& progress = {});
+std::vector<std::uint8_t> estimateAndOrient(
+    PointCloud& cloud, std::size_t k = 10, const std::string& orient = "mst",
+    const std::optional<Vec3>& viewpoint = std::nullopt, const ProgressCallback& progress = {},
+    double acrossWeight = NormalOrientationOptions{}.acrossWeight);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);
