@@ -421,23 +421,21 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.name = std::move(name);
   m.mesh = std::move(mesh);
   m.clean = sampleMesh(m.mesh, points, kSampleSeed);
-  if (printPerCurve || !meshNormals) {
-    const std::vector<Vec3> truth = m.clean.normals();
-    m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
-    estimateOrientedNormals(m.clean);
-    if (printPerCurve) {
-      // Where the estimated orientation disagrees with the mesh's (outward where the mesh is
-      // closed and consistently oriented; on an open mesh either side): a thin part whose two
-      // sides are within the 10 neighbours of the estimate flips in patches.
-      std::size_t flipped = 0;
-      for (std::size_t i = 0; i < truth.size(); ++i)
-        flipped += truth[i].dot(m.clean.normals()[i]) < 0;
-      const double share = double(flipped) / double(std::max<std::size_t>(1, truth.size()));
-      std::printf("# %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
-                  m.name.c_str(), 100 * std::min(share, 1 - share));
-    }
-    if (meshNormals) m.clean.setNormals(truth);
+  const std::vector<Vec3> truth = m.clean.normals();
+  m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
+  estimateOrientedNormals(m.clean);
+  if (printPerCurve) {
+    // Where the estimated orientation disagrees with the mesh's (outward where the mesh is
+    // closed and consistently oriented; on an open mesh either side): a thin part whose two
+    // sides are within the 10 neighbours of the estimate flips in patches.
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i)
+      flipped += truth[i].dot(m.clean.normals()[i]) < 0;
+    const double share = double(flipped) / double(std::max<std::size_t>(1, truth.size()));
+    std::printf("# %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
+                m.name.c_str(), 100 * std::min(share, 1 - share));
   }
+  if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
   m.diagonal = m.clean.boundingBoxDiagonal();
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
   m.edges = findSharpEdges(m.mesh, angle);

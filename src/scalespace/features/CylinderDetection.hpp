@@ -32,13 +32,6 @@ struct TubeCoverageOptions {
   double rmsFactor = 3, radiusFraction = 0.05, maxAngleDegrees = 30;
 };
 
-/// CurvatureLineOptions with the seeds traced in the sampler's random order.
-inline CurvatureLineOptions randomSeedOrder() {
-  CurvatureLineOptions options;
-  options.curvedSeedsFirst = false;
-  return options;
-}
-
 struct CylinderOptions {
   /// The scales, increasing. Empty: scaleCount log-spaced scales in [tMin, tMax].
   std::vector<double> scales;
@@ -50,7 +43,11 @@ struct CylinderOptions {
   /// |kappa1| t is about t / r everywhere, so the most curved seeds are the noise's peaks, and the
   /// lines started there first broke the strands of a noisy cable (bench/README.md,
   /// bench_cylinders).
-  CurvatureLineOptions lines = randomSeedOrder();
+  CurvatureLineOptions lines = [] {
+    CurvatureLineOptions options;
+    options.curvedSeedsFirst = false;
+    return options;
+  }();
   LineFilterOptions filter;
   double epsilon = 0.1;        // Eq. 3.10
   double minAnisotropy = 0.5;  // sigma of a region's points

@@ -226,21 +226,24 @@ void bindFeatures(py::module_& m) {
   m.def("lines", &linesPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scales"_a = py::none(), "tmin"_a = 0.0, "tmax"_a = 0.0,
         "beta"_a = 0.5, "gamma"_a = 0.5, "alpha"_a = 0.1, "robust"_a = false, "max_steps"_a = 2000,
-        "curved_seeds_first"_a = true, "threads"_a = py::none(), "progress"_a = py::none(),
+        "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Minimal-curvature lines on the APSS (Sec. 3.3), as `scalespace lines`.
 
 Give scale=T, or scales=M (log-spaced from tmin, default the mean 16-NN distance, to tmax,
 default a tenth of the diagonal). beta: seeds' Poisson-disk radius / t; gamma: step / t;
 alpha: pyramid radius / t. curved_seeds_first=False traces the seeds in the sampler's random
-order (Sec. 3.3) instead of the most curved first. Returns a dict: vertices (V, 3) absolute, normal, tangent (V, 3),
-line_id, scale, k1, k2, k_gap, nu (V,), offsets (L + 1,: line l is
+order (Sec. 3.3) instead of the most curved first. Returns a dict: vertices (V, 3) absolute,
+normal, tangent (V, 3), line_id, scale, k1, k2, k_gap, nu (V,), offsets (L + 1,: line l is
 vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it started from).)doc");
   m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3,
         "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0, "salient_threshold"_a = 0.5,
-        "min_extent"_a = 1.0, "join_gap"_a = 1.5, "centreline_reach"_a = 3.0,
-        "band_half_width"_a = 0.9, "all_salient"_a = false, "salient_per_scale"_a = false,
-        "beta"_a = 0.5, "gamma"_a = 0.5, "curved_seeds_first"_a = true, "with_lines"_a = false,
+        "min_extent"_a = 1.0, "join_gap"_a = 1.5,
+        "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
+        "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth, "all_salient"_a = false,
+        "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
+        "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
         "triangles"_a = py::none(), "mesh_samples"_a = 100, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
@@ -252,10 +255,9 @@ scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_l
 traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
 scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
 join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False restore the
-thesis' rules. centreline_reach,
-band_half_width: a curve keeps the points within band_half_width x e of the centreline fitted to
-the salient vertices within centreline_reach x e. triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with
-mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
+thesis' rules. centreline_reach, band_half_width: a curve keeps the points within
+band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e.
+triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
