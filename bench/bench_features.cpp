@@ -6,8 +6,10 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
-//                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--mesh-normals]
-//                  (the clean clouds keep the mesh's interpolated normals) [--centreline-reach X]
+//                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
+//                  (NormalOrientationOptions::acrossWeight of the estimated normals)
+//                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
+//                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
 //                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
@@ -378,11 +380,15 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 // ---------------------------------------------------------------------------------------------
 // Clouds.
 
+double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
+
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
 void estimateOrientedNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index);
-  orientNormals(cloud.positions(), est.normals, *index, {}, est.valid);
+  NormalOrientationOptions orientation;
+  orientation.acrossWeight = acrossWeight;
+  orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid);
   cloud.setNormals(std::move(est.normals));
 }
 
@@ -1141,6 +1147,8 @@ int main(int argc, char** argv) {
       ourOptions.bandHalfWidth = std::atof(argv[++i]);
     } else if (a == "--centreline-linearity" && hasValue) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
+    } else if (a == "--across-weight" && hasValue) {
+      acrossWeight = std::atof(argv[++i]);
     } else if (a == "--mesh-normals") {
       meshNormals = true;
     } else if (a == "--robust-fit") {

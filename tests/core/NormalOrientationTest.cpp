@@ -86,7 +86,10 @@ TEST(NormalOrientation, MstOrientsBothSidesOfAThinSlabOutward) {
   NormalOrientationOptions hoppe;
   hoppe.acrossWeight = 0;
   EXPECT_LT(outward(hoppe), 0.6);
-  EXPECT_GT(outward({}), 0.99);
+  NormalOrientationOptions across;
+  across.acrossWeight = 1;
+  EXPECT_GT(outward(across), 0.99);
+  EXPECT_EQ(NormalOrientationOptions{}.acrossWeight, 0) << "Hoppe's cost by default";
   NormalOrientationOptions bad;
   bad.acrossWeight = -1;
   auto normals = estimate.normals;

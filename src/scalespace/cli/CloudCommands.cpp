@@ -185,7 +185,8 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
       ->expected(1, 4);
   cmd.add_option("--across-weight", a.acrossWeight,
                  "mst: extra cost of a graph edge across a thin part (offset along both normals), "
-                 "so that its two sides are oriented apart; 0 = Hoppe's cost alone")
+                 "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
+                 "hurts noisy or sparse ones); 0 = Hoppe's cost alone")
       ->capture_default_str();
 }
 

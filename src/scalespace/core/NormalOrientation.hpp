@@ -38,9 +38,11 @@ struct NormalOrientationOptions {
   /// MST (not in Hoppe 1992): an edge whose offset runs along both normals, between the two sides
   /// of a thin part (parallel sheets facing each other, where Hoppe's cost is 0 and the
   /// propagation orients both sides alike), costs up to this much more, so the tree goes round
-  /// through the part's rim (figures: bench/README.md, bench_features, "The normals'
-  /// orientation on thin parts"). 0: Hoppe's cost alone.
-  double acrossWeight = 1.0;
+  /// through the part's rim. Off by default: it fixes thin parts on clean, dense samples but
+  /// misleads the tree on noisy or sparse ones, where neighbours' offsets leave the tangent planes
+  /// too (figures: bench/README.md, bench_features, "The normals' orientation on thin parts").
+  /// 0: Hoppe's cost alone.
+  double acrossWeight = 0.0;
   double grazingThreshold = 0.05;  // Viewpoint: |cos| below which the sign is unreliable
 };
 
