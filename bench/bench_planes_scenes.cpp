@@ -292,21 +292,22 @@ void diagnose(const PointCloud& cloud, const PlaneDetection& detection, const Pl
           composition(pts, truth).c_str(), composition(outside, truth).c_str());
       // Where the rest of the group is: the next regions holding most of it, and unlabelled.
       std::map<int, std::size_t> holders;
-      std::size_t unlabelled = 0;
+      std::vector<Index> unlabelled;
       std::vector<int> labels(truth.group.size(), -1);
       for (std::size_t r = 0; r < regions.size(); ++r)
         for (Index i : regions[r]) labels[i] = int(r);
       for (std::size_t i = 0; i < truth.group.size(); ++i)
         if (truth.group[i] == int(g)) {
           if (labels[i] < 0)
-            ++unlabelled;
+            unlabelled.push_back(Index(i));
           else if (std::size_t(labels[i]) != bestRegion)
             ++holders[labels[i]];
         }
       std::vector<std::pair<std::size_t, int>> byCount;
       for (const auto& [r, k] : holders) byCount.emplace_back(k, r);
       std::sort(byCount.rbegin(), byCount.rend());
-      std::printf("#        unlabelled %zu; other regions (group points / size):", unlabelled);
+      std::printf("#        unlabelled %zu (%s); other regions (group points / size):",
+                  unlabelled.size(), composition(unlabelled, truth).c_str());
       for (std::size_t k = 0; k < std::min<std::size_t>(5, byCount.size()); ++k)
         std::printf(" %zu/%zu", byCount[k].first, regions[std::size_t(byCount[k].second)].size());
       std::printf("\n");
