@@ -24,6 +24,7 @@
 // bench_planes_scenes [--points N (300000)] [--scales M (50)] [--scene house|yard|stairs]
 //                            [--noise X] [--min-persistence P (5)] [--no-ransac] [--diagnose]
 //                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
+//                            [--merge-parallel DEG]
 //                            [--merge-width F] [--refine-distance F] [--refine-gain F]
 //                            [--refine-offset F] [--planar-noise F]
 //                            (PlaneDetectionOptions; default: the library's)
@@ -530,6 +531,8 @@ int main(int argc, char** argv) {
       detection.refinement.minRelativeOffset = std::atof(argv[++i]);
     } else if (a == "--merge-width" && hasValue) {
       detection.merging.minRelativeWidth = std::atof(argv[++i]);
+    } else if (a == "--merge-parallel" && hasValue) {
+      detection.merging.parallelDegrees = std::atof(argv[++i]);
     } else if (a == "--merge-deviation" && hasValue) {
       detection.merging.maxRelativeDeviation = std::atof(argv[++i]);
     } else if (a == "--max-rms" && hasValue) {

@@ -79,6 +79,36 @@ TEST(RegionMerging, AStaircaseBecomesItsMeanRampAtAScaleOfAFewSteps) {
   EXPECT_EQ(regionCount(s, 0.8, 0.05), 12u);
 }
 
+TEST(RegionMerging, TheDeviationBoundIsOnThePointsNotOnTheBoxesAroundThem) {
+  // The same staircase, but each tread region also holds the top `strip` of the riser under its
+  // nose (what the robust fit gives a tread at its edge). The points stay on the sawtooth, within
+  // 0.3 x 0.18 / (2 x 0.35) = 0.077 of the mean ramp (a little more at its two ends); an L-shaped
+  // tread's box, along the tread's own plane, has a corner `strip` under the back of the tread,
+  // 0.077 + 0.09 cos(31 deg) = 0.154 off the ramp.
+  const auto build = [](double strip) {
+    Scene s;
+    for (int k = 0; k < 6; ++k) {
+      const double y = 0.3 * k, z = 0.18 * k;
+      addFace(s.points, s.seg, Vec3(0, y, z), Vec3(1.2, 0, 0), Vec3(0, 0, 0.18 - strip), 0.03);
+      addFace(s.points, s.seg, Vec3(0, y, z + 0.18), Vec3(1.2, 0, 0), Vec3(0, 0.3, 0), 0.03);
+      if (strip == 0) continue;
+      Segmentation nose;  // the strip, moved into the tread's region
+      addFace(s.points, nose, Vec3(0, y, z + 0.18 - strip), Vec3(1.2, 0, 0), Vec3(0, 0, strip),
+              0.03);
+      for (const Index i : nose.regions.front()) {  // the strip's points were appended last
+        s.seg.labels.push_back(int(s.seg.regions.size()) - 1);
+        s.seg.regions.back().push_back(i);
+      }
+    }
+    return s;
+  };
+  RegionMergeOptions tight;
+  tight.maxRelativeDeviation = 0.2;  // 0.1 at t = 0.5: above the points, below the boxes
+  EXPECT_EQ(regionCount(build(0.09), 0.5, 0, tight), 1u);
+  tight.maxRelativeDeviation = 0.1;  // 0.05: below the sawtooth's corners
+  EXPECT_EQ(regionCount(build(0.09), 0.5, 0, tight), 12u);
+}
+
 TEST(RegionMerging, PiecesFarFromACommonPlaneOrLargeEnoughToStandAloneAreNotMerged) {
   Scene s;
   // Two 0.5 x 0.5 plates side by side, one 0.3 higher: the union's RMS is 0.15 > 0.1 t.
@@ -128,6 +158,9 @@ TEST(RegionMerging, SameRegionsForAnyThreadCountAndOptionsChecked) {
   EXPECT_EQ(one.regions.size(), 1u);
 
   RegionMergeOptions bad;
+  bad.parallelDegrees = 90;
+  EXPECT_THROW(mergeCoplanarRegions(s.points, knn, s.seg, 0.8, 2.56, 0, bad), OptionError);
+  bad.parallelDegrees = 5;
   bad.maxRelativeDeviation = -1;
   try {
     mergeCoplanarRegions(s.points, knn, s.seg, 0.8, 2.56, 0, bad);
@@ -174,10 +207,27 @@ TEST(RegionMerging, AUnionJoinsALargeRegionThatDescribesItAsWellAsItsOwnPoints) 
   EXPECT_EQ(regionCount(lowerGrown, 0.8), 1u);
 
   // An exact plate does not take a union 1 cm off its plane (its own RMS is 0): the face of a box
-  // keeps out the bands along its edges.
+  // keeps out the bands along its edges. Parallel to the plate and that near it, the union is not
+  // a second plane either: it is undone (parallelDegrees), its two pieces left as they were grown.
   Scene plate;
   addFace(plate.points, plate.seg, Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(0, 2, 0), 0.05);
   addFace(plate.points, plate.seg, Vec3(3, 0, 0.01), Vec3(0.45, 0, 0), Vec3(0, 1, 0), 0.05);
   addFace(plate.points, plate.seg, Vec3(3.45, 0, 0.01), Vec3(0.45, 0, 0), Vec3(0, 1, 0), 0.05);
-  EXPECT_EQ(regionCount(plate, 0.8), 2u);
+  std::vector<RegionOrigin> plateOrigins;
+  const Segmentation undone =
+      mergeCoplanarRegions(plate.points, buildKnnGraph(plate.points, 10), plate.seg, 0.8,
+                           std::pow(1.6, 2), 0, {}, &plateOrigins);
+  EXPECT_EQ(undone.regions, plate.seg.regions);
+  EXPECT_EQ(plateOrigins, (std::vector<RegionOrigin>{RegionOrigin::large, RegionOrigin::small,
+                                                     RegionOrigin::small}));
+  RegionMergeOptions keepParallel;
+  keepParallel.parallelDegrees = 0;
+  EXPECT_EQ(regionCount(plate, 0.8, 0, keepParallel), 2u);
+  // Tilted by 10 degrees away from the plate, the same union is a plane of its own and stays.
+  Scene tilted;
+  const Vec3 up(0.45 * std::cos(0.1745), 0, 0.45 * std::sin(0.1745));
+  addFace(tilted.points, tilted.seg, Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(0, 2, 0), 0.05);
+  addFace(tilted.points, tilted.seg, Vec3(3, 0, 0.01), up, Vec3(0, 1, 0), 0.05);
+  addFace(tilted.points, tilted.seg, Vec3(3, 0, 0.01) + up, up, Vec3(0, 1, 0), 0.05);
+  EXPECT_EQ(regionCount(tilted, 0.8), 2u);
 }

@@ -329,6 +329,12 @@ void addPlanesCommand(CLI::App& app) {
                   "with --merge-rms: the farthest any point of a merged union may lie from its "
                   "plane, as a fraction of t")
       ->capture_default_str();
+  cmd->add_option("--merge-parallel", args->detection.merging.parallelDegrees,
+                  "with --merge-rms: a union within this angle (degrees) of a large region next "
+                  "to it and within --merge-deviation of its plane, which that region does not "
+                  "take, is undone: it is that surface cut off by --max-step, not a second plane "
+                  "(0 = kept)")
+      ->capture_default_str();
   cmd->add_option("--refine-distance", args->detection.refinement.maxRelativeDistance,
                   "with --merge-rms: a merged union takes the neighbouring points that lie nearer "
                   "its plane than their own region's, within this fraction of t of it (its "

@@ -38,6 +38,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"PlanarityOptions::maxRelativeRms", "--max-rms"},
     {"RegionMergeOptions::maxRelativeRms", "--merge-rms"},
     {"RegionMergeOptions::maxRelativeDeviation", "--merge-deviation"},
+    {"RegionMergeOptions::parallelDegrees", "--merge-parallel"},
     {"BoundaryRefinementOptions::maxRelativeDistance", "--refine-distance"},
     {"RegionGrowingOptions::maxAngleDegrees", "--angle"},
     {"StackWriteOptions::encoding", "--encoding"},

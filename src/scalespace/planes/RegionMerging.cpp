@@ -83,6 +83,8 @@ void validate(const RegionMergeOptions& options) {
     throw OptionError("RegionMergeOptions::maxRelativeDeviation must be finite and >= 0");
   if (!(options.noiseFactor >= 0) || !std::isfinite(options.noiseFactor))
     throw OptionError("RegionMergeOptions::noiseFactor must be finite and >= 0");
+  if (!(options.parallelDegrees >= 0 && options.parallelDegrees < 90))
+    throw OptionError("RegionMergeOptions::parallelDegrees must be in [0, 90)");
 }
 
 Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnGraph& knn,
@@ -101,6 +103,8 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   const double maxRms = options.maxRelativeRms * t;
   const double maxDeviation = options.maxRelativeDeviation * t;
   const double minWidth = options.minRelativeWidth * t;
+  const double parallelCos =
+      options.parallelDegrees > 0 ? std::cos(options.parallelDegrees * M_PI / 180.0) : 2.0;
   if (maxRms == 0 || maxRms < options.noiseFactor * noiseRms || regionCount < 2)
     return segmentation;
 
@@ -153,25 +157,45 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   std::vector<std::uint8_t> alive(regionCount, 1);
   std::vector<std::vector<Index>> members(regionCount);
   for (std::size_t r = 0; r < regionCount; ++r) members[r] = {Index(r)};
-  using Candidate = std::tuple<double, Index, Index, Index, Index>;  // rms, a, b, versions
+  // rms, a, b, their versions, and whether the points must still be checked against the
+  // deviation bound
+  using Candidate = std::tuple<double, Index, Index, Index, Index, bool>;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue;
-  const auto consider = [&](Index a, Index b) {
-    if (a > b) std::swap(a, b);
+  // The boxes bound a union's deviation from above (a sawtooth's boxes, tilted along its mean
+  // plane, overstate it by a third); where they exceed the bound, the points decide, once the
+  // pair comes out of the queue still current (most candidates are outdated by then).
+  const auto off = [&](const UnionPlane& plane, const Vec3& p) {
+    return std::abs(plane.normal.dot(p - plane.centroid));
+  };
+  const auto pointsWithin = [&](const UnionPlane& plane, Index a, Index b) {
+    for (const Index r : {a, b})
+      for (const Index m : members[r])
+        for (const Index i : segmentation.regions[m])
+          if (off(plane, positions[i]) > maxDeviation) return false;
+    return true;
+  };
+  const auto unionPlane = [&](Index a, Index b) {
     Moments m = moments[a];
     m.add(moments[b]);
-    const UnionPlane plane = planeOf(m);
+    return planeOf(m);
+  };
+  const auto consider = [&](Index a, Index b) {
+    if (a > b) std::swap(a, b);
+    const UnionPlane plane = unionPlane(a, b);
     if (!(plane.rms <= maxRms)) return;
+    bool boxesWithin = true;
     for (const Index r : {a, b})
       for (const Box& box : boxes[r])
         for (const Vec3& corner : box)
-          if (std::abs(plane.normal.dot(corner - plane.centroid)) > maxDeviation) return;
-    queue.emplace(plane.rms, a, b, version[a], version[b]);
+          boxesWithin = boxesWithin && off(plane, corner) <= maxDeviation;
+    queue.emplace(plane.rms, a, b, version[a], version[b], !boxesWithin);
   };
   for (const auto& [a, b] : edges) consider(a, b);
   while (!queue.empty()) {
-    const auto [rms, a, b, va, vb] = queue.top();
+    const auto [rms, a, b, va, vb, check] = queue.top();
     queue.pop();
     if (!alive[a] || !alive[b] || version[a] != va || version[b] != vb) continue;
+    if (check && !pointsWithin(unionPlane(a, b), a, b)) continue;
     moments[a].add(moments[b]);
     boxes[a].insert(boxes[a].end(), boxes[b].begin(), boxes[b].end());
     members[a].insert(members[a].end(), members[b].begin(), members[b].end());
@@ -232,6 +256,7 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   for (std::size_t k = 0; k < kept.size(); ++k)
     for (const Index m : kept[k].second) keptOf[m] = int(k);
   std::vector<int> joinTo(kept.size(), -1);
+  std::vector<std::uint8_t> twin(kept.size(), 0);
   for (std::size_t k = 0; k < kept.size(); ++k) {
     const auto& [survivor, parts] = kept[k];
     if (parts.size() < 2) continue;
@@ -248,10 +273,13 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
     const Vec3 mean = m.sum / m.count;
     const Mat3 covariance = m.outer / m.count - mean * mean.transpose();
     double best = std::numeric_limits<double>::infinity();
+    const Vec3 unionNormal = planeOf(m).normal;  // the union's own plane
     for (const Index g : large) {
       const PlaneFit& plane = ownPlane[g];
       if (!plane.valid) continue;
       const double offset = plane.normal.dot(mean - plane.centroid);
+      twin[k] = twin[k] || (std::abs(unionNormal.dot(plane.normal)) >= parallelCos &&
+                            std::abs(offset) <= maxDeviation);
       const double rms =
           std::sqrt(std::max(0.0, plane.normal.dot(covariance * plane.normal) + offset * offset));
       const double describes = planeDescribesBound(plane.rms, 2 * noiseRms);
@@ -262,6 +290,20 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
       if (within) best = rms, joinTo[k] = keptOf[g];
     }
   }
+  // A union parallel to a large region next to it and within the deviation bound of its plane,
+  // which that plane does not describe well enough to join, is undone: it is that region's surface
+  // (a warped floor's far corner, a table top's rounded rim), cut off by the step limit, and would
+  // stand beside it as a second plane taking its points in the boundary refinement.
+  const std::size_t unionCount = kept.size();
+  for (std::size_t k = 0; k < unionCount; ++k) {
+    if (joinTo[k] >= 0 || !twin[k]) continue;
+    for (std::size_t p = 1; p < kept[k].second.size(); ++p) {
+      const Index part = kept[k].second[p];
+      kept.emplace_back(part, std::vector<Index>{part});
+      joinTo.push_back(-1);
+    }
+    kept[k].second.resize(1);
+  }
   for (std::size_t k = 0; k < kept.size(); ++k)
     if (joinTo[k] >= 0) {
       auto& into = kept[std::size_t(joinTo[k])].second;
@@ -271,6 +313,7 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   kept.erase(
       std::remove_if(kept.begin(), kept.end(), [](const auto& e) { return e.second.empty(); }),
       kept.end());
+  std::sort(kept.begin(), kept.end());
 
   // The merged regions, in the order of their first grown region.
   Segmentation merged;

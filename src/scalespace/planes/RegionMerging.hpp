@@ -21,7 +21,8 @@ struct RegionMergeOptions {
   double maxRelativeRms = 0.1;
   /// ... and no point of the union lies farther than maxRelativeDeviation * t from that plane
   /// (bounded through the bounding boxes, along their own planes' axes, of the grown regions that
-  /// make the union): a box standing on the ground is never its plane's outlier.
+  /// make the union, and checked on the points where those boxes exceed it): a box standing on
+  /// the ground is never its plane's outlier.
   double maxRelativeDeviation = 0.3;
   /// Nothing is merged where maxRelativeRms * t is below noiseFactor times the sensor noise sigma
   /// (t < 50 sigma with the defaults): there the fit's normals scatter beyond the growing's angle
@@ -31,6 +32,12 @@ struct RegionMergeOptions {
   /// A union narrower than this fraction of t (the shorter side of its box in its plane) is undone:
   /// the slivers that the robust fit leaves along a crease would make a bevel that no surface has.
   double minRelativeWidth = 1.0;
+  /// A union whose plane is within parallelDegrees of the plane of a large grown region next to it,
+  /// and whose centroid lies within maxRelativeDeviation * t of that plane, is undone when that
+  /// region does not take it (below): it is the region's own surface cut off by the growing's step
+  /// limit (a warped floor's far corner, the rounded rim of a table top), not a second plane.
+  /// 0: such unions stay.
+  double parallelDegrees = 5.0;
 };
 
 /// What a region of the merged segmentation is: a grown region smaller than the filter's area
@@ -38,7 +45,8 @@ struct RegionMergeOptions {
 /// stand alone, or the union of several small ones.
 enum class RegionOrigin : std::uint8_t { small, large, merged };
 
-/// OptionError naming the field unless the bounds and noiseFactor are finite and >= 0.
+/// OptionError naming the field unless the bounds and noiseFactor are finite and >= 0 and
+/// parallelDegrees is in [0, 90).
 void validate(const RegionMergeOptions& options);
 
 /// The regions of `segmentation` (over `positions`, adjacency from `knn`) merged pairwise, the
@@ -49,8 +57,9 @@ void validate(const RegionMergeOptions& options);
 /// roof its tiles: they are faces at the scales where they are regions). A union (not a single
 /// small region) then joins a large region next to it whose own plane describes it within the
 /// same bounds and as well as the large region's own points (RMS within 1.25 times theirs, or
-/// twice the noise): a staircase whose lower steps grew as one region is one ramp. Regions of the
-/// result are ordered by their first grown region, point lists increasing, labels updated.
+/// twice the noise): a staircase whose lower steps grew as one region is one ramp; a union parallel
+/// to a large region next to it that the region does not take is undone (parallelDegrees). Regions
+/// of the result are ordered by their first grown region, point lists increasing, labels updated.
 /// Sequential and deterministic (same result for any thread count). `noiseRms` is the cloud's
 /// sensor noise (pointNoiseRms). When `origins` is given, it receives each resulting region's
 /// origin, or is left empty where nothing could merge at this scale.

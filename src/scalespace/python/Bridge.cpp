@@ -49,6 +49,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"PlanarityOptions::maxRelativeRms", "max_rms"},
     {"RegionMergeOptions::maxRelativeRms", "merge_rms"},
     {"RegionMergeOptions::maxRelativeDeviation", "merge_deviation"},
+    {"RegionMergeOptions::parallelDegrees", "merge_parallel"},
     {"BoundaryRefinementOptions::maxRelativeDistance", "refine_distance"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},

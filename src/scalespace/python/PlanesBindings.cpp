@@ -168,8 +168,9 @@ class Planes {
 
 std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& normals, int scales,
                                  double alpha, double angle, double maxStep, double maxRms,
-                                 double mergeRms, double mergeDeviation, double refineDistance,
-                                 bool robust, const std::optional<std::string>& stack,
+                                 double mergeRms, double mergeDeviation, double mergeParallel,
+                                 double refineDistance, bool robust,
+                                 const std::optional<std::string>& stack,
                                  const std::optional<std::string>& output, const std::string& input,
                                  std::optional<int> threads, py::object progress) {
   // `scalespace planes`' options and checks, before any work.
@@ -183,6 +184,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   options.planarity.maxRelativeRms = maxRms;
   options.merging.maxRelativeRms = mergeRms;
   options.merging.maxRelativeDeviation = mergeDeviation;
+  options.merging.parallelDegrees = mergeParallel;
   options.refinement.maxRelativeDistance = refineDistance;
   options.growing.maxAngleDegrees = angle;
   validateScaleSpaceOptions(stackOptions);
@@ -282,6 +284,7 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
         "max_rms"_a = PlaneDetectionOptions{}.planarity.maxRelativeRms,
         "merge_rms"_a = PlaneDetectionOptions{}.merging.maxRelativeRms,
         "merge_deviation"_a = PlaneDetectionOptions{}.merging.maxRelativeDeviation,
+        "merge_parallel"_a = PlaneDetectionOptions{}.merging.parallelDegrees,
         "refine_distance"_a = PlaneDetectionOptions{}.refinement.maxRelativeDistance,
         "robust"_a = true, "stack"_a = py::none(), "output"_a = py::none(), "input"_a = "",
         "threads"_a = py::none(), "progress"_a = py::none(),
@@ -294,7 +297,9 @@ t and twice the noise are not planar, never linked to planar ones and their comp
 (0.05; 0: the graph of Sec. 2.3.2); merge_rms, merge_deviation: adjacent regions each smaller
 than the scale are merged before the filter where their union's plane RMS is at most merge_rms t
 and no point is farther than merge_deviation t (0.1, 0.3: a staircase becomes its mean ramp;
-merge_rms 0: as grown, Sec. 2.3.1); refine_distance: a merged region takes the neighbouring
+merge_rms 0: as grown, Sec. 2.3.1); merge_parallel: a union within this angle (degrees) of a
+large region next to it and within merge_deviation t of its plane, which that region does not
+take, is undone (5; 0: kept); refine_distance: a merged region takes the neighbouring
 points nearer its plane than their own region's, its plane within refine_distance t (0.3; 0: its
 edges as grown); robust: the robust APSS of Sec. 2.3. stack: a stack folder
 computed from these points instead of computing one. output: also write the result folder
