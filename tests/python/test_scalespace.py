@@ -161,6 +161,7 @@ def test_planes_merge_options_are_checked_before_any_work(data):
     cloud = ss.read(str(data / "house.ply"))
     for kwargs, name in [({"merge_rms": -1}, "merge_rms"),
                          ({"merge_deviation": float("nan")}, "merge_deviation"),
+                         ({"merge_parallel": 90}, "merge_parallel"),
                          ({"refine_distance": -0.1}, "refine_distance")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.planes(cloud.points, **kwargs)
