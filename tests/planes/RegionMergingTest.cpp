@@ -85,28 +85,24 @@ TEST(RegionMerging, TheDeviationBoundIsOnThePointsNotOnTheBoxesAroundThem) {
   // 0.3 x 0.18 / (2 x 0.35) = 0.077 of the mean ramp (a little more at its two ends); an L-shaped
   // tread's box, along the tread's own plane, has a corner `strip` under the back of the tread,
   // 0.077 + 0.09 cos(31 deg) = 0.154 off the ramp.
-  const auto build = [](double strip) {
-    Scene s;
-    for (int k = 0; k < 6; ++k) {
-      const double y = 0.3 * k, z = 0.18 * k;
-      addFace(s.points, s.seg, Vec3(0, y, z), Vec3(1.2, 0, 0), Vec3(0, 0, 0.18 - strip), 0.03);
-      addFace(s.points, s.seg, Vec3(0, y, z + 0.18), Vec3(1.2, 0, 0), Vec3(0, 0.3, 0), 0.03);
-      if (strip == 0) continue;
-      Segmentation nose;  // the strip, moved into the tread's region
-      addFace(s.points, nose, Vec3(0, y, z + 0.18 - strip), Vec3(1.2, 0, 0), Vec3(0, 0, strip),
-              0.03);
-      for (const Index i : nose.regions.front()) {  // the strip's points were appended last
-        s.seg.labels.push_back(int(s.seg.regions.size()) - 1);
-        s.seg.regions.back().push_back(i);
-      }
+  constexpr double strip = 0.09;
+  Scene s;
+  for (int k = 0; k < 6; ++k) {
+    const double y = 0.3 * k, z = 0.18 * k;
+    addFace(s.points, s.seg, Vec3(0, y, z), Vec3(1.2, 0, 0), Vec3(0, 0, 0.18 - strip), 0.03);
+    addFace(s.points, s.seg, Vec3(0, y, z + 0.18), Vec3(1.2, 0, 0), Vec3(0, 0.3, 0), 0.03);
+    Segmentation nose;  // the strip, moved into the tread's region
+    addFace(s.points, nose, Vec3(0, y, z + 0.18 - strip), Vec3(1.2, 0, 0), Vec3(0, 0, strip), 0.03);
+    for (const Index i : nose.regions.front()) {  // the strip's points were appended last
+      s.seg.labels.push_back(int(s.seg.regions.size()) - 1);
+      s.seg.regions.back().push_back(i);
     }
-    return s;
-  };
+  }
   RegionMergeOptions tight;
   tight.maxRelativeDeviation = 0.2;  // 0.1 at t = 0.5: above the points, below the boxes
-  EXPECT_EQ(regionCount(build(0.09), 0.5, 0, tight), 1u);
+  EXPECT_EQ(regionCount(s, 0.5, 0, tight), 1u);
   tight.maxRelativeDeviation = 0.1;  // 0.05: below the sawtooth's corners
-  EXPECT_EQ(regionCount(build(0.09), 0.5, 0, tight), 12u);
+  EXPECT_EQ(regionCount(s, 0.5, 0, tight), 12u);
 }
 
 TEST(RegionMerging, PiecesFarFromACommonPlaneOrLargeEnoughToStandAloneAreNotMerged) {

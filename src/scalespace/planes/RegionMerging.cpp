@@ -74,6 +74,28 @@ Box boxOf(const std::vector<Vec3>& positions, const std::vector<Index>& region, 
   return box;
 }
 
+// Whether every corner of `boxes` lies within `bound` of the plane through `centroid` with unit
+// `normal`: an upper bound on the points inside them, and cheap.
+bool boxesWithin(const std::vector<Box>& boxes, const Vec3& normal, const Vec3& centroid,
+                 double bound) {
+  for (const Box& box : boxes)
+    for (const Vec3& corner : box)
+      if (std::abs(normal.dot(corner - centroid)) > bound) return false;
+  return true;
+}
+
+// Whether every point of the grown regions `parts` lies within `bound` of that plane: what the
+// boxes bound, decided where they exceed it (a sawtooth's boxes, tilted along its mean plane,
+// overstate its deviation by about a third).
+bool pointsWithin(const std::vector<Vec3>& positions,
+                  const std::vector<std::vector<Index>>& regions, const std::vector<Index>& parts,
+                  const Vec3& normal, const Vec3& centroid, double bound) {
+  for (const Index m : parts)
+    for (const Index i : regions[m])
+      if (std::abs(normal.dot(positions[i] - centroid)) > bound) return false;
+  return true;
+}
+
 }  // namespace
 
 void validate(const RegionMergeOptions& options) {
@@ -103,8 +125,7 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   const double maxRms = options.maxRelativeRms * t;
   const double maxDeviation = options.maxRelativeDeviation * t;
   const double minWidth = options.minRelativeWidth * t;
-  const double parallelCos =
-      options.parallelDegrees > 0 ? std::cos(options.parallelDegrees * M_PI / 180.0) : 2.0;
+  const double parallelCos = std::cos(options.parallelDegrees * M_PI / 180.0);
   if (maxRms == 0 || maxRms < options.noiseFactor * noiseRms || regionCount < 2)
     return segmentation;
 
@@ -158,22 +179,10 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
   std::vector<std::vector<Index>> members(regionCount);
   for (std::size_t r = 0; r < regionCount; ++r) members[r] = {Index(r)};
   // rms, a, b, their versions, and whether the points must still be checked against the
-  // deviation bound
+  // deviation bound: where the boxes exceed it, the points decide once the pair comes out of the
+  // queue still current (most candidates are outdated by then).
   using Candidate = std::tuple<double, Index, Index, Index, Index, bool>;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue;
-  // The boxes bound a union's deviation from above (a sawtooth's boxes, tilted along its mean
-  // plane, overstate it by a third); where they exceed the bound, the points decide, once the
-  // pair comes out of the queue still current (most candidates are outdated by then).
-  const auto off = [&](const UnionPlane& plane, const Vec3& p) {
-    return std::abs(plane.normal.dot(p - plane.centroid));
-  };
-  const auto pointsWithin = [&](const UnionPlane& plane, Index a, Index b) {
-    for (const Index r : {a, b})
-      for (const Index m : members[r])
-        for (const Index i : segmentation.regions[m])
-          if (off(plane, positions[i]) > maxDeviation) return false;
-    return true;
-  };
   const auto unionPlane = [&](Index a, Index b) {
     Moments m = moments[a];
     m.add(moments[b]);
@@ -183,19 +192,23 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
     if (a > b) std::swap(a, b);
     const UnionPlane plane = unionPlane(a, b);
     if (!(plane.rms <= maxRms)) return;
-    bool boxesWithin = true;
-    for (const Index r : {a, b})
-      for (const Box& box : boxes[r])
-        for (const Vec3& corner : box)
-          boxesWithin = boxesWithin && off(plane, corner) <= maxDeviation;
-    queue.emplace(plane.rms, a, b, version[a], version[b], !boxesWithin);
+    const bool bounded = boxesWithin(boxes[a], plane.normal, plane.centroid, maxDeviation) &&
+                         boxesWithin(boxes[b], plane.normal, plane.centroid, maxDeviation);
+    queue.emplace(plane.rms, a, b, version[a], version[b], !bounded);
   };
   for (const auto& [a, b] : edges) consider(a, b);
   while (!queue.empty()) {
     const auto [rms, a, b, va, vb, check] = queue.top();
     queue.pop();
     if (!alive[a] || !alive[b] || version[a] != va || version[b] != vb) continue;
-    if (check && !pointsWithin(unionPlane(a, b), a, b)) continue;
+    if (check) {
+      const UnionPlane plane = unionPlane(a, b);
+      if (!pointsWithin(positions, segmentation.regions, members[a], plane.normal, plane.centroid,
+                        maxDeviation) ||
+          !pointsWithin(positions, segmentation.regions, members[b], plane.normal, plane.centroid,
+                        maxDeviation))
+        continue;
+    }
     moments[a].add(moments[b]);
     boxes[a].insert(boxes[a].end(), boxes[b].begin(), boxes[b].end());
     members[a].insert(members[a].end(), members[b].begin(), members[b].end());
@@ -278,22 +291,24 @@ Segmentation mergeCoplanarRegions(const std::vector<Vec3>& positions, const KnnG
       const PlaneFit& plane = ownPlane[g];
       if (!plane.valid) continue;
       const double offset = plane.normal.dot(mean - plane.centroid);
-      twin[k] = twin[k] || (std::abs(unionNormal.dot(plane.normal)) >= parallelCos &&
+      twin[k] = twin[k] || (options.parallelDegrees > 0 &&
+                            std::abs(unionNormal.dot(plane.normal)) >= parallelCos &&
                             std::abs(offset) <= maxDeviation);
       const double rms =
           std::sqrt(std::max(0.0, plane.normal.dot(covariance * plane.normal) + offset * offset));
       const double describes = planeDescribesBound(plane.rms, 2 * noiseRms);
-      bool within = rms <= maxRms && rms <= describes && rms < best;
-      for (const Box& box : boxes[survivor])
-        for (const Vec3& corner : box)
-          within = within && std::abs(plane.normal.dot(corner - plane.centroid)) <= maxDeviation;
+      const bool within =
+          rms <= maxRms && rms <= describes && rms < best &&
+          (boxesWithin(boxes[survivor], plane.normal, plane.centroid, maxDeviation) ||
+           pointsWithin(positions, segmentation.regions, parts, plane.normal, plane.centroid,
+                        maxDeviation));
       if (within) best = rms, joinTo[k] = keptOf[g];
     }
   }
   // A union parallel to a large region next to it and within the deviation bound of its plane,
   // which that plane does not describe well enough to join, is undone: it is that region's surface
-  // (a warped floor's far corner, a table top's rounded rim), cut off by the step limit, and would
-  // stand beside it as a second plane taking its points in the boundary refinement.
+  // (a floor's far corner among clutter, a table top's rounded rim), cut off by the step limit, and
+  // would stand beside it as a second plane taking its points in the boundary refinement.
   const std::size_t unionCount = kept.size();
   for (std::size_t k = 0; k < unionCount; ++k) {
     if (joinTo[k] >= 0 || !twin[k]) continue;

@@ -35,7 +35,8 @@ struct RegionMergeOptions {
   /// A union whose plane is within parallelDegrees of the plane of a large grown region next to it,
   /// and whose centroid lies within maxRelativeDeviation * t of that plane, is undone when that
   /// region does not take it (below): it is the region's own surface cut off by the growing's step
-  /// limit (a warped floor's far corner, the rounded rim of a table top), not a second plane.
+  /// limit (a floor's far corner among clutter, the rounded rim of a table top), not a second
+  /// plane.
   /// 0: such unions stay.
   double parallelDegrees = 5.0;
 };

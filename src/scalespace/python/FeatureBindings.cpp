@@ -257,7 +257,8 @@ scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curva
 join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False restore the
 thesis' rules. centreline_reach, band_half_width: a curve keeps the points within
 band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e.
-triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
+triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per
+vertex by area and labelled on the mesh edges (Sec. 3.4.1).)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
