@@ -7,7 +7,8 @@
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
-//                  (NormalOrientationOptions::acrossWeight of the estimated normals)
+//                  [--no-visibility] (NormalOrientationOptions::acrossWeight of the estimated
+//                  normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
@@ -381,6 +382,7 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 // Clouds.
 
 double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
+bool visibility = NormalOrientationOptions{}.visibility;        // --no-visibility
 
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
 void estimateOrientedNormals(PointCloud& cloud) {
@@ -388,6 +390,7 @@ void estimateOrientedNormals(PointCloud& cloud) {
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index);
   NormalOrientationOptions orientation;
   orientation.acrossWeight = acrossWeight;
+  orientation.visibility = visibility;
   orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid);
   cloud.setNormals(std::move(est.normals));
 }
@@ -1149,6 +1152,8 @@ int main(int argc, char** argv) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
     } else if (a == "--across-weight" && hasValue) {
       acrossWeight = std::atof(argv[++i]);
+    } else if (a == "--no-visibility") {
+      visibility = false;
     } else if (a == "--mesh-normals") {
       meshNormals = true;
     } else if (a == "--robust-fit") {

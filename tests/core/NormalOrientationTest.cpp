@@ -58,7 +58,8 @@ TEST(NormalOrientation, MstOrientsAClosedSphereOutward) {
 // A closed slab 2.5 spacings thick (1 x 1 x 0.025, spacing about 0.01): the 10 nearest neighbours
 // of a point of one face include points of the other, with parallel normals. Hoppe's cost is 0
 // across the slab and orients both faces alike (half the points face in); the across-sheet term
-// makes the tree go round the rim, and both faces face out. (Below 2 spacings the rim itself is
+// makes the tree go round the rim, and both faces face out; so does the visibility pass, which
+// turns over the face whose rays are stopped by the other face. (Below 2 spacings the rim itself is
 // too thin for its normals: 1.5 spacings gave 0.56 against Hoppe's 0.50.)
 TEST(NormalOrientation, MstOrientsBothSidesOfAThinSlabOutward) {
   const double h = 0.025;
@@ -85,15 +86,39 @@ TEST(NormalOrientation, MstOrientsBothSidesOfAThinSlabOutward) {
   };
   NormalOrientationOptions hoppe;
   hoppe.acrossWeight = 0;
+  hoppe.visibility = false;
   EXPECT_LT(outward(hoppe), 0.6);
   NormalOrientationOptions across;
   across.acrossWeight = 1;
+  across.visibility = false;
   EXPECT_GT(outward(across), 0.99);
+  // The rays see it too (the default), where the cells are finer than the slab.
+  EXPECT_GT(outward(NormalOrientationOptions{}), 0.99);
+  NormalOrientationOptions coarse;
+  coarse.visibilityCell = 1.0;  // 1.4 cells across: both sides in one run of cells, no verdict
+  EXPECT_LT(outward(coarse), 0.6);
   EXPECT_EQ(NormalOrientationOptions{}.acrossWeight, 0) << "Hoppe's cost by default";
   NormalOrientationOptions bad;
   bad.acrossWeight = -1;
   auto normals = estimate.normals;
   EXPECT_THROW(orientNormals(points, normals, bad), OptionError);
+  NormalOrientationOptions badCell;
+  badCell.visibilityCell = 0;
+  EXPECT_THROW(orientNormals(points, normals, badCell), OptionError);
+}
+
+// An open sheet seen from above has two open sides: every ray escapes and the rays have no say.
+TEST(NormalOrientation, VisibilityLeavesAnOpenSurfaceAsTheTreeOrientsIt) {
+  const auto points = noisyTerrain(20000, 35);
+  const auto estimate = estimateNormals(points);
+  auto withRays = estimate.normals, without = estimate.normals;
+  NormalOrientationOptions off;
+  off.visibility = false;
+  const auto r = orientNormals(points, withRays, {}, estimate.valid);
+  orientNormals(points, without, off, estimate.valid);
+  EXPECT_EQ(withRays, without);
+  EXPECT_EQ(r.piecesFlipped, 0u);
+  EXPECT_GE(r.pieceCount, 1u);
 }
 
 TEST(NormalOrientation, MstRestoresRandomlyFlippedNormalsOfTwoSpheres) {

@@ -116,10 +116,14 @@ def test_curvature_without_normals_equals_the_cli(data, tmp_path):
 def test_estimate_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)
-    for weight in (1, 0):  # the default, and Hoppe's cost alone
-        cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight)
+    # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone
+    for weight, visibility in ((1, True), (0, True), (0, False)):
+        flag = "--visibility" if visibility else "--no-visibility"
+        cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight,
+            flag)
         expected = columns(tmp_path / "n.ply")
-        normals, reliable = ss.estimate_normals(points, across_weight=weight)
+        normals, reliable = ss.estimate_normals(points, across_weight=weight,
+                                                visibility=visibility)
         for c, name in enumerate(("nx", "ny", "nz")):
             np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
         np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)

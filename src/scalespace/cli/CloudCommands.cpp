@@ -174,6 +174,7 @@ struct NormalArgs {
   std::size_t k = 10;
   std::vector<std::string> orient{"mst"};
   double acrossWeight = NormalOrientationOptions{}.acrossWeight;
+  bool visibility = NormalOrientationOptions{}.visibility;
 };
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
@@ -188,6 +189,11 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                  "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
                  "hurts noisy or sparse ones); 0 = Hoppe's cost alone")
       ->capture_default_str();
+  cmd.add_flag("--visibility,!--no-visibility", a.visibility,
+               "mst: turn over the pieces of the propagation tree that rays cast from the points "
+               "show facing the inside of a closed surface (both sides of thin parts, creases); "
+               "on by default")
+      ->capture_default_str();
 }
 
 NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointCloud& cloud) {
@@ -199,6 +205,7 @@ NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointClou
   NormalOrientationOptions o;
   o.k = a.k;
   o.acrossWeight = a.acrossWeight;
+  o.visibility = a.visibility;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {
     o.method = OrientationMethod::MinimumSpanningTree;
   } else if (a.orient.size() == 4 && a.orient[0] == "viewpoint") {

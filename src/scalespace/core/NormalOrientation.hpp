@@ -17,6 +17,13 @@
 //    nearest neighbour that has a valid one (a non-finite normal is left as it is).
 //  - MST: |n_child . n_parent| < creaseThreshold along the tree edge that oriented the point (a
 //    sharp crease: the sign decision is a guess), or the point is alone in its component.
+//  - Visibility (MST, not in Hoppe 1992; NormalOrientationOptions::visibility): after the
+//    propagation the tree is cut at the edges where its sign decision is a guess (a crease,
+//    |n_child . n_parent| < creaseThreshold, or an edge across a thin part, whose offset runs along
+//    both normals), and each piece is flipped when rays cast from its points (core/OccupancyGrid)
+//    leave the cloud on the side its normals point away from and are stopped on the other: the
+//    inside of a closed surface. Where both sides are open (a single scan of a scene, an open
+//    sheet) or both closed (the inside of a room), the rays have no say and the tree's sign stays.
 //  - Viewpoint: flipped so that n . (viewpoint - p) >= 0; unreliable when the view ray grazes the
 //    surface, |cos(n, viewpoint - p)| < grazingThreshold, or p == viewpoint.
 #include <cstdint>
@@ -43,6 +50,15 @@ struct NormalOrientationOptions {
   /// too (figures: bench/README.md, bench_features, "The normals' orientation on thin parts").
   /// 0: Hoppe's cost alone.
   double acrossWeight = 0.0;
+  /// MST: correct the tree's guesses by visibility (file comment). Hoppe's propagation alone
+  /// orients both sides of a thin part alike and guesses at creases; CAD parts sampled without
+  /// normals lose half their normals to it (bench_features: blade, rotor).
+  bool visibility = true;
+  /// MST, visibility: the side of the occupancy grid's cells in units of the median distance to
+  /// the k-th neighbour. Smaller cells see thinner parts; larger ones let fewer rays slip through
+  /// the gaps between samples. 0.7 sees both sides of a slab 2.5 spacings thick (1.0 does not);
+  /// at 0.5 the rays leak through rotor's surface (bench_features) and its rims stay wrong.
+  double visibilityCell = 0.7;
   double grazingThreshold = 0.05;  // Viewpoint: |cos| below which the sign is unreliable
 };
 
@@ -50,6 +66,8 @@ struct NormalOrientationResult {
   std::size_t flippedCount = 0;        // normals whose sign was changed
   std::size_t unreliableCount = 0;     // number of zeros in `reliable`
   std::size_t componentCount = 0;      // MST: connected components of the graph (0 for Viewpoint)
+  std::size_t pieceCount = 0;          // MST, visibility: pieces of the cut tree
+  std::size_t piecesFlipped = 0;       // MST, visibility: pieces the rays turned over
   std::vector<std::uint8_t> reliable;  // one per point, see the file comment
 };
 

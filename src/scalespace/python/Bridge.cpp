@@ -379,7 +379,8 @@ ScalarType scalarTypeOf(const py::dtype& dtype, const std::string& name) {
 std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
-                                            const ProgressCallback& progress, double acrossWeight) {
+                                            const ProgressCallback& progress, double acrossWeight,
+                                            bool visibility) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
   if (k >= cloud.size())
@@ -388,6 +389,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   NormalOrientationOptions o;
   o.k = k;
   o.acrossWeight = acrossWeight;
+  o.visibility = visibility;
   if (orient == "mst") {
     if (viewpoint) throw OptionError("viewpoint goes with orient='viewpoint'");
     o.method = OrientationMethod::MinimumSpanningTree;

@@ -143,7 +143,8 @@ class Call {
 std::vector<std::uint8_t> estimateAndOrient(
     PointCloud& cloud, std::size_t k = 10, const std::string& orient = "mst",
     const std::optional<Vec3>& viewpoint = std::nullopt, const ProgressCallback& progress = {},
-    double acrossWeight = NormalOrientationOptions{}.acrossWeight);
+    double acrossWeight = NormalOrientationOptions{}.acrossWeight,
+    bool visibility = NormalOrientationOptions{}.visibility);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);
