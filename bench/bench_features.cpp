@@ -416,14 +416,26 @@ const PointCloud* lastCloud = nullptr;  // the cloud ours ran on
 struct Model {
   std::string name;
   TriangleMesh mesh;
-  PointCloud clean;     // with estimated normals
-  std::vector<int> gt;  // per point: ground-truth curve or -1
+  PointCloud clean;               // with estimated normals
+  std::vector<Vec3> meshNormals;  // of the samples, interpolated from the mesh
+  std::vector<int> gt;            // per point: ground-truth curve or -1
   std::vector<int> gt2,
       gt3;           // the same within 2 e and 3 e (--per-curve: where false positives lie)
   int gtCurves = 0;  // curves with at least one point
   MeshEdges edges;
   double spacing = 0, diagonal = 0;
 };
+
+/// --per-curve: where the estimated orientation disagrees with the mesh's (outward where the mesh
+/// is closed and consistently oriented; on an open mesh either side).
+void printOrientation(const Model& m, const PointCloud& cloud, const char* which) {
+  std::size_t flipped = 0;
+  for (std::size_t i = 0; i < m.meshNormals.size(); ++i)
+    flipped += m.meshNormals[i].dot(cloud.normals()[i]) < 0;
+  const double share = double(flipped) / double(std::max<std::size_t>(1, m.meshNormals.size()));
+  std::printf("# %s, %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
+              m.name.c_str(), which, 100 * std::min(share, 1 - share));
+}
 
 Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, double angle) {
   Model m;
@@ -433,17 +445,8 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   const std::vector<Vec3> truth = m.clean.normals();
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
   estimateOrientedNormals(m.clean);
-  if (printPerCurve) {
-    // Where the estimated orientation disagrees with the mesh's (outward where the mesh is
-    // closed and consistently oriented; on an open mesh either side): a thin part whose two
-    // sides are within the 10 neighbours of the estimate flips in patches.
-    std::size_t flipped = 0;
-    for (std::size_t i = 0; i < truth.size(); ++i)
-      flipped += truth[i].dot(m.clean.normals()[i]) < 0;
-    const double share = double(flipped) / double(std::max<std::size_t>(1, truth.size()));
-    std::printf("# %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
-                m.name.c_str(), 100 * std::min(share, 1 - share));
-  }
+  m.meshNormals = truth;
+  if (printPerCurve) printOrientation(m, m.clean, "clean");
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
   m.diagonal = m.clean.boundingBoxDiagonal();
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
@@ -1194,6 +1197,7 @@ int main(int argc, char** argv) {
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
           estimateOrientedNormals(cloud);
+          if (printPerCurve) printOrientation(m, cloud, "noisy");
           runMethods(m, cloud, peers, rows);
         }
       } catch (const Error& error) {

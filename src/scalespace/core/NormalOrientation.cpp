@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scalespace/core/DisjointSets.hpp"
@@ -74,9 +75,9 @@ int escapingRays(const OccupancyGrid& grid, const Vec3& p, const Vec3& unitNorma
 
 /// Each graph edge that agrees with a piece's sign outweighs two of the rays' votes against it.
 /// Measured on libcgal-demo's points_3 (bench/README.md, "visibility"): with 1, the floor of
-/// building.ply, under its roof and open below, was turned down (against the file's normals) by
-/// 1,652 votes against 890 edges; with 2, it stays up, and the thin parts of rotor and blade and
-/// the pieces of spheres.ply are still turned (7-70 votes per edge).
+/// building.ply, under its roof and open below, is turned down (its points against the file's
+/// normals: 2.1% -> 30.7%); with 2 it stays up, and the thin parts of rotor and blade and the
+/// pieces of spheres.ply are still turned.
 constexpr double kEdgeWeight = 2.0;
 
 /// Visibility pass (file comment of the header). A point votes for its side when at least three
@@ -146,13 +147,17 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   // The rays can be wrong where an object is open (a scan's missing base lets the inward rays
   // out) and its own parts hide the outside. The graph edges that join a piece to the rest along
   // one surface (not across a thin part, normals within 60 degrees) also speak for its sign: a
-  // piece is turned only when the votes against it outnumber those for it by more than the
-  // edges that agree with its sign outnumber those that disagree.
+  // group of candidates (joined by such edges that agree) is turned only when its votes against
+  // outnumber those for by more than kEdgeWeight times the edges to other pieces that agree
+  // with its sign outnumber those that disagree.
   std::vector<std::uint16_t> agreeAt(n, 0), disagreeAt(n, 0);
+  using Link = std::pair<Index, Index>;
   tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
+  tbb::enumerable_thread_specific<std::vector<Link>> linkScratch;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<Neighbor>& nbrs = scratch.local();
+                      std::vector<Link>& links = linkScratch.local();
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
                         index.knnSearch(points[i], options.k + 1, nbrs);
@@ -163,20 +168,40 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                           if (acrossSheet(points[i], oriented[i], points[j], oriented[j])) continue;
                           const double c = oriented[i].dot(oriented[j]) /
                                            (oriented[i].norm() * oriented[j].norm());
+                          if (c >= 0.5 && turn[piece[j]]) {
+                            links.emplace_back(piece[i], piece[j]);
+                            continue;
+                          }
                           agreeAt[i] += c >= 0.5 ? 1 : 0;
                           disagreeAt[i] += c <= -0.5 ? 1 : 0;
                         }
                       }
                     });
-  std::vector<std::size_t> agree(pieces, 0), disagree(pieces, 0);
+  // Candidates that agree with each other along one surface are decided together: noise cuts a
+  // misoriented side into many pieces, each agreeing with the next.
+  DisjointSets groups(pieces);
+  for (const std::vector<Link>& links : linkScratch)
+    for (const Link& l : links) groups.unite(l.first, l.second);
+  std::vector<double> groupAgainst(pieces, 0), groupAlong(pieces, 0), groupAgree(pieces, 0),
+      groupDisagree(pieces, 0), groupMembers(pieces, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!inGraph[i] || piece[i] == kNone) continue;
-    agree[piece[i]] += agreeAt[i];
-    disagree[piece[i]] += disagreeAt[i];
+    if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
+    const Index g = groups.find(piece[i]);
+    groupAgree[g] += agreeAt[i];
+    groupDisagree[g] += disagreeAt[i];
   }
   for (Index q = 0; q < pieces; ++q) {
-    if (turn[q] && against[q] - along[q] <= kEdgeWeight * (double(agree[q]) - double(disagree[q])))
-      turn[q] = 0;
+    if (!turn[q]) continue;
+    const Index g = groups.find(q);
+    groupAgainst[g] += against[q];
+    groupAlong[g] += along[q];
+    groupMembers[g] += double(members[q]);
+  }
+  for (Index q = 0; q < pieces; ++q) {
+    if (!turn[q]) continue;
+    const Index g = groups.find(q);
+    turn[q] =
+        groupAgainst[g] - groupAlong[g] > kEdgeWeight * (groupAgree[g] - groupDisagree[g]) ? 1 : 0;
     result.piecesFlipped += turn[q];
   }
   for (std::size_t i = 0; i < n; ++i) {
