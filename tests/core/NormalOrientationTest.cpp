@@ -94,6 +94,21 @@ TEST(NormalOrientation, MstOrientsBothSidesOfAThinSlabOutward) {
   EXPECT_GT(outward(across), 0.99);
   // The rays see it too (the default), where the cells are finer than the slab.
   EXPECT_GT(outward(NormalOrientationOptions{}), 0.99);
+  {  // the pieces turned and their votes do not depend on the thread count
+    std::vector<Vec3> one = estimate.normals, two = estimate.normals;
+    NormalOrientationResult r1, r2;
+    {
+      ThreadLimit limit(1);
+      r1 = orientNormals(points, one, {}, estimate.valid);
+    }
+    {
+      ThreadLimit limit(2);
+      r2 = orientNormals(points, two, {}, estimate.valid);
+    }
+    EXPECT_EQ(one, two);
+    EXPECT_GT(r1.piecesFlipped, 0u);
+    EXPECT_EQ(r1.piecesFlipped, r2.piecesFlipped);
+  }
   NormalOrientationOptions coarse;
   coarse.visibilityCell = 1.0;  // 1.4 cells across: both sides in one run of cells, no verdict
   EXPECT_LT(outward(coarse), 0.6);
