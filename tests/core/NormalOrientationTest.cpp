@@ -34,6 +34,20 @@ std::vector<Vec3> noisyTerrain(std::size_t n, std::uint64_t seed) {
   return p;
 }
 
+struct OrientedOn {
+  std::vector<Vec3> normals;
+  NormalOrientationResult result;
+};
+
+/// The default orientation of `estimate`'s normals on `threads` threads.
+OrientedOn orientOn(int threads, const std::vector<Vec3>& points,
+                    const NormalEstimationResult& estimate) {
+  ThreadLimit limit(threads);
+  OrientedOn out{estimate.normals, {}};
+  out.result = orientNormals(points, out.normals, {}, estimate.valid);
+  return out;
+}
+
 }  // namespace
 
 TEST(NormalOrientation, MstOrientsAClosedSphereOutward) {
@@ -95,19 +109,10 @@ TEST(NormalOrientation, MstOrientsBothSidesOfAThinSlabOutward) {
   // The rays see it too (the default), where the cells are finer than the slab.
   EXPECT_GT(outward(NormalOrientationOptions{}), 0.99);
   {  // the pieces turned and their votes do not depend on the thread count
-    std::vector<Vec3> one = estimate.normals, two = estimate.normals;
-    NormalOrientationResult r1, r2;
-    {
-      ThreadLimit limit(1);
-      r1 = orientNormals(points, one, {}, estimate.valid);
-    }
-    {
-      ThreadLimit limit(2);
-      r2 = orientNormals(points, two, {}, estimate.valid);
-    }
-    EXPECT_EQ(one, two);
-    EXPECT_GT(r1.piecesFlipped, 0u);
-    EXPECT_EQ(r1.piecesFlipped, r2.piecesFlipped);
+    const OrientedOn one = orientOn(1, points, estimate), two = orientOn(2, points, estimate);
+    EXPECT_EQ(one.normals, two.normals);
+    EXPECT_GT(one.result.piecesFlipped, 0u);
+    EXPECT_EQ(one.result.piecesFlipped, two.result.piecesFlipped);
   }
   NormalOrientationOptions coarse;
   coarse.visibilityCell = 1.0;  // 1.4 cells across: both sides in one run of cells, no verdict
@@ -269,19 +274,10 @@ TEST(NormalOrientation, Viewpoint) {
 TEST(NormalOrientation, DeterministicAcrossThreadsAndCancellable) {
   const auto points = noisyTerrain(6000, 39);
   const auto estimate = estimateNormals(points);
-  std::vector<Vec3> one = estimate.normals, two = estimate.normals;
-  NormalOrientationResult r1, r2;
-  {
-    ThreadLimit limit(1);
-    r1 = orientNormals(points, one, {}, estimate.valid);
-  }
-  {
-    ThreadLimit limit(2);
-    r2 = orientNormals(points, two, {}, estimate.valid);
-  }
-  EXPECT_EQ(one, two);
-  EXPECT_EQ(r1.reliable, r2.reliable);
-  EXPECT_EQ(r1.flippedCount, r2.flippedCount);
+  const OrientedOn one = orientOn(1, points, estimate), two = orientOn(2, points, estimate);
+  EXPECT_EQ(one.normals, two.normals);
+  EXPECT_EQ(one.result.reliable, two.result.reliable);
+  EXPECT_EQ(one.result.flippedCount, two.result.flippedCount);
 
   std::vector<Vec3> untouched = estimate.normals;
   const ProgressCallback stop = [](double, std::string_view) { return false; };
