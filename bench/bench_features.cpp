@@ -7,8 +7,8 @@
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
-//                  [--no-visibility] (NormalOrientationOptions::acrossWeight of the estimated
-//                  normals)
+//                  [--no-visibility] (NormalOrientationOptions::acrossWeight and ::visibility
+//                  of the estimated normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]

@@ -283,6 +283,11 @@ TEST(NormalOrientation, DeterministicAcrossThreadsAndCancellable) {
   const ProgressCallback stop = [](double, std::string_view) { return false; };
   EXPECT_THROW(orientNormals(points, untouched, {}, estimate.valid, stop), Cancelled);
   EXPECT_EQ(untouched, estimate.normals);
+  const ProgressCallback stopAtTheRays = [](double, std::string_view stage) {
+    return stage != "orientation visibility";
+  };
+  EXPECT_THROW(orientNormals(points, untouched, {}, estimate.valid, stopAtTheRays), Cancelled);
+  EXPECT_EQ(untouched, estimate.normals);
   std::vector<Vec3> wrongSize(3);
   EXPECT_THROW(orientNormals(points, wrongSize), OptionError);
 }

@@ -41,24 +41,30 @@ struct Edge {
 /// sides alike where one must face the other way. Their offset runs along both normals; between
 /// neighbours of one sheet it lies in the tangent planes (the term is about 0), and across a crease
 /// along at most one of the two normals.
+/// |cos| of the angles between the offset d = pb - pa and each normal (0 for coincident points).
+struct OffsetCosines {
+  double a = 0, b = 0;
+};
+OffsetCosines offsetCosines(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb) {
+  const Vec3 d = pb - pa;
+  const double length = d.norm();
+  if (!(length > 0)) return {};
+  return {std::abs(na.dot(d)) / (length * na.norm()), std::abs(nb.dot(d)) / (length * nb.norm())};
+}
+
 double edgeCost(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb,
                 double acrossWeight) {
-  const double scale = na.norm() * nb.norm();
-  const double c = std::min(1.0, std::abs(na.dot(nb)) / scale);
-  const Vec3 d = pb - pa;
-  const double d2 = d.squaredNorm();
-  if (!(acrossWeight > 0) || !(d2 > 0)) return 1.0 - c;
-  return 1.0 - c + acrossWeight * std::abs(na.dot(d)) * std::abs(nb.dot(d)) / (d2 * scale);
+  const double c = std::min(1.0, std::abs(na.dot(nb)) / (na.norm() * nb.norm()));
+  if (!(acrossWeight > 0)) return 1.0 - c;
+  const OffsetCosines along = offsetCosines(pa, na, pb, nb);
+  return 1.0 - c + acrossWeight * along.a * along.b;
 }
 
 /// The offset between two points runs along both normals (within 60 degrees): an edge between the
 /// two sides of a thin part rather than along one surface.
 bool acrossSheet(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb) {
-  const Vec3 d = pb - pa;
-  const double d2 = d.squaredNorm();
-  if (!(d2 > 0)) return false;
-  const double ca = na.dot(d), cb = nb.dot(d);
-  return ca * ca > 0.25 * d2 * na.squaredNorm() && cb * cb > 0.25 * d2 * nb.squaredNorm();
+  const OffsetCosines along = offsetCosines(pa, na, pb, nb);
+  return along.a > 0.5 && along.b > 0.5;
 }
 
 /// The rays of one side of a point: along the normal and four tilted 25 degrees around it.
@@ -87,7 +93,8 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                          const SpatialIndex& index, const std::vector<std::uint8_t>& inGraph,
                          const std::vector<float>& kthDistance, const std::vector<Index>& piece,
                          Index pieces, const NormalOrientationOptions& options,
-                         std::vector<std::uint8_t>& flipped, NormalOrientationResult& result) {
+                         const ProgressCallback& progress, std::vector<std::uint8_t>& flipped,
+                         NormalOrientationResult& result) {
   const std::size_t n = points.size();
   result.pieceCount = pieces;
   std::vector<float> spacing;
@@ -117,8 +124,10 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
     return size >= minPiece && (i % stride == 0 || size < 16);
   };
   std::vector<std::int8_t> vote(n, 0);
+  ProgressTracker tracker(progress, "orientation visibility", n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
                     [&](const tbb::blocked_range<std::size_t>& range) {
+                      if (tracker.cancelled()) return;
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         if (!votes(i)) continue;
                         const Vec3 nrm = oriented[i].normalized();
@@ -126,7 +135,9 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                         const int in = escapingRays(grid, points[i], -nrm);
                         vote[i] = out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0);
                       }
+                      tracker.advance(range.size());
                     });
+  tracker.finish();
   // Votes scaled to the whole piece, so that they weigh against its edges as if all had voted.
   std::vector<double> against(pieces, 0), along(pieces, 0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -397,12 +408,9 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   }
   checkCancel(progress, 1.0, "orientation tree");
 
-  if (options.visibility) {
-    checkCancel(progress, 0.0, "orientation visibility");
+  if (options.visibility)
     correctByVisibility(points, oriented, index, inGraph, kthDistance, piece, pieces, options,
-                        flipped, result);
-    checkCancel(progress, 1.0, "orientation visibility");
-  }
+                        progress, flipped, result);
 
   // 5. Points outside the graph follow their nearest graph neighbour; never reliable.
   for (std::size_t i = 0; i < n; ++i) {
@@ -444,8 +452,8 @@ NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vect
                       std::to_string(options.k));
   if (!(options.visibilityCell > 0) || !std::isfinite(options.visibilityCell))
     throw OptionError(
-        "NormalOrientationOptions::visibilityCell must be finite and > 0 (default 1: the median "
-        "distance to the k-th neighbour)");
+        "NormalOrientationOptions::visibilityCell must be finite and > 0 (default 0.7, in units of "
+        "the median distance to the k-th neighbour)");
   if (!std::isfinite(options.acrossWeight) || options.acrossWeight < 0)
     throw OptionError(
         "NormalOrientationOptions::acrossWeight must be finite and >= 0 (0: Hoppe's "
