@@ -23,8 +23,9 @@
 //    both normals), and each piece is flipped when rays cast from its points (core/OccupancyGrid)
 //    leave the cloud on the side its normals point away from and are stopped on the other: the
 //    inside of a closed surface, unless the graph edges that join it to the rest along one
-//    surface agree with its sign (each counts as two of the rays' votes). Where both sides are open (a single scan of a scene, an open
-//    sheet) or both closed (the inside of a room), the rays have no say and the tree's sign stays.
+//    surface agree with its sign (each counts as two of the rays' votes). Where both sides are open
+//    (a single scan of a scene, an open sheet) or both closed (the inside of a room), the rays have
+//    no say and the tree's sign stays.
 //  - Viewpoint: flipped so that n . (viewpoint - p) >= 0; unreliable when the view ray grazes the
 //    surface, |cos(n, viewpoint - p)| < grazingThreshold, or p == viewpoint.
 #include <cstdint>
