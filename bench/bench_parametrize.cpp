@@ -10,9 +10,14 @@
 // at 16 and 64 neighbours, and the median stretch of the 16-neighbour local maps (the ratio of
 // their singular values, MapDefects::stretch). The mesh peers are scored on the mesh's vertices.
 //
+// Rows: "scalespace" is `parametrize`'s default (the flattening, then the rigid robust
+// relaxation of a plane domain), "thesis" the flattening alone (--relax 0), "+conformal" and
+// "+rigid-1round" the other relaxations (similarities; one plain least-squares round).
+//
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]
 //                     [--scales M (50)] [--resolution R (128): the peers' mesh grid]
-//                     [--no-peers] [--threads T]
+//                     [--no-peers] [--threads T] [--relax-iterations I (5)]
+//                     [--relax-max-solve N (200000)]: the relaxations' options
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
@@ -166,7 +171,8 @@ int main(int argc, char** argv) {
   std::size_t points = 100000;
   std::vector<ParamShape> shapes = allParamShapes();
   std::vector<double> noises{0, 1e-3};
-  int scales = 50, resolution = 128, threads = 0;
+  int scales = 50, resolution = 128, threads = 0, relaxIterations = 5;
+  std::size_t relaxMaxSolve = RelaxationOptions{}.maxSolvePoints;
   bool peers = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -184,12 +190,17 @@ int main(int argc, char** argv) {
       resolution = std::stoi(argv[++i]);
     } else if (a == "--threads" && i + 1 < argc) {
       threads = std::stoi(argv[++i]);
+    } else if (a == "--relax-iterations" && i + 1 < argc) {
+      relaxIterations = std::stoi(argv[++i]);
+    } else if (a == "--relax-max-solve" && i + 1 < argc) {
+      relaxMaxSolve = std::stoul(argv[++i]);
     } else if (a == "--no-peers") {
       peers = false;
     } else {
       std::fprintf(stderr,
                    "usage: bench_parametrize [--points N] [--shapes a,b] [--noise 0,0.001] "
-                   "[--scales M] [--resolution R] [--no-peers] [--threads T]\n");
+                   "[--scales M] [--resolution R] [--no-peers] [--threads T] "
+                   "[--relax-iterations I] [--relax-max-solve N]\n");
       return 2;
     }
   }
@@ -210,29 +221,45 @@ int main(int argc, char** argv) {
       for (std::size_t i = 0; i < cloud.size(); ++i) positions[i] = cloud.absolutePosition(i);
       const std::vector<Vec3>& normals = cloud.normals();
 
+      // The thesis' map (no relaxation), then the relaxations of a plane domain: the default
+      // (rigid, robust), the conformal one (similarities) and the plain least-squares one.
       ParametrizationOptions options;
       options.flattening.scaleCount = scales;
+      options.relaxation.iterations = 0;
       const auto start = std::chrono::steady_clock::now();
-      const Parametrization ours = parametrize(positions, normals, options);
+      const Parametrization thesis = parametrize(positions, normals, options);
       const double seconds = secondsSince(start);
-      Score s = scoreMap("scalespace", positions, normals, ours.domain, seconds);
-      s.note = std::string(domainKindName(ours.domain.kind)) +
-               (ours.oneToOne ? "" : ", flagged not one-to-one");
-      print(name, noise, s);
-      if (ours.domain.kind == DomainKind::Plane) {
-        DomainMap relaxed = ours.domain;
-        const RelaxationResult r = relaxConformally(positions, normals, relaxed);
-        Score sr = scoreMap("scalespace+relax", positions, normals, relaxed, seconds + r.seconds);
-        sr.note = r.applied ? "relaxed in " + std::to_string(r.seconds) + " s" : r.reason;
-        print(name, noise, sr);
-        DomainMap rigid = ours.domain;
-        RelaxationOptions rigidOptions;
-        rigidOptions.rigid = true;
-        const RelaxationResult rr = relaxConformally(positions, normals, rigid, rigidOptions);
-        Score sg = scoreMap("scalespace+rigid", positions, normals, rigid, seconds + rr.seconds);
-        sg.note = rr.applied ? "relaxed in " + std::to_string(rr.seconds) + " s" : rr.reason;
-        print(name, noise, sg);
+      const std::string domainNote = std::string(domainKindName(thesis.domain.kind)) +
+                                     (thesis.oneToOne ? "" : ", flagged not one-to-one");
+      const bool relaxable = thesis.domain.kind == DomainKind::Plane && relaxIterations > 0;
+      struct Variant {
+        const char* method;
+        bool rigid;
+        int rounds;
+      };
+      const Variant variants[] = {{"scalespace", true, RelaxationOptions{}.rounds},
+                                  {"+conformal", false, RelaxationOptions{}.rounds},
+                                  {"+rigid-1round", true, 1}};
+      for (const Variant& v : variants) {
+        if (!relaxable && v.method != variants[0].method) continue;
+        DomainMap map = thesis.domain;
+        RelaxationOptions relax;
+        relax.iterations = relaxIterations;
+        relax.maxSolvePoints = relaxMaxSolve;
+        relax.rigid = v.rigid;
+        relax.rounds = v.rounds;
+        const RelaxationResult r =
+            relaxable ? relaxConformally(positions, normals, map, relax) : RelaxationResult{};
+        Score score = scoreMap(v.method, positions, normals, map, seconds + r.seconds);
+        score.note = domainNote;
+        if (relaxable)
+          score.note += r.applied ? ", relaxed in " + std::to_string(r.seconds) + " s"
+                                  : ", not relaxed: " + r.reason;
+        print(name, noise, score);
       }
+      Score plain = scoreMap("thesis", positions, normals, thesis.domain, seconds);
+      plain.note = domainNote;
+      print(name, noise, plain);
 
       const bool disk = topology == ParamTopology::Disk;
       const auto t0 = std::chrono::steady_clock::now();

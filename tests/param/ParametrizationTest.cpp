@@ -232,38 +232,115 @@ TEST(Parametrization, DuplicatePointsStillMap) {
     ASSERT_LT((p.domain.direction[i] - p.domain.direction[i + n]).norm(), 1e-9);
 }
 
-TEST(Parametrization, RelaxationLowersTheConformalDistortionWithoutFolds) {
+double medianAt16(const Cloud& c, const DomainMap& map, bool conformal) {
+  const DistortionAtSize d = measureDistortion(c.positions, c.normals, map, {{16}}).sizes[0];
+  return conformal ? d.medianConformal : d.medianAuthalic;
+}
+
+TEST(Parametrization, RelaxationLowersTheDistortionWithoutFolds) {
   const Cloud c = shape(ParamShape::Relief, 12000);
-  ParametrizationOptions plain = fewScales(), relaxed = fewScales();
-  relaxed.relaxation.iterations = 5;
-  const Parametrization a = parametrize(c.positions, c.normals, plain);
-  const Parametrization b = parametrize(c.positions, c.normals, relaxed);
-  ASSERT_EQ(a.domain.kind, DomainKind::Plane);
-  ASSERT_TRUE(b.relaxation.applied) << b.relaxation.reason;
-  EXPECT_EQ(b.defects.folds + b.defects.overlaps, 0u);
-  const DistortionOptions k16{{16}};
-  const double before =
-      measureDistortion(c.positions, c.normals, a.domain, k16).sizes[0].medianConformal;
-  const double after =
-      measureDistortion(c.positions, c.normals, b.domain, k16).sizes[0].medianConformal;
-  EXPECT_LT(after - 1, 0.5 * (before - 1)) << before << " -> " << after;
-  // As rigid as possible: the areas too come closer to the surface's.
-  ParametrizationOptions rigid = relaxed;
-  rigid.relaxation.rigid = true;
-  const Parametrization r = parametrize(c.positions, c.normals, rigid);
-  ASSERT_TRUE(r.relaxation.applied) << r.relaxation.reason;
-  const auto authalic = [&](const DomainMap& d) {
-    return measureDistortion(c.positions, c.normals, d, k16).sizes[0].medianAuthalic;
-  };
-  EXPECT_LT(authalic(r.domain) - 1, 0.5 * (authalic(a.domain) - 1));
-  EXPECT_EQ(r.defects.folds + r.defects.overlaps, 0u);
+  ParametrizationOptions thesisOptions = fewScales(), conformalOptions = fewScales();
+  thesisOptions.relaxation.iterations = 0;
+  conformalOptions.relaxation.rigid = false;
+  const Parametrization thesis = parametrize(c.positions, c.normals, thesisOptions);
+  ASSERT_EQ(thesis.domain.kind, DomainKind::Plane);
+  EXPECT_FALSE(thesis.relaxation.applied);
+  // Similarities: the conformal distortion falls.
+  const Parametrization conformal = parametrize(c.positions, c.normals, conformalOptions);
+  ASSERT_TRUE(conformal.relaxation.applied) << conformal.relaxation.reason;
+  EXPECT_EQ(conformal.defects.folds + conformal.defects.overlaps, 0u);
+  const double thesisConformal = medianAt16(c, thesis.domain, true);
+  EXPECT_LT(medianAt16(c, conformal.domain, true) - 1, 0.5 * (thesisConformal - 1));
+  // The default, as rigid as possible: both distortions fall.
+  const Parametrization rigid = parametrize(c.positions, c.normals, fewScales());
+  ASSERT_TRUE(rigid.relaxation.applied) << rigid.relaxation.reason;
+  EXPECT_EQ(rigid.defects.folds + rigid.defects.overlaps, 0u);
+  EXPECT_EQ(rigid.relaxation.solvedPoints, c.positions.size());
+  EXPECT_LT(medianAt16(c, rigid.domain, true) - 1, 0.5 * (thesisConformal - 1));
+  EXPECT_LT(medianAt16(c, rigid.domain, false) - 1,
+            0.5 * (medianAt16(c, thesis.domain, false) - 1));
+  // The defects reported are those of the relaxed map.
+  const MapDefects check = findMapDefects(c.positions, c.normals, rigid.domain);
+  EXPECT_EQ(check.fold, rigid.defects.fold);
+  EXPECT_EQ(check.overlap, rigid.defects.overlap);
   // A sphere domain is left alone, and says why.
   const Cloud closed = shape(ParamShape::Blob, 3000);
-  const Parametrization s = parametrize(closed.positions, closed.normals, relaxed);
+  const Parametrization s = parametrize(closed.positions, closed.normals, fewScales());
   EXPECT_FALSE(s.relaxation.applied);
   EXPECT_NE(s.relaxation.reason.find("plane domains"), std::string::npos);
-  RelaxationOptions bad;
-  bad.neighbors = 2;
-  DomainMap copy = a.domain;
-  EXPECT_THROW(relaxConformally(c.positions, c.normals, copy, bad), OptionError);
+  using Breaker = void (*)(RelaxationOptions&);
+  const Breaker breakers[] = {[](RelaxationOptions& o) { o.neighbors = 2; },
+                              [](RelaxationOptions& o) { o.rounds = 0; },
+                              [](RelaxationOptions& o) { o.maxDownweight = 0.5; },
+                              [](RelaxationOptions& o) { o.maxSolvePoints = 10; }};
+  for (Breaker bad : breakers) {
+    RelaxationOptions options;
+    bad(options);
+    DomainMap copy = thesis.domain;
+    EXPECT_THROW(relaxConformally(c.positions, c.normals, copy, options), OptionError);
+  }
+}
+
+TEST(Parametrization, RobustRoundsKeepABumpsMisfitOnTheBump) {
+  // One least-squares round spreads the relief's bumps as shear over its flat part; the robust
+  // rounds keep the flat part a similarity: lower medians, both of them.
+  const Cloud c = shape(ParamShape::Relief, 12000);
+  ParametrizationOptions oneRound = fewScales();
+  oneRound.relaxation.rounds = 1;
+  const Parametrization plain = parametrize(c.positions, c.normals, oneRound);
+  const Parametrization robust = parametrize(c.positions, c.normals, fewScales());
+  ASSERT_TRUE(plain.relaxation.applied && robust.relaxation.applied);
+  EXPECT_LT(medianAt16(c, robust.domain, true) - 1, 0.7 * (medianAt16(c, plain.domain, true) - 1));
+  EXPECT_LT(medianAt16(c, robust.domain, false), medianAt16(c, plain.domain, false));
+}
+
+TEST(Parametrization, ALargeCloudIsRelaxedOnASubsample) {
+  const Cloud c = shape(ParamShape::Relief, 12000);
+  ParametrizationOptions thesisOptions = fewScales(), sub = fewScales();
+  thesisOptions.relaxation.iterations = 0;
+  sub.relaxation.maxSolvePoints = 3000;
+  const Parametrization thesis = parametrize(c.positions, c.normals, thesisOptions);
+  const Parametrization full = parametrize(c.positions, c.normals, fewScales());
+  const Parametrization p = parametrize(c.positions, c.normals, sub);
+  ASSERT_TRUE(p.relaxation.applied) << p.relaxation.reason;
+  EXPECT_LE(p.relaxation.solvedPoints, 3000u);
+  EXPECT_GT(p.relaxation.solvedPoints, 1500u);
+  EXPECT_EQ(p.defects.folds + p.defects.overlaps, 0u);
+  // Nearly what the whole system gives, far below the thesis' map.
+  for (bool conformal : {true, false}) {
+    const double ours = medianAt16(c, p.domain, conformal) - 1;
+    EXPECT_LT(ours, 0.5 * (medianAt16(c, thesis.domain, conformal) - 1)) << conformal;
+    EXPECT_LT(ours, 2 * (medianAt16(c, full.domain, conformal) - 1) + 1e-3) << conformal;
+  }
+  // Identical for any thread count, the placement from the samples included.
+  ParametrizationOptions one = sub, two = sub;
+  one.flattening.threads = 1;
+  two.flattening.threads = 2;
+  const Parametrization a = parametrize(c.positions, c.normals, one);
+  const Parametrization b = parametrize(c.positions, c.normals, two);
+  ASSERT_EQ(a.domain.uv.size(), b.domain.uv.size());
+  for (std::size_t i = 0; i < a.domain.uv.size(); ++i)
+    ASSERT_EQ(a.domain.uv[i], b.domain.uv[i]) << i;
+}
+
+TEST(Parametrization, RelaxationReportsProgressAndCanBeCancelled) {
+  const Cloud c = shape(ParamShape::Relief, 6000);
+  ParametrizationOptions thesisOptions = fewScales();
+  thesisOptions.relaxation.iterations = 0;
+  const Parametrization thesis = parametrize(c.positions, c.normals, thesisOptions);
+  double last = -1;
+  bool increasing = true;
+  DomainMap map = thesis.domain;
+  relaxConformally(c.positions, c.normals, map, {}, [&](double f, std::string_view) {
+    increasing = increasing && f >= last - 1e-12 && f <= 1;
+    last = f;
+    return true;
+  });
+  EXPECT_TRUE(increasing);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  DomainMap untouched = thesis.domain;
+  EXPECT_THROW(relaxConformally(c.positions, c.normals, untouched, {},
+                                [](double f, std::string_view) { return f < 0.5; }),
+               Cancelled);
+  EXPECT_EQ(untouched.uv, thesis.domain.uv);
 }

@@ -105,13 +105,19 @@ void addParametrizeCommand(CLI::App& app) {
                   "pyramid decimation: samples at least 2 alpha t apart (Sec. 1.5.2)")
       ->capture_default_str();
   cmd->add_option("--relax", args->options.relaxation.iterations,
-                  "beyond the thesis: local-global iterations that lower the conformal "
-                  "distortion of a plane domain (0: none); not applied if it would add folds")
+                  "beyond the thesis: local-global iterations per round that lower the "
+                  "distortion of a plane domain (0: none, the thesis' map); not applied if it "
+                  "would add folds or overlaps")
       ->capture_default_str();
-  cmd->add_flag("--rigid", args->options.relaxation.rigid,
-                "with --relax: rotations instead of similarities (as rigid as possible): keeps "
+  cmd->add_option("--relax-rounds", args->options.relaxation.rounds,
+                  "robust re-weighting rounds of the relaxation (1: plain least squares, which "
+                  "spreads a bump's misfit as shear over the whole map)")
+      ->capture_default_str();
+  cmd->add_flag("--rigid,!--conformal", args->options.relaxation.rigid,
+                "the relaxation's local maps: rotations (--rigid, as rigid as possible: keeps "
                 "lengths, so areas too, where the surface allows, and gives the domain the "
-                "surface's units");
+                "surface's units) or similarities (--conformal: angles only, areas drift)")
+      ->capture_default_str();
   cmd->add_option("--flattened", args->flattened,
                   "also write the flowed points, on their sphere or plane, to this cloud");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
@@ -195,7 +201,9 @@ void addParametrizeCommand(CLI::App& app) {
                                  {"invalid_points", result.invalid},
                                  {"relaxation",
                                   {{"iterations", args->options.relaxation.iterations},
+                                   {"rounds", args->options.relaxation.rounds},
                                    {"rigid", args->options.relaxation.rigid},
+                                   {"solved_points", result.relaxation.solvedPoints},
                                    {"applied", result.relaxation.applied},
                                    {"reason", result.relaxation.reason},
                                    {"seconds", result.relaxation.seconds}}},

@@ -74,6 +74,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FlatteningOptions::tMax", "--tmax"},
     {"DistortionOptions::neighbors", "--scales-k"},
     {"RelaxationOptions::iterations", "--relax"},
+    {"RelaxationOptions::rounds", "--relax-rounds"},
     {"the thread count (threads option)", "--threads"},
     {"findSimilar: no component", "--similar: no component"},
 };

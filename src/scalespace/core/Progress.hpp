@@ -68,4 +68,13 @@ class ProgressTracker {
   std::mutex mutex_;
 };
 
+/// The part [from, to] of a progress callback, for one stage of a longer operation (empty when
+/// `progress` is).
+inline ProgressCallback subProgress(const ProgressCallback& progress, double from, double to) {
+  if (!progress) return {};
+  return [progress, from, to](double f, std::string_view stage) {
+    return progress(from + f * (to - from), stage);
+  };
+}
+
 }  // namespace scalespace

@@ -2,6 +2,7 @@
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -11,6 +12,7 @@
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/param/LocalMapSample.hpp"
 #include "scalespace/param/MapDefects.hpp"
+#include "scalespace/scales/PoissonDiskSampler.hpp"
 
 namespace scalespace {
 namespace {
@@ -25,12 +27,334 @@ double spread(const std::vector<Vec2>& uv, Vec2& centroid) {
   return std::sqrt(sum / double(uv.size()));
 }
 
+double lowerMedianOf(std::vector<double> values) {
+  const auto middle = values.begin() + std::ptrdiff_t((values.size() - 1) / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+/// The k-NN graph of the points being relaxed, fixed for every iteration: per point its k
+/// neighbours, their tangent-plane offsets a_ij (mirrored when the map is), the kernel weights
+/// w_ij, and the map from a 3D offset to those tangent coordinates (for the points placed from
+/// a subsample).
+struct RelaxationGraph {
+  std::size_t n = 0, k = 0;
+  std::vector<Index> neighbor;
+  std::vector<Vec2> offset;
+  std::vector<double> weight;
+  std::vector<Eigen::Matrix<double, 2, 3>> toTangent;
+};
+
+RelaxationGraph gatherGraph(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                            const DomainMap& domain, std::size_t k, double mirror) {
+  RelaxationGraph g;
+  g.n = positions.size();
+  g.k = k;
+  g.neighbor.resize(g.n * k);
+  g.offset.resize(g.n * k);
+  g.weight.assign(g.n * k, 0.0);
+  g.toTangent.resize(g.n);
+  const auto index = makeSpatialIndex(positions);
+  ProgressTracker gathering({}, "neighbours", g.n);
+  forEachLocalMap(positions, normals, *index, domain, k + 1, gathering,
+                  [&](std::size_t i, const LocalMapSample& sample, LocalMapSample&) {
+                    // A mirrored map is matched by anti-similarities: mirror a first.
+                    g.toTangent[i].row(0) = sample.t1.transpose();
+                    g.toTangent[i].row(1) = mirror * sample.t2.transpose();
+                    std::size_t e = 0;
+                    for (std::size_t s = 0; s < sample.index.size() && e < k; ++s) {
+                      if (sample.index[s] == i) continue;
+                      g.neighbor[i * k + e] = sample.index[s];
+                      g.offset[i * k + e] =
+                          Vec2(sample.tangent[s].x(), mirror * sample.tangent[s].y());
+                      g.weight[i * k + e] = sample.weight[s] + 1e-12;
+                      ++e;
+                    }
+                    for (; e < k; ++e) {  // duplicates of i filled the neighbourhood
+                      g.neighbor[i * k + e] = Index(i);
+                      g.weight[i * k + e] = 0;
+                    }
+                  });
+  return g;
+}
+
+/// The graph Laplacian with edge weights w_ij rho_i: each directed edge i -> j adds w to L_ii,
+/// L_jj and -w to L_ij, L_ji; a small diagonal term `pin` pins the translation.
+Eigen::SparseMatrix<double> laplacianOf(const RelaxationGraph& g, const std::vector<double>& rho,
+                                        double& pin) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(g.n * g.k * 4 + g.n);
+  double meanDiagonal = 0;
+  for (std::size_t i = 0; i < g.n; ++i)
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const std::size_t j = g.neighbor[i * g.k + e];
+      const double w = g.weight[i * g.k + e] * rho[i];
+      if (j == i || !(w > 0)) continue;
+      triplets.emplace_back(int(i), int(i), w);
+      triplets.emplace_back(int(j), int(j), w);
+      triplets.emplace_back(int(i), int(j), -w);
+      triplets.emplace_back(int(j), int(i), -w);
+      meanDiagonal += 2 * w;
+    }
+  meanDiagonal /= double(g.n);
+  pin = 1e-6 * meanDiagonal;
+  for (std::size_t i = 0; i < g.n; ++i) triplets.emplace_back(int(i), int(i), pin);
+  Eigen::SparseMatrix<double> laplacian(Eigen::Index(g.n), Eigen::Index(g.n));
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  return laplacian;
+}
+
+/// The local step: per point the similarity (or rotation) best taking a_ij to u_j - u_i. In
+/// complex form S_i = (a + ib) = sum w conj(x) y / sum w |x|^2.
+void fitSimilarities(const RelaxationGraph& g, const std::vector<Vec2>& uv, bool rigid,
+                     std::vector<Eigen::Matrix2d>& similarity) {
+  parallelFor(g.n, [&](std::size_t i) {
+    double a = 0, b = 0, norm = 0;
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const double w = g.weight[i * g.k + e];
+      const Vec2& x = g.offset[i * g.k + e];
+      const Vec2 y = uv[g.neighbor[i * g.k + e]] - uv[i];
+      a += w * (x.x() * y.x() + x.y() * y.y());
+      b += w * (x.x() * y.y() - x.y() * y.x());
+      norm += w * x.squaredNorm();
+    }
+    if (rigid) {
+      // The rotation of the similarity (its angle), at unit scale: as rigid as possible.
+      const double length = std::hypot(a, b);
+      a = length > 0 ? a / length : 1;
+      b = length > 0 ? b / length : 0;
+    } else if (norm > 0) {
+      a /= norm;
+      b /= norm;
+    }
+    similarity[i] << a, -b, b, a;
+  });
+}
+
+/// The robust weights for the next round: rho_i = min(1, median / residual_i), at least
+/// 1 / maxDownweight, residual_i the point's RMS misfit relative to its offsets' lengths.
+std::vector<double> robustWeights(const RelaxationGraph& g, const std::vector<Vec2>& uv,
+                                  const std::vector<Eigen::Matrix2d>& similarity,
+                                  double maxDownweight) {
+  std::vector<double> residual(g.n, 0.0);
+  parallelFor(g.n, [&](std::size_t i) {
+    double misfit = 0, length = 0;
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const double w = g.weight[i * g.k + e];
+      const Vec2& a = g.offset[i * g.k + e];
+      misfit += w * (uv[g.neighbor[i * g.k + e]] - uv[i] - similarity[i] * a).squaredNorm();
+      length += w * a.squaredNorm();
+    }
+    residual[i] = length > 0 ? std::sqrt(misfit / length) : 0;
+  });
+  const double median = lowerMedianOf(residual);
+  std::vector<double> rho(g.n, 1.0);
+  if (!(median > 0)) return rho;
+  for (std::size_t i = 0; i < g.n; ++i)
+    rho[i] = std::max(1.0 / maxDownweight, std::min(1.0, median / residual[i]));
+  return rho;
+}
+
+/// Relaxes `uv` (the graph's points) in place; `similarity` gets the final local similarities.
+/// Returns an empty string, or why the relaxation could not run.
+std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& options,
+                         std::vector<Vec2>& uv, std::vector<Eigen::Matrix2d>& similarity,
+                         ProgressTracker& tracker) {
+  Vec2 centroid;
+  const double size = spread(uv, centroid);
+  similarity.assign(g.n, Eigen::Matrix2d::Identity());
+  std::vector<double> rho(g.n, 1.0);
+  // The matrix's pattern does not change between rounds (every weight stays > 0): ordered once,
+  // factorized once per round. (Conjugate gradients from the current map were slower at 100k
+  // and at 1M points: the pinned graph Laplacian is badly conditioned, bench/README.md.)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  for (int round = 0; round < options.rounds; ++round) {
+    if (round > 0) rho = robustWeights(g, uv, similarity, options.maxDownweight);
+    double pin = 0;
+    const Eigen::SparseMatrix<double> laplacian = laplacianOf(g, rho, pin);
+    if (round == 0) solver.analyzePattern(laplacian);
+    solver.factorize(laplacian);
+    if (solver.info() != Eigen::Success)
+      return "the k-NN graph's Laplacian could not be factorized";
+    for (int iteration = 0; iteration < options.iterations; ++iteration) {
+      fitSimilarities(g, uv, options.rigid, similarity);
+      // Global: rhs_m = sum_{i->m} w rho_i S_i a_im - sum_{m->j} w rho_m S_m a_mj (+ pin u_m).
+      Eigen::MatrixXd rhs(int(g.n), 2);
+      for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * uv[i].transpose();
+      for (std::size_t i = 0; i < g.n; ++i)
+        for (std::size_t e = 0; e < g.k; ++e) {
+          const std::size_t j = g.neighbor[i * g.k + e];
+          const double w = g.weight[i * g.k + e] * rho[i];
+          if (j == i || !(w > 0)) continue;
+          const Vec2 r = similarity[i] * g.offset[i * g.k + e];
+          rhs.row(int(j)) += w * r.transpose();
+          rhs.row(int(i)) -= w * r.transpose();
+        }
+      const Eigen::MatrixXd solved = solver.solve(rhs);
+      // The similarity energy has no scale of its own: keep the domain's spread and centroid
+      // (the rigid one takes the surface's lengths).
+      std::vector<Vec2> next(g.n);
+      for (std::size_t i = 0; i < g.n; ++i) next[i] = solved.row(int(i)).transpose();
+      Vec2 c;
+      const double s = spread(next, c);
+      if (!(s > 0) || !std::isfinite(s)) return "the relaxation collapsed the domain";
+      const double factor = options.rigid ? 1.0 : size / s;
+      for (std::size_t i = 0; i < g.n; ++i) uv[i] = centroid + (next[i] - c) * factor;
+      tracker.advance(1);
+    }
+  }
+  fitSimilarities(g, uv, options.rigid, similarity);
+  return {};
+}
+
+/// Per point the linear map (any 2 x 2) that best takes a_ij to u_j - u_i: the relaxed map's
+/// own Jacobian, scale and shear included, which places the points between samples
+/// consistently with where the samples landed.
+std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, const std::vector<Vec2>& uv) {
+  std::vector<Eigen::Matrix2d> jacobian(g.n);
+  parallelFor(g.n, [&](std::size_t i) {
+    Eigen::Matrix2d xx = Eigen::Matrix2d::Zero(), yx = Eigen::Matrix2d::Zero();
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const double w = g.weight[i * g.k + e];
+      const Vec2& x = g.offset[i * g.k + e];
+      xx += w * x * x.transpose();
+      yx += w * (uv[g.neighbor[i * g.k + e]] - uv[i]) * x.transpose();
+    }
+    // xx is symmetric positive semi-definite: its inverse in closed form, when it has one.
+    const double det = xx(0, 0) * xx(1, 1) - xx(0, 1) * xx(1, 0);
+    if (!(det > 1e-12 * xx.squaredNorm())) {
+      jacobian[i] = Eigen::Matrix2d::Identity();
+      return;
+    }
+    Eigen::Matrix2d inverse;
+    inverse << xx(1, 1), -xx(0, 1), -xx(1, 0), xx(0, 0);
+    jacobian[i] = yx * (inverse / det);
+  });
+  return jacobian;
+}
+
+/// Local-global iterations whose global step is `sweeps` damped Jacobi sweeps of the system from
+/// the current map instead of a solve: after the placement from a subsample, they remove the
+/// error finer than the samples' spacing (a smoother's job: a two-grid scheme), at the cost of a
+/// few passes over the edges. Deterministic (sequential accumulation).
+constexpr int kSmoothingIterations = 2, kSmoothingSweeps = 3;
+
+void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, int iterations,
+                   int sweeps, std::vector<Vec2>& uv) {
+  Vec2 centroid;
+  const double size = spread(uv, centroid);
+  std::vector<Eigen::Matrix2d> similarity(g.n, Eigen::Matrix2d::Identity());
+  fitSimilarities(g, uv, options.rigid, similarity);
+  const std::vector<double> rho = options.rounds > 1
+                                      ? robustWeights(g, uv, similarity, options.maxDownweight)
+                                      : std::vector<double>(g.n, 1.0);
+  std::vector<double> diagonal(g.n, 0.0);
+  for (std::size_t i = 0; i < g.n; ++i)
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const std::size_t j = g.neighbor[i * g.k + e];
+      const double w = g.weight[i * g.k + e] * rho[i];
+      if (j == i || !(w > 0)) continue;
+      diagonal[i] += w;
+      diagonal[j] += w;
+    }
+  constexpr double kDamping = 0.7;
+  std::vector<Vec2> sum(g.n);
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    if (iteration > 0) fitSimilarities(g, uv, options.rigid, similarity);
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      // Row m of L u = rhs solved for u_m: u_m = (rhs_m + sum_{edges m-j} w u_j) / L_mm.
+      std::fill(sum.begin(), sum.end(), Vec2::Zero());
+      for (std::size_t i = 0; i < g.n; ++i)
+        for (std::size_t e = 0; e < g.k; ++e) {
+          const std::size_t j = g.neighbor[i * g.k + e];
+          const double w = g.weight[i * g.k + e] * rho[i];
+          if (j == i || !(w > 0)) continue;
+          const Vec2 r = similarity[i] * g.offset[i * g.k + e];
+          sum[j] += w * (uv[i] + r);
+          sum[i] += w * (uv[j] - r);
+        }
+      for (std::size_t i = 0; i < g.n; ++i)
+        if (diagonal[i] > 0) uv[i] += kDamping * (sum[i] / diagonal[i] - uv[i]);
+    }
+  }
+  Vec2 c;
+  const double s = spread(uv, c);
+  const double factor = options.rigid || !(s > 0) ? 1.0 : size / s;
+  for (Vec2& p : uv) p = centroid + (p - c) * factor;
+}
+
+/// About `target` points of the cloud, Poisson-disk spaced. The separation comes from the
+/// points' density (10 neighbours within the median 10-NN radius) and a random packing's count
+/// (about 0.7 area / separation^2); it is widened until the sample fits.
+std::vector<Index> solveSubsample(const std::vector<Vec3>& positions, std::size_t target) {
+  const std::size_t n = positions.size();
+  const auto index = makeSpatialIndex(positions);
+  const std::size_t stride = std::max<std::size_t>(1, n / 20000);
+  std::vector<double> radii;
+  std::vector<Neighbor> neighbors;
+  for (std::size_t i = 0; i < n; i += stride) {
+    index->knnSearch(positions[i], 11, neighbors);
+    radii.push_back(std::sqrt(neighbors.back().distSq));
+  }
+  const double r10 = lowerMedianOf(radii);
+  const double area = double(n) * std::acos(-1.0) * r10 * r10 / 10;
+  double separation = std::sqrt(0.7 * area / (0.8 * double(target)));
+  std::vector<Index> all(n);
+  for (std::size_t i = 0; i < n; ++i) all[i] = Index(i);
+  std::vector<Index> sample;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    sample = poissonDiskSample(positions, all, separation, 1);
+    if (sample.size() <= target) break;
+    separation *= std::sqrt(double(sample.size()) / (0.8 * double(target)));
+  }
+  return sample;
+}
+
+/// Every point placed by the local maps of its 4 nearest samples: u = sum_s w_s (u_s +
+/// J_s T_s (p - p_s)) / sum_s w_s, with the kernel of Eq. 1.6 over 1.5 x the 4th distance.
+std::vector<Vec2> placeFromSamples(const std::vector<Vec3>& positions,
+                                   const std::vector<Index>& sample,
+                                   const std::vector<Vec3>& samplePositions,
+                                   const RelaxationGraph& g, const std::vector<Vec2>& sampleUv,
+                                   const std::vector<Eigen::Matrix2d>& jacobian) {
+  const auto index = makeSpatialIndex(samplePositions);
+  std::vector<Vec2> uv(positions.size());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, positions.size(), 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Neighbor> near;
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          index->knnSearch(positions[i], 4, near);
+          const double r2 = 2.25 * near.back().distSq;
+          Vec2 sum = Vec2::Zero();
+          double total = 0;
+          for (const Neighbor& s : near) {
+            const double x = r2 > 0 ? 1 - s.distSq / r2 : 1;
+            const double w = x * x * x * x + 1e-300;
+            const Vec3 d = positions[i] - samplePositions[s.index];
+            sum += w * (sampleUv[s.index] + jacobian[s.index] * (g.toTangent[s.index] * d));
+            total += w;
+          }
+          uv[i] = sum / total;
+        }
+      });
+  for (std::size_t s = 0; s < sample.size(); ++s) uv[sample[s]] = sampleUv[s];
+  return uv;
+}
+
 }  // namespace
 
 void validateRelaxationOptions(const RelaxationOptions& options) {
   if (options.iterations < 0) throw OptionError("RelaxationOptions::iterations must be >= 0");
   if (options.neighbors < 3 || options.neighbors > 64)
     throw OptionError("RelaxationOptions::neighbors must be in [3, 64]");
+  if (options.rounds < 1 || options.rounds > 20)
+    throw OptionError("RelaxationOptions::rounds must be in [1, 20]");
+  if (!(options.maxDownweight >= 1) || !std::isfinite(options.maxDownweight))
+    throw OptionError("RelaxationOptions::maxDownweight must be finite and >= 1");
+  if (options.maxSolvePoints < 1000)
+    throw OptionError("RelaxationOptions::maxSolvePoints must be >= 1000");
+  validateMapDefectOptions(options.defects);
 }
 
 RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
@@ -51,130 +375,56 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     result.reason = options.iterations == 0 ? "no iteration asked" : "too few points";
     return result;
   }
-  const MapDefects before = findMapDefects(positions, normals, domain);
+  // Progress: the check before [0, 0.25], the relaxation [0.25, 0.75], the check after.
+  result.defects =
+      findMapDefects(positions, normals, domain, options.defects, subProgress(progress, 0, 0.25));
+  const MapDefects& before = result.defects;
   result.foldsBefore = before.folds;
   const double mirror = before.majoritySign < 0 ? -1.0 : 1.0;
 
-  // The k-NN graph with the tangent offsets a_ij and weights w_ij (fixed for every iteration).
-  const std::size_t k = std::size_t(options.neighbors);
-  std::vector<Index> neighbor(n * k);
-  std::vector<Vec2> offset(n * k);
-  std::vector<double> weight(n * k, 0.0);
-  {
-    const auto index = makeSpatialIndex(positions);
-    ProgressTracker gathering({}, "neighbours", n);
-    forEachLocalMap(positions, normals, *index, domain, k + 1, gathering,
-                    [&](std::size_t i, const LocalMapSample& sample, LocalMapSample&) {
-                      std::size_t e = 0;
-                      for (std::size_t s = 0; s < sample.index.size() && e < k; ++s) {
-                        if (sample.index[s] == i) continue;
-                        neighbor[i * k + e] = sample.index[s];
-                        // A mirrored map is matched by anti-similarities: mirror a first.
-                        offset[i * k + e] =
-                            Vec2(sample.tangent[s].x(), mirror * sample.tangent[s].y());
-                        weight[i * k + e] = sample.weight[s] + 1e-12;
-                        ++e;
-                      }
-                      for (; e < k; ++e) {  // duplicates of i filled the neighbourhood
-                        neighbor[i * k + e] = Index(i);
-                        weight[i * k + e] = 0;
-                      }
-                    });
-  }
-  // L u = rhs: each directed edge i -> j adds w to L_ii, L_jj and -w to L_ij, L_ji; a small
-  // diagonal term pins the translation (the rhs gets the same times the current position).
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(n * k * 4 + n);
-  double meanDiagonal = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t e = 0; e < k; ++e) {
-      const std::size_t j = neighbor[i * k + e];
-      const double w = weight[i * k + e];
-      if (j == i || !(w > 0)) continue;
-      triplets.emplace_back(int(i), int(i), w);
-      triplets.emplace_back(int(j), int(j), w);
-      triplets.emplace_back(int(i), int(j), -w);
-      triplets.emplace_back(int(j), int(i), -w);
-      meanDiagonal += 2 * w;
+  // The system's points: all of them, or a Poisson-disk subsample of a large cloud.
+  const bool subsampled = n > options.maxSolvePoints;
+  std::vector<Index> sample;
+  if (subsampled) sample = solveSubsample(positions, options.maxSolvePoints);
+  std::vector<Vec3> solvePositions, solveNormals;
+  DomainMap solveDomain;
+  if (subsampled) {
+    solveDomain.kind = DomainKind::Plane;
+    for (Index i : sample) {
+      solvePositions.push_back(positions[i]);
+      if (!normals.empty()) solveNormals.push_back(normals[i]);
+      solveDomain.uv.push_back(domain.uv[i]);
     }
-  meanDiagonal /= double(n);
-  const double pin = 1e-6 * meanDiagonal;
-  for (std::size_t i = 0; i < n; ++i) triplets.emplace_back(int(i), int(i), pin);
-  const Eigen::Index rows = Eigen::Index(n);
-  Eigen::SparseMatrix<double> laplacian(rows, rows);
-  laplacian.setFromTriplets(triplets.begin(), triplets.end());
-  triplets = {};
-  // The matrix does not change between iterations: factorized once. (Conjugate gradients from
-  // the current map were slower at 100k and at 1M points: the pinned graph Laplacian is badly
-  // conditioned, bench/README.md.)
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
-  if (solver.info() != Eigen::Success) {
-    result.reason = "the k-NN graph's Laplacian could not be factorized";
+  }
+  const std::vector<Vec3>& p = subsampled ? solvePositions : positions;
+  const std::vector<Vec3>& m = subsampled ? solveNormals : normals;
+  const DomainMap& d = subsampled ? solveDomain : domain;
+  if (p.size() < std::size_t(options.neighbors) + 1) {
+    result.reason = "too few points";
     return result;
   }
+  result.solvedPoints = p.size();
+  const RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), mirror);
 
-  std::vector<Vec2> uv = domain.uv;
-  Vec2 centroid;
-  const double size = spread(uv, centroid);
-  ProgressTracker tracker(progress, "relaxation", std::size_t(options.iterations));
-  std::vector<Eigen::Matrix2d> similarity(n);
-  for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    // Local: S_i = [[a, -b], [b, a]], (a + ib) = sum w conj(x) y / sum w |x|^2 in complex form.
-    parallelFor(n, [&](std::size_t i) {
-      double a = 0, b = 0, norm = 0;
-      for (std::size_t e = 0; e < k; ++e) {
-        const double w = weight[i * k + e];
-        const Vec2& x = offset[i * k + e];
-        const Vec2 y = uv[neighbor[i * k + e]] - uv[i];
-        a += w * (x.x() * y.x() + x.y() * y.y());
-        b += w * (x.x() * y.y() - x.y() * y.x());
-        norm += w * x.squaredNorm();
-      }
-      Eigen::Matrix2d s;
-      if (options.rigid) {
-        // The rotation of the similarity (its angle), at unit scale: as rigid as possible.
-        const double length = std::hypot(a, b);
-        a = length > 0 ? a / length : 1;
-        b = length > 0 ? b / length : 0;
-      } else if (norm > 0) {
-        a /= norm;
-        b /= norm;
-      }
-      s << a, -b, b, a;
-      similarity[i] = s;
-    });
-    // Global: rhs_m = sum_{i->m} w S_i a_im - sum_{m->j} w S_m a_mj (+ pin u_m).
-    Eigen::MatrixXd rhs(int(n), 2);
-    for (std::size_t i = 0; i < n; ++i) rhs.row(int(i)) = pin * uv[i].transpose();
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t e = 0; e < k; ++e) {
-        const std::size_t j = neighbor[i * k + e];
-        const double w = weight[i * k + e];
-        if (j == i || !(w > 0)) continue;
-        const Vec2 r = similarity[i] * offset[i * k + e];
-        rhs.row(int(j)) += w * r.transpose();
-        rhs.row(int(i)) -= w * r.transpose();
-      }
-    const Eigen::MatrixXd solved = solver.solve(rhs);
-    // The similarity energy has no scale of its own: keep the domain's spread and centroid
-    // (the rigid one takes the surface's lengths).
-    std::vector<Vec2> next(n);
-    for (std::size_t i = 0; i < n; ++i) next[i] = solved.row(int(i)).transpose();
-    Vec2 c;
-    const double s = spread(next, c);
-    if (!(s > 0) || !std::isfinite(s)) {
-      result.reason = "the relaxation collapsed the domain";
-      return result;
-    }
-    const double factor = options.rigid ? 1.0 : size / s;
-    for (std::size_t i = 0; i < n; ++i) uv[i] = centroid + (next[i] - c) * factor;
-    tracker.advance(1);
-  }
+  ProgressTracker tracker(subProgress(progress, 0.25, 0.75), "relaxation",
+                          std::size_t(options.iterations) * std::size_t(options.rounds));
+  std::vector<Vec2> uv = d.uv;
+  std::vector<Eigen::Matrix2d> similarity;
+  result.reason = relaxOnGraph(graph, options, uv, similarity, tracker);
+  if (!result.reason.empty()) return result;
   tracker.finish();
 
   DomainMap relaxed = domain;
-  relaxed.uv = std::move(uv);
-  const MapDefects after = findMapDefects(positions, normals, relaxed);
+  if (subsampled) {
+    relaxed.uv = placeFromSamples(positions, sample, p, graph, uv, localJacobians(graph, uv));
+    const RelaxationGraph fine =
+        gatherGraph(positions, normals, relaxed, std::size_t(options.neighbors), mirror);
+    smoothOnGraph(fine, options, kSmoothingIterations, kSmoothingSweeps, relaxed.uv);
+  } else {
+    relaxed.uv = std::move(uv);
+  }
+  MapDefects after =
+      findMapDefects(positions, normals, relaxed, options.defects, subProgress(progress, 0.75, 1));
   result.foldsAfter = after.folds;
   if (after.folds + after.overlaps > before.folds + before.overlaps) {
     result.reason = "the relaxation would add folds or overlaps (" +
@@ -183,6 +433,7 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     return result;
   }
   domain = std::move(relaxed);
+  result.defects = std::move(after);
   result.applied = true;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -6,35 +6,60 @@
 //   local:  per point, the similarity S_i (rotation and scale, or an anti-similarity where the
 //           map is mirrored) that best takes its neighbours' tangent-plane offsets a_ij to their
 //           domain offsets u_j - u_i;
-//   global: the domain positions minimizing sum_i sum_j w_ij |u_j - u_i - S_i a_ij|^2, a sparse
-//           Laplacian system whose matrix does not change between iterations (factorized once;
-//           about 1.5 s at 100k points, 96 s at 1M: meant for clouds up to a few 100k points).
+//   global: the domain positions minimizing sum_i rho_i sum_j w_ij |u_j - u_i - S_i a_ij|^2, a
+//           sparse Laplacian system whose matrix does not change between the iterations of a
+//           round (factorized once per round).
+// Robust rounds (iteratively re-weighted least squares): after each round a point whose
+// residual exceeds the median weighs rho_i = median / residual (at least 1 / maxDownweight).
+// A least-squares energy spreads the misfit of a curved patch (a bump's excess area) as shear
+// over the whole domain; the re-weighting keeps it on the patch, so the rest of the map stays
+// a similarity where the surface is flat (bench/README.md, bench_parametrize).
+// Large clouds: the system is solved on a Poisson-disk subsample of about maxSolvePoints
+// points (the factorization's fill grows faster than the point count), and every other point
+// is placed by the local similarities of its nearest samples.
 // The domain's size is kept (RMS distance to the centroid) so the scale-free energy cannot
-// shrink it. A relaxation that would add folds (MapDefects) is not applied.
+// shrink it. A relaxation that would add folds or overlaps (MapDefects) is not applied.
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/core/Types.hpp"
+#include "scalespace/param/MapDefects.hpp"
 #include "scalespace/param/ParamDomain.hpp"
 
 namespace scalespace {
 
 struct RelaxationOptions {
-  int iterations = 5;  // local-global iterations (0: none)
+  int iterations = 5;  // local-global iterations per round (0: no relaxation)
   int neighbors = 10;  // k of the k-NN graph
+  /// Rounds of robust re-weighting (1: plain least squares, as the first relaxation was).
+  int rounds = 3;
+  /// The smallest robust weight is 1 / maxDownweight (>= 1).
+  double maxDownweight = 10;
+  /// Above this many points the system is solved on a Poisson-disk subsample of about this
+  /// size (>= 1000).
+  std::size_t maxSolvePoints = 200000;
   /// Rotations instead of similarities ("as rigid as possible"): the map then also keeps the
-  /// surface's lengths where it can, which lowers the authalic distortion as well on nearly
-  /// developable surfaces, and gives the domain the surface's units.
-  bool rigid = false;
+  /// surface's lengths where it can, which lowers the authalic distortion as well, and gives the
+  /// domain the surface's units. false: similarities, the conformal energy alone (its areas
+  /// drift: bench/README.md).
+  bool rigid = true;
+  /// The fold and overlap check of the map before and after (a relaxation that adds defects is
+  /// not applied).
+  MapDefectOptions defects;
 };
 
-/// OptionError naming the field unless iterations >= 0 and 3 <= neighbors <= 64.
+/// OptionError naming the field unless iterations >= 0, 3 <= neighbors <= 64, 1 <= rounds <= 20,
+/// maxDownweight >= 1 (finite) and maxSolvePoints >= 1000.
 void validateRelaxationOptions(const RelaxationOptions& options);
 
 struct RelaxationResult {
   bool applied = false;  // false: not a plane domain, no iteration, or it would add folds
   std::string reason;    // why not, when not applied
   std::size_t foldsBefore = 0, foldsAfter = 0;
+  std::size_t solvedPoints = 0;  // the points of the system (a subsample of a large cloud)
+  /// The defects of the map left in `domain` (relaxed or not); empty when the map was not
+  /// checked (not a plane domain, no iteration).
+  MapDefects defects;
   double seconds = 0;
 };
 

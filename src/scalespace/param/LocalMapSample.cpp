@@ -41,7 +41,8 @@ void gatherLocalMap(std::size_t i, std::size_t k, const std::vector<Vec3>& posit
     }
     n = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0);
   }
-  Vec3 t1, t2;
+  Vec3& t1 = sample.t1;
+  Vec3& t2 = sample.t2;
   tangentBasisOf(n.normalized(), t1, t2);
   sample.tangent.resize(count);
   sample.domain.resize(count);
@@ -61,6 +62,8 @@ void gatherLocalMap(std::size_t i, std::size_t k, const std::vector<Vec3>& posit
 
 void truncateLocalMap(const LocalMapSample& from, std::size_t k, LocalMapSample& to) {
   const std::size_t count = std::min(k, from.index.size());
+  to.t1 = from.t1;
+  to.t2 = from.t2;
   to.tangent.assign(from.tangent.begin(), from.tangent.begin() + count);
   to.domain.assign(from.domain.begin(), from.domain.begin() + count);
   to.distance.assign(from.distance.begin(), from.distance.begin() + count);

@@ -19,9 +19,10 @@ struct LocalMapSample {
   std::vector<Vec2> tangent;  // p_j - p_i in the tangent plane at p_i (basis t1 x t2 = n_i)
   std::vector<Vec2> domain;   // where j lands seen from i in the domain (DomainMap::localOffset)
   std::vector<double> weight;
-  std::vector<double> distance;  // |p_j - p_i| in 3D
-  std::vector<Index> index;      // j
-  double radius = 0;             // support of the weights
+  std::vector<double> distance;                 // |p_j - p_i| in 3D
+  std::vector<Index> index;                     // j
+  double radius = 0;                            // support of the weights
+  Vec3 t1 = Vec3::UnitX(), t2 = Vec3::UnitY();  // the tangent basis of `tangent`
 };
 
 /// The k nearest neighbours of point i in 3D (i itself included), weighted by the kernel of

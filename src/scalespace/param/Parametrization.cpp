@@ -15,14 +15,6 @@ std::string percent(std::size_t part, std::size_t whole) {
   return text;
 }
 
-/// The part [from, to] of a progress callback.
-ProgressCallback subProgress(const ProgressCallback& progress, double from, double to) {
-  if (!progress) return {};
-  return [progress, from, to](double f, std::string_view stage) {
-    return progress(from + f * (to - from), stage);
-  };
-}
-
 }  // namespace
 
 Parametrization parametrize(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
@@ -38,17 +30,23 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
   Parametrization result;
   const bool relax = options.relaxation.iterations > 0;
   result.flattening = flattenScaleSpace(positions, normals, options.flattening,
-                                        subProgress(progress, 0, relax ? 0.8 : 0.9));
+                                        subProgress(progress, 0, relax ? 0.75 : 0.9));
   result.domain = mapToDomain(result.flattening, options.domain);
   result.warnings = result.domain.warnings;
   if (relax) {
-    result.relaxation = relaxConformally(positions, normals, result.domain, options.relaxation,
-                                         subProgress(progress, 0.8, 0.9));
-    if (!result.relaxation.applied)
+    RelaxationOptions relaxation = options.relaxation;
+    relaxation.defects = options.defects;
+    result.relaxation = relaxConformally(positions, normals, result.domain, relaxation,
+                                         subProgress(progress, 0.75, 1));
+    if (!result.relaxation.applied && result.domain.kind == DomainKind::Plane)
       result.warnings.push_back("relaxation not applied: " + result.relaxation.reason);
   }
-  result.defects = findMapDefects(positions, normals, result.domain, options.defects,
-                                  subProgress(progress, 0.9, 1));
+  // The relaxation checked the map it leaves (a sphere domain is neither relaxed nor checked).
+  if (!result.relaxation.defects.fold.empty())
+    result.defects = std::move(result.relaxation.defects);
+  else
+    result.defects = findMapDefects(positions, normals, result.domain, options.defects,
+                                    subProgress(progress, relax ? 0.75 : 0.9, 1));
 
   const std::size_t n = positions.size();
   const double maxFailed = options.maxFailedStepFraction * options.flattening.scaleCount;

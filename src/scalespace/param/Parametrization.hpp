@@ -17,8 +17,9 @@ struct ParametrizationOptions {
   FlatteningOptions flattening;
   DomainOptions domain;
   MapDefectOptions defects;
-  /// Beyond the thesis: conformal relaxation of a plane domain (off by default: 0 iterations).
-  RelaxationOptions relaxation{0};
+  /// Beyond the thesis: the relaxation of a plane domain, on by default (as rigid as possible,
+  /// robust); iterations 0 gives the thesis' map.
+  RelaxationOptions relaxation;
   /// The share of points flagged (folds plus overlaps) above which the map is reported as not
   /// one-to-one (the target for genus-0 surfaces: below 0.1%).
   double maxDefectFraction = 0.001;

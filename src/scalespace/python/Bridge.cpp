@@ -79,6 +79,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FlatteningOptions::tMax", "tmax"},
     {"DistortionOptions::neighbors", "scales_k"},
     {"RelaxationOptions::iterations", "relax"},
+    {"RelaxationOptions::rounds", "relax_rounds"},
     {"CylinderOptions::minAnisotropy", "min_anisotropy"},
     {"TubeFitOptions::minArcDegrees", "min_arc"},
     {"TubeFitOptions::maxRelativeRms", "max_rms"},

@@ -38,13 +38,15 @@ PooledCloud cloudWithNormals(const Points& points, const py::handle& normals, Ca
 
 py::dict parametrizePy(const py::handle& points, const py::handle& normals, int scales,
                        const std::string& domain, int k, double tmax, double alpha, int relax,
-                       bool rigid, std::optional<int> threads, py::object progress) {
+                       int relaxRounds, bool rigid, std::optional<int> threads,
+                       py::object progress) {
   ParametrizationOptions options;
   options.flattening.scaleCount = scales;
   options.flattening.K = k;
   options.flattening.tMax = tmax;
   options.flattening.alpha = alpha;
   options.relaxation.iterations = relax;
+  options.relaxation.rounds = relaxRounds;
   options.relaxation.rigid = rigid;
   options.domain.kind = parseDomainKind(domain);
   validateFlatteningOptions(options.flattening);
@@ -145,15 +147,18 @@ void bindParametrization(py::module_& m) {
   using namespace pybind11::literals;
   m.def("parametrize", &parametrizePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = 50, "domain"_a = "auto", "k"_a = 10, "tmax"_a = 0.0, "alpha"_a = 0.1,
-        "relax"_a = 0, "rigid"_a = false, "threads"_a = py::none(), "progress"_a = py::none(),
+        "relax"_a = RelaxationOptions{}.iterations, "relax_rounds"_a = RelaxationOptions{}.rounds,
+        "rigid"_a = RelaxationOptions{}.rigid, "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Meshless parametrization (Sec. 4.3), as `scalespace parametrize`.
 
 The points flow onto their APSS while the scale grows along `scales` linear per-point scales
 (from each point's distance to its k-th neighbour to tmax, 0: the diagonal), then onto one
 sphere or plane. domain: "auto" (a plane when the points fit in a cap of 80 degrees), "plane"
-or "sphere". relax > 0: that many conformal relaxation iterations of a plane domain (beyond the
-thesis; not applied when it would add folds); rigid: rotations instead of similarities (keeps
-lengths, so areas too, where the surface allows). Without normals they are estimated and oriented,
+or "sphere". relax: local-global iterations per round of the relaxation of a plane domain
+(beyond the thesis, on by default; 0 gives the thesis' map; not applied when it would add folds
+or overlaps); relax_rounds: its robust re-weighting rounds (1: plain least squares); rigid:
+rotations (keeps lengths, so areas too, where the surface allows) or, False, similarities
+(angles only). Without normals they are estimated and oriented,
 as the CLI does. Returns a dict: domain, uv (N, 2) or None, direction (N, 3), longitude and
 latitude (N,) in degrees or None, valid, fold, overlap (N,) uint8, local_scale (N,), flattened
 (N, 3) absolute, global_fit_is_plane, centre, radius, cap_degrees, one_to_one, folds, overlaps,
