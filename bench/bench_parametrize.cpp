@@ -17,7 +17,7 @@
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]
 //                     [--scales M (50)] [--resolution R (128): the peers' mesh grid]
 //                     [--no-peers] [--threads T] [--relax-iterations I (5)]
-//                     [--relax-max-solve N (200000)]: the relaxations' options
+//                     [--relax-max-solve N (100000)]: the relaxations' options
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>

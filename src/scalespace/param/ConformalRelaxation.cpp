@@ -283,6 +283,23 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
   for (Vec2& p : uv) p = centroid + (p - c) * factor;
 }
 
+/// The sign of the determinant of most of the local maps (+1 on ties).
+double majorityDeterminantSign(const std::vector<Eigen::Matrix2d>& jacobian) {
+  std::size_t negative = 0, positive = 0;
+  for (const Eigen::Matrix2d& a : jacobian) {
+    const double det = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
+    negative += det < 0;
+    positive += det > 0;
+  }
+  return negative > positive ? -1.0 : 1.0;
+}
+
+/// The graph's tangent coordinates mirrored (y -> -y).
+void mirrorGraph(RelaxationGraph& g) {
+  for (Vec2& a : g.offset) a.y() = -a.y();
+  for (auto& t : g.toTangent) t.row(1) = -t.row(1);
+}
+
 /// About `target` points of the cloud, Poisson-disk spaced. The separation comes from the
 /// points' density (10 neighbours within the median 10-NN radius) and a random packing's count
 /// (about 0.7 area / separation^2); it is widened until the sample fits.
@@ -375,13 +392,6 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     result.reason = options.iterations == 0 ? "no iteration asked" : "too few points";
     return result;
   }
-  // Progress: the check before [0, 0.25], the relaxation [0.25, 0.75], the check after.
-  result.defects =
-      findMapDefects(positions, normals, domain, options.defects, subProgress(progress, 0, 0.25));
-  const MapDefects& before = result.defects;
-  result.foldsBefore = before.folds;
-  const double mirror = before.majoritySign < 0 ? -1.0 : 1.0;
-
   // The system's points: all of them, or a Poisson-disk subsample of a large cloud.
   const bool subsampled = n > options.maxSolvePoints;
   std::vector<Index> sample;
@@ -404,9 +414,14 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     return result;
   }
   result.solvedPoints = p.size();
-  const RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), mirror);
+  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
+  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
+  const double mirror = majorityDeterminantSign(localJacobians(graph, d.uv));
+  if (mirror < 0) mirrorGraph(graph);
 
-  ProgressTracker tracker(subProgress(progress, 0.25, 0.75), "relaxation",
+  // Progress: the relaxation [0, 0.6], the check after [0.6, 0.8], the one before (only when
+  // the relaxed map has defects) [0.8, 1].
+  ProgressTracker tracker(subProgress(progress, 0, 0.6), "relaxation",
                           std::size_t(options.iterations) * std::size_t(options.rounds));
   std::vector<Vec2> uv = d.uv;
   std::vector<Eigen::Matrix2d> similarity;
@@ -424,14 +439,21 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     relaxed.uv = std::move(uv);
   }
   MapDefects after =
-      findMapDefects(positions, normals, relaxed, options.defects, subProgress(progress, 0.75, 1));
-  result.foldsAfter = after.folds;
-  if (after.folds + after.overlaps > before.folds + before.overlaps) {
-    result.reason = "the relaxation would add folds or overlaps (" +
-                    std::to_string(after.folds + after.overlaps) + " points against " +
-                    std::to_string(before.folds + before.overlaps) + ")";
-    return result;
+      findMapDefects(positions, normals, relaxed, options.defects, subProgress(progress, 0.6, 0.8));
+  // The map before is checked only when the relaxed one has defects: it cannot have fewer than
+  // none (the check costs as much as the relaxation's solve at 1M points).
+  if (after.folds + after.overlaps > 0) {
+    MapDefects before =
+        findMapDefects(positions, normals, domain, options.defects, subProgress(progress, 0.8, 1));
+    if (after.folds + after.overlaps > before.folds + before.overlaps) {
+      result.reason = "the relaxation would add folds or overlaps (" +
+                      std::to_string(after.folds + after.overlaps) + " points against " +
+                      std::to_string(before.folds + before.overlaps) + ")";
+      result.defects = std::move(before);
+      return result;
+    }
   }
+  if (progress && !progress(1.0, "relaxation")) throw Cancelled();
   domain = std::move(relaxed);
   result.defects = std::move(after);
   result.applied = true;

@@ -37,7 +37,7 @@ struct RelaxationOptions {
   double maxDownweight = 10;
   /// Above this many points the system is solved on a Poisson-disk subsample of about this
   /// size (>= 1000).
-  std::size_t maxSolvePoints = 200000;
+  std::size_t maxSolvePoints = 100000;
   /// Rotations instead of similarities ("as rigid as possible"): the map then also keeps the
   /// surface's lengths where it can, which lowers the authalic distortion as well, and gives the
   /// domain the surface's units. false: similarities, the conformal energy alone (its areas
@@ -53,12 +53,11 @@ struct RelaxationOptions {
 void validateRelaxationOptions(const RelaxationOptions& options);
 
 struct RelaxationResult {
-  bool applied = false;  // false: not a plane domain, no iteration, or it would add folds
-  std::string reason;    // why not, when not applied
-  std::size_t foldsBefore = 0, foldsAfter = 0;
+  bool applied = false;          // false: not a plane domain, no iteration, or it would add folds
+  std::string reason;            // why not, when not applied
   std::size_t solvedPoints = 0;  // the points of the system (a subsample of a large cloud)
-  /// The defects of the map left in `domain` (relaxed or not); empty when the map was not
-  /// checked (not a plane domain, no iteration).
+  /// The defects of the map left in `domain` (relaxed or not); empty when that map was not
+  /// checked (not a plane domain, no iteration, the relaxation failed).
   MapDefects defects;
   double seconds = 0;
 };
