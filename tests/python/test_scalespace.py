@@ -623,6 +623,30 @@ def test_parametrize_equals_the_cli(tmp_path):
         assert g["conformal"].shape == (4000,) and g["conformal"].dtype == np.float32
 
 
+def test_parametrize_relaxation_options_equal_the_cli(tmp_path):
+    cli("generate", "relief", "-n", 4000, "-o", tmp_path / "r.ply")
+    cloud = ss.read(str(tmp_path / "r.ply"))
+    runs = {"thesis": (["--relax", 0], dict(relax=0)),
+            "conformal": (["--conformal", "--relax-rounds", 2], dict(rigid=False, relax_rounds=2))}
+    maps = {}
+    for name, (flags, kwargs) in runs.items():
+        cli("parametrize", tmp_path / "r.ply", "--scales", 15, *flags, "-o", tmp_path / f"{name}.ply")
+        written = ss.read(str(tmp_path / f"{name}.ply"))
+        got = ss.parametrize(cloud.points, cloud.normals, scales=15, **kwargs)
+        np.testing.assert_allclose(got["uv"][:, 0], written.attributes["u"], rtol=1e-9, atol=1e-9)
+        summary = json.loads((tmp_path / f"{name}.json").read_text())["relaxation"]
+        assert summary["applied"] == got["relaxed"] == (name != "thesis")
+        maps[name] = got["uv"]
+    default = ss.parametrize(cloud.points, cloud.normals, scales=15)
+    assert default["relaxed"]
+    assert not np.allclose(default["uv"], maps["thesis"]) and not np.allclose(default["uv"], maps["conformal"])
+    with pytest.raises(ss.OptionError, match="relax_rounds"):
+        ss.parametrize(cloud.points, cloud.normals, relax_rounds=0)
+    bad = subprocess.run([CLI, "parametrize", str(tmp_path / "r.ply"), "--relax-rounds", "0", "-o",
+                          str(tmp_path / "x.ply"), "-q"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--relax-rounds" in bad.stderr
+
+
 def test_parametrize_a_sphere_and_bad_arguments():
     p = sphere_points(3000, 4) * 2 + [10, 0, 0]
     got = ss.parametrize(p, (p - [10, 0, 0]) * 3, scales=10)  # normals of any length

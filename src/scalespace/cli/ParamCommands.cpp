@@ -204,6 +204,7 @@ void addParametrizeCommand(CLI::App& app) {
                                    {"rounds", args->options.relaxation.rounds},
                                    {"rigid", args->options.relaxation.rigid},
                                    {"solved_points", result.relaxation.solvedPoints},
+                                   {"rounds_applied", result.relaxation.roundsApplied},
                                    {"applied", result.relaxation.applied},
                                    {"reason", result.relaxation.reason},
                                    {"seconds", result.relaxation.seconds}}},

@@ -18,7 +18,8 @@
 // points (the factorization's fill grows faster than the point count), and every other point
 // is placed by the local similarities of its nearest samples.
 // The domain's size is kept (RMS distance to the centroid) so the scale-free energy cannot
-// shrink it. A relaxation that would add folds or overlaps (MapDefects) is not applied.
+// shrink it. A relaxation that would add folds or overlaps (MapDefects) is retried with one
+// plain round, then not applied.
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
@@ -56,6 +57,9 @@ struct RelaxationResult {
   bool applied = false;          // false: not a plane domain, no iteration, or it would add folds
   std::string reason;            // why not, when not applied
   std::size_t solvedPoints = 0;  // the points of the system (a subsample of a large cloud)
+  /// The robust rounds of the map applied: RelaxationOptions::rounds, or 1 when those would
+  /// have added folds or overlaps and one plain round did not (0: not applied).
+  int roundsApplied = 0;
   /// The defects of the map left in `domain` (relaxed or not); empty when that map was not
   /// checked (not a plane domain, no iteration, the relaxation failed).
   MapDefects defects;

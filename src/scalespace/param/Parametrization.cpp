@@ -40,6 +40,9 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
                                          subProgress(progress, 0.75, 1));
     if (!result.relaxation.applied && result.domain.kind == DomainKind::Plane)
       result.warnings.push_back("relaxation not applied: " + result.relaxation.reason);
+    else if (result.relaxation.applied && result.relaxation.roundsApplied < relaxation.rounds)
+      result.warnings.push_back(
+          "the relaxation's robust rounds would add folds or overlaps: one plain round applied");
   }
   // The relaxation checked the map it leaves (a sphere domain is neither relaxed nor checked).
   if (!result.relaxation.defects.fold.empty())

@@ -80,6 +80,7 @@ py::dict parametrizePy(const py::handle& points, const py::handle& normals, int 
   out["folds"] = p.defects.folds;
   out["overlaps"] = p.defects.overlaps;
   out["relaxed"] = p.relaxation.applied;
+  out["relax_rounds_applied"] = p.relaxation.roundsApplied;
   out["warnings"] = p.warnings;
   out["seconds"] = p.flattening.seconds;
   return out;
@@ -162,7 +163,7 @@ rotations (keeps lengths, so areas too, where the surface allows) or, False, sim
 as the CLI does. Returns a dict: domain, uv (N, 2) or None, direction (N, 3), longitude and
 latitude (N,) in degrees or None, valid, fold, overlap (N,) uint8, local_scale (N,), flattened
 (N, 3) absolute, global_fit_is_plane, centre, radius, cap_degrees, one_to_one, folds, overlaps,
-relaxed, warnings, seconds.)doc");
+relaxed, relax_rounds_applied, warnings, seconds.)doc");
   m.def("distortion", &distortionPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "uv"_a = py::none(), "direction"_a = py::none(),
         "scales_k"_a = std::vector<int>{16, 64, 256}, "threads"_a = py::none(),
