@@ -116,8 +116,8 @@ void addParametrizeCommand(CLI::App& app) {
   cmd->add_flag("--rigid,!--conformal", args->options.relaxation.rigid,
                 "the relaxation's local maps: rotations (--rigid, as rigid as possible: keeps "
                 "lengths, so areas too, where the surface allows, and gives the domain the "
-                "surface's units) or similarities (--conformal: angles only, areas drift)")
-      ->capture_default_str();
+                "surface's units; the default) or similarities (--conformal: angles only, areas "
+                "drift)");
   cmd->add_option("--flattened", args->flattened,
                   "also write the flowed points, on their sphere or plane, to this cloud");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");

@@ -108,6 +108,20 @@ Eigen::SparseMatrix<double> laplacianOf(const RelaxationGraph& g, const std::vec
   return laplacian;
 }
 
+/// Calls visit(i, j, w, r) for every edge i -> j of the graph, in a fixed order, with its weight
+/// w_ij rho_i and the offset S_i a_ij it asks of u_j - u_i (the global step's terms).
+template <class Visit>
+void forEachTargetOffset(const RelaxationGraph& g, const std::vector<double>& rho,
+                         const std::vector<Eigen::Matrix2d>& similarity, Visit visit) {
+  for (std::size_t i = 0; i < g.n; ++i)
+    for (std::size_t e = 0; e < g.k; ++e) {
+      const std::size_t j = g.neighbor[i * g.k + e];
+      const double w = g.weight[i * g.k + e] * rho[i];
+      if (j == i || !(w > 0)) continue;
+      visit(i, j, w, Vec2(similarity[i] * g.offset[i * g.k + e]));
+    }
+}
+
 /// The local step: per point the similarity (or rotation) best taking a_ij to u_j - u_i. In
 /// complex form S_i = (a + ib) = sum w conj(x) y / sum w |x|^2.
 void fitSimilarities(const RelaxationGraph& g, const std::vector<Vec2>& uv, bool rigid,
@@ -185,15 +199,11 @@ std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& opti
       // Global: rhs_m = sum_{i->m} w rho_i S_i a_im - sum_{m->j} w rho_m S_m a_mj (+ pin u_m).
       Eigen::MatrixXd rhs(int(g.n), 2);
       for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * uv[i].transpose();
-      for (std::size_t i = 0; i < g.n; ++i)
-        for (std::size_t e = 0; e < g.k; ++e) {
-          const std::size_t j = g.neighbor[i * g.k + e];
-          const double w = g.weight[i * g.k + e] * rho[i];
-          if (j == i || !(w > 0)) continue;
-          const Vec2 r = similarity[i] * g.offset[i * g.k + e];
-          rhs.row(int(j)) += w * r.transpose();
-          rhs.row(int(i)) -= w * r.transpose();
-        }
+      forEachTargetOffset(g, rho, similarity,
+                          [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
+                            rhs.row(int(j)) += w * r.transpose();
+                            rhs.row(int(i)) -= w * r.transpose();
+                          });
       const Eigen::MatrixXd solved = solver.solve(rhs);
       // The similarity energy has no scale of its own: keep the domain's spread and centroid
       // (the rigid one takes the surface's lengths).
@@ -268,15 +278,11 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       // Row m of L u = rhs solved for u_m: u_m = (rhs_m + sum_{edges m-j} w u_j) / L_mm.
       std::fill(sum.begin(), sum.end(), Vec2::Zero());
-      for (std::size_t i = 0; i < g.n; ++i)
-        for (std::size_t e = 0; e < g.k; ++e) {
-          const std::size_t j = g.neighbor[i * g.k + e];
-          const double w = g.weight[i * g.k + e] * rho[i];
-          if (j == i || !(w > 0)) continue;
-          const Vec2 r = similarity[i] * g.offset[i * g.k + e];
-          sum[j] += w * (uv[i] + r);
-          sum[i] += w * (uv[j] - r);
-        }
+      forEachTargetOffset(g, rho, similarity,
+                          [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
+                            sum[j] += w * (uv[i] + r);
+                            sum[i] += w * (uv[j] - r);
+                          });
       for (std::size_t i = 0; i < g.n; ++i)
         if (diagonal[i] > 0) uv[i] += kDamping * (sum[i] / diagonal[i] - uv[i]);
     }
