@@ -231,7 +231,7 @@ int main(int argc, char** argv) {
       const double seconds = secondsSince(start);
       const std::string domainNote = std::string(domainKindName(thesis.domain.kind)) +
                                      (thesis.oneToOne ? "" : ", flagged not one-to-one");
-      const bool relaxable = thesis.domain.kind == DomainKind::Plane && relaxIterations > 0;
+      const bool relaxable = relaxIterations > 0;
       struct Variant {
         const char* method;
         bool rigid;

@@ -110,7 +110,9 @@ TEST(Parametrization, ASpheresPointsStayWhereTheyAre) {
     c.positions.push_back(centre + 2 * d);
     c.normals.push_back(d);
   }
-  const Parametrization p = parametrize(c.positions, c.normals, fewScales());
+  ParametrizationOptions thesis = fewScales();
+  thesis.relaxation.iterations = 0;
+  const Parametrization p = parametrize(c.positions, c.normals, thesis);
   ASSERT_EQ(p.domain.kind, DomainKind::Sphere);
   EXPECT_NEAR(p.domain.radius, 2, 1e-6);
   EXPECT_LT((p.domain.centre - centre).norm(), 1e-6);
@@ -118,6 +120,19 @@ TEST(Parametrization, ASpheresPointsStayWhereTheyAre) {
   for (std::size_t i = 0; i < c.positions.size(); ++i)
     worst = std::max(worst, (p.domain.direction[i] - c.normals[i]).norm());
   EXPECT_LT(worst, 1e-6);
+  // Relaxed (the default), up to a rotation: the best one (Kabsch) explains every point.
+  const Parametrization r = parametrize(c.positions, c.normals, fewScales());
+  ASSERT_TRUE(r.relaxation.applied) << r.relaxation.reason;
+  EXPECT_NEAR(r.domain.radius, 2, 2e-3);  // rigid: the surface's units
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < c.positions.size(); ++i)
+    h += r.domain.direction[i] * c.normals[i].transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d rotation = svd.matrixV() * svd.matrixU().transpose();
+  double worstRotated = 0;
+  for (std::size_t i = 0; i < c.positions.size(); ++i)
+    worstRotated = std::max(worstRotated, (rotation * r.domain.direction[i] - c.normals[i]).norm());
+  EXPECT_LT(worstRotated, 1e-3);
   EXPECT_EQ(p.defects.folds + p.defects.overlaps, 0u);
   // Longitude and latitude read the direction about the world z axis.
   const Vec3& d = p.domain.direction[0];
@@ -263,11 +278,24 @@ TEST(Parametrization, RelaxationLowersTheDistortionWithoutFolds) {
   const MapDefects check = findMapDefects(c.positions, c.normals, rigid.domain);
   EXPECT_EQ(check.fold, rigid.defects.fold);
   EXPECT_EQ(check.overlap, rigid.defects.overlap);
-  // A sphere domain is left alone, and says why.
-  const Cloud closed = shape(ParamShape::Blob, 3000);
-  const Parametrization s = parametrize(closed.positions, closed.normals, fewScales());
-  EXPECT_FALSE(s.relaxation.applied);
-  EXPECT_NE(s.relaxation.reason.find("plane domains"), std::string::npos);
+  // A sphere domain too: the blob's areas come much closer to the surface's.
+  const Cloud closed = shape(ParamShape::Blob, 12000);
+  const Parametrization round = parametrize(closed.positions, closed.normals, thesisOptions);
+  const Parametrization relaxedRound = parametrize(closed.positions, closed.normals, fewScales());
+  ASSERT_EQ(relaxedRound.domain.kind, DomainKind::Sphere);
+  ASSERT_TRUE(relaxedRound.relaxation.applied) << relaxedRound.relaxation.reason;
+  EXPECT_EQ(relaxedRound.defects.folds + relaxedRound.defects.overlaps, 0u);
+  EXPECT_LT(medianAt16(closed, relaxedRound.domain, false) - 1,
+            0.5 * (medianAt16(closed, round.domain, false) - 1));
+  // Not above maxSolvePoints (no subsample for spheres yet): said, not warned about.
+  ParametrizationOptions small = fewScales();
+  small.relaxation.maxSolvePoints = 1000;
+  const Parametrization large = parametrize(closed.positions, closed.normals, small);
+  EXPECT_FALSE(large.relaxation.applied);
+  EXPECT_NE(large.relaxation.reason.find("maxSolvePoints"), std::string::npos);
+  EXPECT_EQ(large.domain.direction, round.domain.direction);
+  for (const std::string& warning : large.warnings)
+    EXPECT_EQ(warning.find("relaxation"), std::string::npos) << warning;
   using Breaker = void (*)(RelaxationOptions&);
   const Breaker breakers[] = {[](RelaxationOptions& o) { o.neighbors = 2; },
                               [](RelaxationOptions& o) { o.rounds = 0; },

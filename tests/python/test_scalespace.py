@@ -649,10 +649,14 @@ def test_parametrize_relaxation_options_equal_the_cli(tmp_path):
 
 def test_parametrize_a_sphere_and_bad_arguments():
     p = sphere_points(3000, 4) * 2 + [10, 0, 0]
-    got = ss.parametrize(p, (p - [10, 0, 0]) * 3, scales=10)  # normals of any length
+    got = ss.parametrize(p, (p - [10, 0, 0]) * 3, scales=10, relax=0)  # normals of any length
     assert got["domain"] == "sphere" and got["uv"] is None
     np.testing.assert_allclose(got["radius"], 2, rtol=1e-6)
     np.testing.assert_allclose(got["direction"], (p - [10, 0, 0]) / 2, atol=1e-6)
+    relaxed = ss.parametrize(p, (p - [10, 0, 0]) * 3, scales=10)  # an exact sphere stays put
+    assert relaxed["relaxed"]
+    np.testing.assert_allclose(relaxed["radius"], 2, rtol=1e-3)
+    np.testing.assert_allclose(relaxed["direction"], (p - [10, 0, 0]) / 2, atol=1e-3)
     assert got["longitude"].shape == (3000,)
     with pytest.raises(ss.OptionError, match="scales"):
         ss.parametrize(p, scales=1)

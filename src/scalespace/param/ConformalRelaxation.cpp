@@ -1,5 +1,6 @@
 #include "scalespace/param/ConformalRelaxation.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -122,16 +123,18 @@ void forEachTargetOffset(const RelaxationGraph& g, const std::vector<double>& rh
     }
 }
 
-/// The local step: per point the similarity (or rotation) best taking a_ij to u_j - u_i. In
-/// complex form S_i = (a + ib) = sum w conj(x) y / sum w |x|^2.
-void fitSimilarities(const RelaxationGraph& g, const std::vector<Vec2>& uv, bool rigid,
+/// The local step: per point the similarity (or rotation) best taking a_ij to the domain offset
+/// y_ij = offsetOf(i, e) of its e-th neighbour, in i's tangent frame of the domain. In complex
+/// form S_i = (a + ib) = sum w conj(x) y / sum w |x|^2.
+template <class OffsetOf>
+void fitSimilarities(const RelaxationGraph& g, OffsetOf offsetOf, bool rigid,
                      std::vector<Eigen::Matrix2d>& similarity) {
   parallelFor(g.n, [&](std::size_t i) {
     double a = 0, b = 0, norm = 0;
     for (std::size_t e = 0; e < g.k; ++e) {
       const double w = g.weight[i * g.k + e];
       const Vec2& x = g.offset[i * g.k + e];
-      const Vec2 y = uv[g.neighbor[i * g.k + e]] - uv[i];
+      const Vec2 y = offsetOf(i, e);
       a += w * (x.x() * y.x() + x.y() * y.y());
       b += w * (x.x() * y.y() - x.y() * y.x());
       norm += w * x.squaredNorm();
@@ -151,7 +154,8 @@ void fitSimilarities(const RelaxationGraph& g, const std::vector<Vec2>& uv, bool
 
 /// The robust weights for the next round: rho_i = min(1, median / residual_i), at least
 /// 1 / maxDownweight, residual_i the point's RMS misfit relative to its offsets' lengths.
-std::vector<double> robustWeights(const RelaxationGraph& g, const std::vector<Vec2>& uv,
+template <class OffsetOf>
+std::vector<double> robustWeights(const RelaxationGraph& g, OffsetOf offsetOf,
                                   const std::vector<Eigen::Matrix2d>& similarity,
                                   double maxDownweight) {
   std::vector<double> residual(g.n, 0.0);
@@ -160,7 +164,7 @@ std::vector<double> robustWeights(const RelaxationGraph& g, const std::vector<Ve
     for (std::size_t e = 0; e < g.k; ++e) {
       const double w = g.weight[i * g.k + e];
       const Vec2& a = g.offset[i * g.k + e];
-      misfit += w * (uv[g.neighbor[i * g.k + e]] - uv[i] - similarity[i] * a).squaredNorm();
+      misfit += w * (offsetOf(i, e) - similarity[i] * a).squaredNorm();
       length += w * a.squaredNorm();
     }
     residual[i] = length > 0 ? std::sqrt(misfit / length) : 0;
@@ -173,13 +177,13 @@ std::vector<double> robustWeights(const RelaxationGraph& g, const std::vector<Ve
   return rho;
 }
 
-/// Relaxes `uv` (the graph's points) in place; `similarity` gets the final local similarities.
-/// Returns an empty string, or why the relaxation could not run.
-std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& options,
-                         std::vector<Vec2>& uv, std::vector<Eigen::Matrix2d>& similarity,
-                         ProgressTracker& tracker) {
-  Vec2 centroid;
-  const double size = spread(uv, centroid);
+/// The rounds of local-global iterations: `step(solver, pin, rho, similarity)` is the global
+/// step of the domain at hand (a solve, then the domain's own constraint); it returns why it
+/// failed, or an empty string. `similarity` gets the final local similarities.
+template <class OffsetOf, class GlobalStep>
+std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& options,
+                        ProgressTracker& tracker, OffsetOf offsetOf, GlobalStep step,
+                        std::vector<Eigen::Matrix2d>& similarity) {
   similarity.assign(g.n, Eigen::Matrix2d::Identity());
   std::vector<double> rho(g.n, 1.0);
   // The matrix's pattern does not change between rounds (every weight stays > 0): ordered once,
@@ -187,7 +191,7 @@ std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& opti
   // and at 1M points: the pinned graph Laplacian is badly conditioned, bench/README.md.)
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
   for (int round = 0; round < options.rounds; ++round) {
-    if (round > 0) rho = robustWeights(g, uv, similarity, options.maxDownweight);
+    if (round > 0) rho = robustWeights(g, offsetOf, similarity, options.maxDownweight);
     double pin = 0;
     const Eigen::SparseMatrix<double> laplacian = laplacianOf(g, rho, pin);
     if (round == 0) solver.analyzePattern(laplacian);
@@ -195,36 +199,118 @@ std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& opti
     if (solver.info() != Eigen::Success)
       return "the k-NN graph's Laplacian could not be factorized";
     for (int iteration = 0; iteration < options.iterations; ++iteration) {
-      fitSimilarities(g, uv, options.rigid, similarity);
-      // Global: rhs_m = sum_{i->m} w rho_i S_i a_im - sum_{m->j} w rho_m S_m a_mj (+ pin u_m).
-      Eigen::MatrixXd rhs(int(g.n), 2);
-      for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * uv[i].transpose();
-      forEachTargetOffset(g, rho, similarity,
-                          [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
-                            rhs.row(int(j)) += w * r.transpose();
-                            rhs.row(int(i)) -= w * r.transpose();
-                          });
-      const Eigen::MatrixXd solved = solver.solve(rhs);
-      // The similarity energy has no scale of its own: keep the domain's spread and centroid
-      // (the rigid one takes the surface's lengths).
-      std::vector<Vec2> next(g.n);
-      for (std::size_t i = 0; i < g.n; ++i) next[i] = solved.row(int(i)).transpose();
-      Vec2 c;
-      const double s = spread(next, c);
-      if (!(s > 0) || !std::isfinite(s)) return "the relaxation collapsed the domain";
-      const double factor = options.rigid ? 1.0 : size / s;
-      for (std::size_t i = 0; i < g.n; ++i) uv[i] = centroid + (next[i] - c) * factor;
+      fitSimilarities(g, offsetOf, options.rigid, similarity);
+      const std::string failure = step(solver, pin, rho, similarity);
+      if (!failure.empty()) return failure;
       tracker.advance(1);
     }
   }
-  fitSimilarities(g, uv, options.rigid, similarity);
+  fitSimilarities(g, offsetOf, options.rigid, similarity);
   return {};
 }
 
-/// Per point the linear map (any 2 x 2) that best takes a_ij to u_j - u_i: the relaxed map's
+/// The domain offsets of plane coordinates.
+auto planeOffsets(const RelaxationGraph& g, const std::vector<Vec2>& uv) {
+  return [&g, &uv](std::size_t i, std::size_t e) -> Vec2 {
+    return uv[g.neighbor[i * g.k + e]] - uv[i];
+  };
+}
+
+/// A tangent basis of the unit sphere at d (e1 x e2 = d).
+Eigen::Matrix<double, 3, 2> sphereBasis(const Vec3& d) {
+  const Vec3 a = std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 e1 = (a - a.dot(d) * d).normalized();
+  Eigen::Matrix<double, 3, 2> basis;
+  basis.col(0) = e1;
+  basis.col(1) = d.cross(e1);
+  return basis;
+}
+
+/// Relaxes plane coordinates `uv` (the graph's points) in place; `similarity` gets the final
+/// local similarities. Returns an empty string, or why the relaxation could not run.
+std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& options,
+                         std::vector<Vec2>& uv, std::vector<Eigen::Matrix2d>& similarity,
+                         ProgressTracker& tracker) {
+  Vec2 centroid;
+  const double size = spread(uv, centroid);
+  const auto step = [&](const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver,
+                        double pin, const std::vector<double>& rho,
+                        const std::vector<Eigen::Matrix2d>& s) -> std::string {
+    // Global: rhs_m = sum_{i->m} w rho_i S_i a_im - sum_{m->j} w rho_m S_m a_mj (+ pin u_m).
+    Eigen::MatrixXd rhs(int(g.n), 2);
+    for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * uv[i].transpose();
+    forEachTargetOffset(g, rho, s, [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
+      rhs.row(int(j)) += w * r.transpose();
+      rhs.row(int(i)) -= w * r.transpose();
+    });
+    const Eigen::MatrixXd solved = solver.solve(rhs);
+    // The similarity energy has no scale of its own: keep the domain's spread and centroid
+    // (the rigid one takes the surface's lengths).
+    std::vector<Vec2> next(g.n);
+    for (std::size_t i = 0; i < g.n; ++i) next[i] = solved.row(int(i)).transpose();
+    Vec2 c;
+    const double spreadNow = spread(next, c);
+    if (!(spreadNow > 0) || !std::isfinite(spreadNow)) return "the relaxation collapsed the domain";
+    const double factor = options.rigid ? 1.0 : size / spreadNow;
+    for (std::size_t i = 0; i < g.n; ++i) uv[i] = centroid + (next[i] - c) * factor;
+    return {};
+  };
+  return relaxRounds(g, options, tracker, planeOffsets(g, uv), step, similarity);
+}
+
+/// The same on a sphere domain: the points x_i = R d_i in 3D; the local step reads the domain
+/// offsets in the sphere's tangent plane at d_i (basis E_i), the global step solves for 3D points
+/// with the chords whose tangent parts are S_i a_ij, which are then put back on the sphere (for
+/// rotations, of the radius their mean distance gives: the surface's units).
+std::string relaxOnSphere(const RelaxationGraph& g, const RelaxationOptions& options,
+                          std::vector<Vec3>& x, std::vector<Eigen::Matrix2d>& similarity,
+                          ProgressTracker& tracker) {
+  std::vector<Eigen::Matrix<double, 3, 2>> basis(g.n);
+  const auto updateBases = [&] {
+    parallelFor(g.n, [&](std::size_t i) { basis[i] = sphereBasis(x[i].normalized()); });
+  };
+  updateBases();
+  double radius = 0;
+  for (const Vec3& p : x) radius += p.norm();
+  radius /= double(g.n);
+  const auto offsetOf = [&](std::size_t i, std::size_t e) -> Vec2 {
+    return basis[i].transpose() * (x[g.neighbor[i * g.k + e]] - x[i]);
+  };
+  const auto step = [&](const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver,
+                        double pin, const std::vector<double>& rho,
+                        const std::vector<Eigen::Matrix2d>& s) -> std::string {
+    Eigen::MatrixXd rhs(int(g.n), 3);
+    for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * x[i].transpose();
+    forEachTargetOffset(g, rho, s, [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
+      // The chord of the sphere whose tangent part is r (it dips by |r|^2 / 2R below the
+      // tangent plane): an exact sphere is then a fixed point.
+      const Vec3 lifted = basis[i] * r - (r.squaredNorm() / (2 * radius)) * x[i].normalized();
+      rhs.row(int(j)) += w * lifted.transpose();
+      rhs.row(int(i)) -= w * lifted.transpose();
+    });
+    // Back onto the sphere about its own centre (the pin keeps it where it was: the points'
+    // centroid is not the centre when they do not cover the sphere evenly).
+    const Eigen::MatrixXd solved = solver.solve(rhs);
+    double mean = 0;
+    for (std::size_t i = 0; i < g.n; ++i) mean += solved.row(int(i)).norm();
+    mean /= double(g.n);
+    if (!(mean > 0) || !std::isfinite(mean)) return "the relaxation collapsed the domain";
+    if (options.rigid) radius = mean;
+    for (std::size_t i = 0; i < g.n; ++i) {
+      const Vec3 p = solved.row(int(i)).transpose();
+      if (p.norm() > 0) x[i] = radius * p.normalized();
+    }
+    updateBases();
+    return {};
+  };
+  return relaxRounds(g, options, tracker, offsetOf, step, similarity);
+}
+
+/// Per point the linear map (any 2 x 2) that best takes a_ij to y_ij: the relaxed map's
 /// own Jacobian, scale and shear included, which places the points between samples
 /// consistently with where the samples landed.
-std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, const std::vector<Vec2>& uv) {
+template <class OffsetOf>
+std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, OffsetOf offsetOf) {
   std::vector<Eigen::Matrix2d> jacobian(g.n);
   parallelFor(g.n, [&](std::size_t i) {
     Eigen::Matrix2d xx = Eigen::Matrix2d::Zero(), yx = Eigen::Matrix2d::Zero();
@@ -232,7 +318,7 @@ std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, const std:
       const double w = g.weight[i * g.k + e];
       const Vec2& x = g.offset[i * g.k + e];
       xx += w * x * x.transpose();
-      yx += w * (uv[g.neighbor[i * g.k + e]] - uv[i]) * x.transpose();
+      yx += w * offsetOf(i, e) * x.transpose();
     }
     // xx is symmetric positive semi-definite: its inverse in closed form, when it has one.
     const double det = xx(0, 0) * xx(1, 1) - xx(0, 1) * xx(1, 0);
@@ -258,10 +344,11 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
   Vec2 centroid;
   const double size = spread(uv, centroid);
   std::vector<Eigen::Matrix2d> similarity(g.n, Eigen::Matrix2d::Identity());
-  fitSimilarities(g, uv, options.rigid, similarity);
-  const std::vector<double> rho = options.rounds > 1
-                                      ? robustWeights(g, uv, similarity, options.maxDownweight)
-                                      : std::vector<double>(g.n, 1.0);
+  const auto offsetOf = planeOffsets(g, uv);
+  fitSimilarities(g, offsetOf, options.rigid, similarity);
+  const std::vector<double> rho =
+      options.rounds > 1 ? robustWeights(g, offsetOf, similarity, options.maxDownweight)
+                         : std::vector<double>(g.n, 1.0);
   std::vector<double> diagonal(g.n, 0.0);
   for (std::size_t i = 0; i < g.n; ++i)
     for (std::size_t e = 0; e < g.k; ++e) {
@@ -274,7 +361,7 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
   constexpr double kDamping = 0.7;
   std::vector<Vec2> sum(g.n);
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    if (iteration > 0) fitSimilarities(g, uv, options.rigid, similarity);
+    if (iteration > 0) fitSimilarities(g, offsetOf, options.rigid, similarity);
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       // Row m of L u = rhs solved for u_m: u_m = (rhs_m + sum_{edges m-j} w u_j) / L_mm.
       std::fill(sum.begin(), sum.end(), Vec2::Zero());
@@ -337,36 +424,129 @@ std::vector<Index> solveSubsample(const std::vector<Vec3>& positions, std::size_
   return sample;
 }
 
-/// Every point placed by the local maps of its 4 nearest samples: u = sum_s w_s (u_s +
-/// J_s T_s (p - p_s)) / sum_s w_s, with the kernel of Eq. 1.6 over 1.5 x the 4th distance.
-std::vector<Vec2> placeFromSamples(const std::vector<Vec3>& positions,
-                                   const std::vector<Index>& sample,
-                                   const std::vector<Vec3>& samplePositions,
-                                   const RelaxationGraph& g, const std::vector<Vec2>& sampleUv,
-                                   const std::vector<Eigen::Matrix2d>& jacobian) {
+/// Every point placed by the local maps of its 4 nearest samples: u = sum_s w_s predict(s, p -
+/// p_s) / sum_s w_s, with the kernel of Eq. 1.6 over 1.5 x the 4th distance; the samples keep
+/// their own positions. Point is Vec2 (plane) or Vec3 (sphere, put back on it by the caller).
+template <class Point, class Predict>
+std::vector<Point> placeFromSamples(const std::vector<Vec3>& positions,
+                                    const std::vector<Index>& sample,
+                                    const std::vector<Vec3>& samplePositions,
+                                    const std::vector<Point>& samplePoints, Predict predict) {
   const auto index = makeSpatialIndex(samplePositions);
-  std::vector<Vec2> uv(positions.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, positions.size(), 1024),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<Neighbor> near;
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          index->knnSearch(positions[i], 4, near);
-          const double r2 = 2.25 * near.back().distSq;
-          Vec2 sum = Vec2::Zero();
-          double total = 0;
-          for (const Neighbor& s : near) {
-            const double x = r2 > 0 ? 1 - s.distSq / r2 : 1;
-            const double w = x * x * x * x + 1e-300;
-            const Vec3 d = positions[i] - samplePositions[s.index];
-            sum += w * (sampleUv[s.index] + jacobian[s.index] * (g.toTangent[s.index] * d));
-            total += w;
-          }
-          uv[i] = sum / total;
-        }
-      });
-  for (std::size_t s = 0; s < sample.size(); ++s) uv[sample[s]] = sampleUv[s];
-  return uv;
+  std::vector<Point> out(positions.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<Neighbor> near;
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        index->knnSearch(positions[i], 4, near);
+                        const double r2 = 2.25 * near.back().distSq;
+                        Point sum = Point::Zero();
+                        double total = 0;
+                        for (const Neighbor& s : near) {
+                          const double x = r2 > 0 ? 1 - s.distSq / r2 : 1;
+                          const double w = x * x * x * x + 1e-300;
+                          sum += w * predict(s.index, positions[i] - samplePositions[s.index]);
+                          total += w;
+                        }
+                        out[i] = sum / total;
+                      }
+                    });
+  for (std::size_t s = 0; s < sample.size(); ++s) out[sample[s]] = samplePoints[s];
+  return out;
+}
+
+/// The points of the system: all of them, or a Poisson-disk subsample of a large cloud.
+struct SolveSet {
+  bool subsampled = false;
+  std::vector<Index> sample;
+  std::vector<Vec3> positions, normals;
+};
+
+SolveSet solveSetOf(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                    const RelaxationOptions& options) {
+  SolveSet set;
+  set.subsampled = positions.size() > options.maxSolvePoints;
+  if (!set.subsampled) return set;
+  set.sample = solveSubsample(positions, options.maxSolvePoints);
+  for (Index i : set.sample) {
+    set.positions.push_back(positions[i]);
+    if (!normals.empty()) set.normals.push_back(normals[i]);
+  }
+  return set;
+}
+
+/// Relaxes the plane coordinates of `map`; returns why it could not, or an empty string.
+std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                       DomainMap& map, const RelaxationOptions& options,
+                       const ProgressCallback& progress, std::size_t& solved) {
+  const SolveSet set = solveSetOf(positions, normals, options);
+  DomainMap solveDomain;
+  if (set.subsampled)
+    for (Index i : set.sample) solveDomain.uv.push_back(map.uv[i]);
+  const std::vector<Vec3>& p = set.subsampled ? set.positions : positions;
+  const std::vector<Vec3>& m = set.subsampled ? set.normals : normals;
+  const DomainMap& d = set.subsampled ? solveDomain : map;
+  if (p.size() < std::size_t(options.neighbors) + 1) return "too few points";
+  solved = p.size();
+  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
+  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
+  const double mirror = majorityDeterminantSign(localJacobians(graph, planeOffsets(graph, d.uv)));
+  if (mirror < 0) mirrorGraph(graph);
+
+  ProgressTracker tracker(progress, "relaxation",
+                          std::size_t(options.iterations) * std::size_t(options.rounds));
+  std::vector<Vec2> uv = d.uv;
+  std::vector<Eigen::Matrix2d> similarity;
+  std::string failure = relaxOnGraph(graph, options, uv, similarity, tracker);
+  if (!failure.empty()) return failure;
+  tracker.finish();
+  if (!set.subsampled) {
+    map.uv = std::move(uv);
+    return {};
+  }
+  const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, planeOffsets(graph, uv));
+  map.uv = placeFromSamples<Vec2>(positions, set.sample, p, uv, [&](Index s, const Vec3& offset) {
+    return Vec2(uv[s] + jacobian[s] * (graph.toTangent[s] * offset));
+  });
+  const RelaxationGraph fine =
+      gatherGraph(positions, normals, map, std::size_t(options.neighbors), mirror);
+  smoothOnGraph(fine, options, kSmoothingIterations, kSmoothingSweeps, map.uv);
+  return {};
+}
+
+/// Relaxes the sphere directions of `map` (and its radius: the surface's units for rotations).
+std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                        DomainMap& map, const RelaxationOptions& options,
+                        const ProgressCallback& progress, std::size_t& solved) {
+  solved = positions.size();
+  RelaxationGraph graph = gatherGraph(positions, normals, map, std::size_t(options.neighbors), 1.0);
+  const double radius = map.radius > 0 ? map.radius : 1.0;
+  std::vector<Vec3> x(positions.size());
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = radius * map.direction[i];
+  const auto sphereOffsets = [&](std::size_t i, std::size_t e) -> Vec2 {
+    return sphereBasis(x[i].normalized()).transpose() * (x[graph.neighbor[i * graph.k + e]] - x[i]);
+  };
+  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
+  if (majorityDeterminantSign(localJacobians(graph, sphereOffsets)) < 0) mirrorGraph(graph);
+
+  ProgressTracker tracker(progress, "relaxation",
+                          std::size_t(options.iterations) * std::size_t(options.rounds));
+  std::vector<Eigen::Matrix2d> similarity;
+  std::string failure = relaxOnSphere(graph, options, x, similarity, tracker);
+  if (!failure.empty()) return failure;
+  tracker.finish();
+  constexpr double kDegrees = 180 / 3.14159265358979323846;
+  double sum = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!(x[i].norm() > 0)) return "the relaxation put a point at the sphere's centre";
+    sum += x[i].norm();
+    const Vec3 d = x[i].normalized();
+    map.direction[i] = d;
+    map.longitude[i] = std::atan2(d.y(), d.x()) * kDegrees;
+    map.latitude[i] = std::asin(std::clamp(d.z(), -1.0, 1.0)) * kDegrees;
+  }
+  map.radius = sum / double(x.size());
+  return {};
 }
 
 }  // namespace
@@ -394,60 +574,26 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
   if (domain.size() != n || (!normals.empty() && normals.size() != n))
     throw OptionError("the cloud and its parametrization have different point counts");
   RelaxationResult result;
-  if (domain.kind != DomainKind::Plane) {
-    result.reason = "the relaxation applies to plane domains";
-    return result;
-  }
   if (options.iterations == 0 || n < std::size_t(options.neighbors) + 1) {
     result.reason = options.iterations == 0 ? "no iteration asked" : "too few points";
     return result;
   }
-  // The system's points: all of them, or a Poisson-disk subsample of a large cloud.
-  const bool subsampled = n > options.maxSolvePoints;
-  std::vector<Index> sample;
-  if (subsampled) sample = solveSubsample(positions, options.maxSolvePoints);
-  std::vector<Vec3> solvePositions, solveNormals;
-  DomainMap solveDomain;
-  if (subsampled) {
-    solveDomain.kind = DomainKind::Plane;
-    for (Index i : sample) {
-      solvePositions.push_back(positions[i]);
-      if (!normals.empty()) solveNormals.push_back(normals[i]);
-      solveDomain.uv.push_back(domain.uv[i]);
-    }
-  }
-  const std::vector<Vec3>& p = subsampled ? solvePositions : positions;
-  const std::vector<Vec3>& m = subsampled ? solveNormals : normals;
-  const DomainMap& d = subsampled ? solveDomain : domain;
-  if (p.size() < std::size_t(options.neighbors) + 1) {
-    result.reason = "too few points";
+  // A sphere is not yet relaxed on a subsample: placed from its samples without the plane's
+  // smoothing pass, a 1M-point triaxial ellipsoid got folds (bench/README.md).
+  if (domain.kind == DomainKind::Sphere && n > options.maxSolvePoints) {
+    result.reason = "a sphere domain is relaxed up to RelaxationOptions::maxSolvePoints = " +
+                    std::to_string(options.maxSolvePoints) + " points";
     return result;
   }
-  result.solvedPoints = p.size();
-  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
-  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
-  const double mirror = majorityDeterminantSign(localJacobians(graph, d.uv));
-  if (mirror < 0) mirrorGraph(graph);
-
   // Progress: the relaxation [0, 0.6], the check after [0.6, 0.8], the one before (only when
   // the relaxed map has defects) [0.8, 1].
-  ProgressTracker tracker(subProgress(progress, 0, 0.6), "relaxation",
-                          std::size_t(options.iterations) * std::size_t(options.rounds));
-  std::vector<Vec2> uv = d.uv;
-  std::vector<Eigen::Matrix2d> similarity;
-  result.reason = relaxOnGraph(graph, options, uv, similarity, tracker);
-  if (!result.reason.empty()) return result;
-  tracker.finish();
-
   DomainMap relaxed = domain;
-  if (subsampled) {
-    relaxed.uv = placeFromSamples(positions, sample, p, graph, uv, localJacobians(graph, uv));
-    const RelaxationGraph fine =
-        gatherGraph(positions, normals, relaxed, std::size_t(options.neighbors), mirror);
-    smoothOnGraph(fine, options, kSmoothingIterations, kSmoothingSweeps, relaxed.uv);
-  } else {
-    relaxed.uv = std::move(uv);
-  }
+  result.reason = domain.kind == DomainKind::Plane
+                      ? relaxPlane(positions, normals, relaxed, options,
+                                   subProgress(progress, 0, 0.6), result.solvedPoints)
+                      : relaxSphere(positions, normals, relaxed, options,
+                                    subProgress(progress, 0, 0.6), result.solvedPoints);
+  if (!result.reason.empty()) return result;
   MapDefects after =
       findMapDefects(positions, normals, relaxed, options.defects, subProgress(progress, 0.6, 0.8));
   // The map before is checked only when the relaxed one has defects: it cannot have fewer than

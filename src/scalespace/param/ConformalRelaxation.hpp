@@ -1,7 +1,7 @@
 #pragma once
-// Beyond the thesis (its Sec. 4.5 future work): a relaxation of a plane parametrization that
-// lowers the conformal distortion. The thesis suggests moving points to match the 3D and 2D
-// ellipses of Eq. 4.1-4.2; here that idea is the local-global "as similar as possible" scheme
+// Beyond the thesis (its Sec. 4.5 future work): a relaxation of a parametrization (plane or
+// sphere domain) that lowers its distortion. The thesis suggests moving points to match the 3D and
+// 2D ellipses of Eq. 4.1-4.2; here that idea is the local-global "as similar as possible" scheme
 // (the energy LSCM minimizes on meshes) on the point cloud's k-NN graph:
 //   local:  per point, the similarity S_i (rotation and scale, or an anti-similarity where the
 //           map is mirrored) that best takes its neighbours' tangent-plane offsets a_ij to their
@@ -17,9 +17,11 @@
 // Large clouds: the system is solved on a Poisson-disk subsample of about maxSolvePoints
 // points (the factorization's fill grows faster than the point count), and every other point
 // is placed by the local similarities of its nearest samples.
-// The domain's size is kept (RMS distance to the centroid) so the scale-free energy cannot
-// shrink it. A relaxation that would add folds or overlaps (MapDefects) is retried with one
-// plain round, then not applied.
+// Sphere domains (up to maxSolvePoints points): the same on the domain points R d_i in 3D, the
+// offsets read in the sphere's tangent planes, the solved points put back on the sphere.
+// The domain's size is kept (RMS distance to the centroid; a sphere's radius) so the scale-free
+// energy cannot shrink it; rotations give it the surface's units. A relaxation that would add folds
+// or overlaps (MapDefects) is retried with one plain round, then not applied.
 #include <vector>
 
 #include "scalespace/core/Progress.hpp"
@@ -61,12 +63,12 @@ struct RelaxationResult {
   /// have added folds or overlaps and one plain round did not (0: not applied).
   int roundsApplied = 0;
   /// The defects of the map left in `domain` (relaxed or not); empty when that map was not
-  /// checked (not a plane domain, no iteration, the relaxation failed).
+  /// checked (no iteration, the relaxation failed).
   MapDefects defects;
   double seconds = 0;
 };
 
-/// Relaxes `domain` (a plane domain of `positions`, with oriented `normals` or none) in place.
+/// Relaxes `domain` (a parametrization of `positions`, with oriented `normals` or none) in place.
 /// Throws OptionError on different sizes or invalid options, Cancelled through `progress`.
 /// Identical results for any thread count.
 RelaxationResult relaxConformally(const std::vector<Vec3>& positions,

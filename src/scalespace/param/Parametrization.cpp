@@ -38,13 +38,16 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
     relaxation.defects = options.defects;
     result.relaxation = relaxConformally(positions, normals, result.domain, relaxation,
                                          subProgress(progress, 0.75, 1));
-    if (!result.relaxation.applied && result.domain.kind == DomainKind::Plane)
+    // A large sphere domain is left as the thesis maps it, said in the JSON, not warned about.
+    const bool largeSphere =
+        result.domain.kind == DomainKind::Sphere && positions.size() > relaxation.maxSolvePoints;
+    if (!result.relaxation.applied && !largeSphere)
       result.warnings.push_back("relaxation not applied: " + result.relaxation.reason);
     else if (result.relaxation.applied && result.relaxation.roundsApplied < relaxation.rounds)
       result.warnings.push_back(
           "the relaxation's robust rounds would add folds or overlaps: one plain round applied");
   }
-  // The relaxation checked the map it leaves (a sphere domain is neither relaxed nor checked).
+  // The relaxation checked the map it leaves (unless it could not run).
   if (!result.relaxation.defects.fold.empty())
     result.defects = std::move(result.relaxation.defects);
   else

@@ -17,7 +17,7 @@ struct ParametrizationOptions {
   FlatteningOptions flattening;
   DomainOptions domain;
   MapDefectOptions defects;
-  /// Beyond the thesis: the relaxation of a plane domain, on by default (as rigid as possible,
+  /// Beyond the thesis: the relaxation of the domain, on by default (as rigid as possible,
   /// robust); iterations 0 gives the thesis' map.
   RelaxationOptions relaxation;
   /// The share of points flagged (folds plus overlaps) above which the map is reported as not
