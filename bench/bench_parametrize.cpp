@@ -11,7 +11,7 @@
 // their singular values, MapDefects::stretch). The mesh peers are scored on the mesh's vertices.
 //
 // Rows: "scalespace" is `parametrize`'s default (the flattening, then the rigid robust
-// relaxation of a plane domain), "thesis" the flattening alone (--relax 0), "+conformal" and
+// relaxation of the domain), "thesis" the flattening alone (--relax 0), "+conformal" and
 // "+rigid-1round" the other relaxations (similarities; one plain least-squares round).
 //
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]

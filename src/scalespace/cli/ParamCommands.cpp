@@ -106,8 +106,8 @@ void addParametrizeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--relax", args->options.relaxation.iterations,
                   "beyond the thesis: local-global iterations per round that lower the "
-                  "distortion of a plane domain (0: none, the thesis' map); not applied if it "
-                  "would add folds or overlaps")
+                  "distortion of the domain (a sphere up to 100k points; 0: none, the thesis' "
+                  "map); not applied if it would add folds or overlaps")
       ->capture_default_str();
   cmd->add_option("--relax-rounds", args->options.relaxation.rounds,
                   "robust re-weighting rounds of the relaxation (1: plain least squares, which "

@@ -155,9 +155,9 @@ void bindParametrization(py::module_& m) {
 The points flow onto their APSS while the scale grows along `scales` linear per-point scales
 (from each point's distance to its k-th neighbour to tmax, 0: the diagonal), then onto one
 sphere or plane. domain: "auto" (a plane when the points fit in a cap of 80 degrees), "plane"
-or "sphere". relax: local-global iterations per round of the relaxation of a plane domain
-(beyond the thesis, on by default; 0 gives the thesis' map; not applied when it would add folds
-or overlaps); relax_rounds: its robust re-weighting rounds (1: plain least squares); rigid:
+or "sphere". relax: local-global iterations per round of the relaxation of the domain (beyond
+the thesis, on by default, a sphere up to 100k points; 0 gives the thesis' map; not applied when
+it would add folds or overlaps); relax_rounds: its robust re-weighting rounds (1: plain least squares); rigid:
 rotations (keeps lengths, so areas too, where the surface allows) or, False, similarities
 (angles only). Without normals they are estimated and oriented,
 as the CLI does. Returns a dict: domain, uv (N, 2) or None, direction (N, 3), longitude and
