@@ -14,6 +14,7 @@
 #include "scalespace/param/LocalMapSample.hpp"
 #include "scalespace/param/MapDefects.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
 
 namespace scalespace {
 namespace {
@@ -30,12 +31,6 @@ double spread(const std::vector<Vec2>& uv, Vec2& centroid) {
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-double lowerMedianOf(std::vector<double> values) {
-  const auto middle = values.begin() + std::ptrdiff_t((values.size() - 1) / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 /// The k-NN graph of the points being relaxed, fixed for every iteration: per point its k
@@ -169,7 +164,7 @@ std::vector<double> robustWeights(const RelaxationGraph& g, OffsetOf offsetOf,
     }
     residual[i] = length > 0 ? std::sqrt(misfit / length) : 0;
   });
-  const double median = lowerMedianOf(residual);
+  const double median = lowerMedian(residual);
   std::vector<double> rho(g.n, 1.0);
   if (!(median > 0)) return rho;
   for (std::size_t i = 0; i < g.n; ++i)
@@ -410,7 +405,7 @@ std::vector<Index> solveSubsample(const std::vector<Vec3>& positions, std::size_
     index->knnSearch(positions[i], 11, neighbors);
     radii.push_back(std::sqrt(neighbors.back().distSq));
   }
-  const double r10 = lowerMedianOf(radii);
+  const double r10 = lowerMedian(radii);
   const double area = double(n) * std::acos(-1.0) * r10 * r10 / 10;
   double separation = std::sqrt(0.7 * area / (0.8 * double(target)));
   std::vector<Index> all(n);
@@ -426,21 +421,21 @@ std::vector<Index> solveSubsample(const std::vector<Vec3>& positions, std::size_
 
 /// Every point placed by the local maps of its 4 nearest samples: u = sum_s w_s predict(s, p -
 /// p_s) / sum_s w_s, with the kernel of Eq. 1.6 over 1.5 x the 4th distance; the samples keep
-/// their own positions. Point is Vec2 (plane) or Vec3 (sphere, put back on it by the caller).
-template <class Point, class Predict>
-std::vector<Point> placeFromSamples(const std::vector<Vec3>& positions,
-                                    const std::vector<Index>& sample,
-                                    const std::vector<Vec3>& samplePositions,
-                                    const std::vector<Point>& samplePoints, Predict predict) {
+/// their own positions.
+template <class Predict>
+std::vector<Vec2> placeFromSamples(const std::vector<Vec3>& positions,
+                                   const std::vector<Index>& sample,
+                                   const std::vector<Vec3>& samplePositions,
+                                   const std::vector<Vec2>& samplePoints, Predict predict) {
   const auto index = makeSpatialIndex(samplePositions);
-  std::vector<Point> out(positions.size());
+  std::vector<Vec2> out(positions.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<Neighbor> near;
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         index->knnSearch(positions[i], 4, near);
                         const double r2 = 2.25 * near.back().distSq;
-                        Point sum = Point::Zero();
+                        Vec2 sum = Vec2::Zero();
                         double total = 0;
                         for (const Neighbor& s : near) {
                           const double x = r2 > 0 ? 1 - s.distSq / r2 : 1;
@@ -505,7 +500,7 @@ std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec
     return {};
   }
   const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, planeOffsets(graph, uv));
-  map.uv = placeFromSamples<Vec2>(positions, set.sample, p, uv, [&](Index s, const Vec3& offset) {
+  map.uv = placeFromSamples(positions, set.sample, p, uv, [&](Index s, const Vec3& offset) {
     return Vec2(uv[s] + jacobian[s] * (graph.toTangent[s] * offset));
   });
   const RelaxationGraph fine =
