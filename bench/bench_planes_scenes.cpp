@@ -26,6 +26,7 @@
 //                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
 //                            [--merge-parallel DEG]
 //                            [--merge-width F] [--refine-distance F] [--refine-gain F]
+//                            [--no-refine-unlabelled]
 //                            [--refine-offset F] [--planar-noise F]
 //                            (PlaneDetectionOptions; default: the library's)
 //                            [--no-robust] (the plain APSS stack)
@@ -521,6 +522,8 @@ int main(int argc, char** argv) {
       detection.growing.maxStep = std::atof(argv[++i]);
     } else if (a == "--merge-rms" && hasValue) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--no-refine-unlabelled") {
+      detection.refinement.takeUnlabelled = false;
     } else if (a == "--refine-distance" && hasValue) {
       detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
     } else if (a == "--planar-noise" && hasValue) {

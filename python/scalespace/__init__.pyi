@@ -89,7 +89,7 @@ def planes(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int
            alpha: float = ..., angle: float = ..., max_step: float = ..., max_rms: float = ...,
            merge_rms: float = ..., merge_deviation: float = ...,
            merge_parallel: float = ...,
-           refine_distance: float = ...,
+           refine_distance: float = ..., refine_unlabelled: bool = ...,
            robust: bool = ..., stack: Optional[str] = ..., output: Optional[str] = ...,
            input: str = ..., threads: Optional[int] = ..., progress: Progress = ...) -> Planes: ...
 def read_planes(directory: str) -> Planes: ...

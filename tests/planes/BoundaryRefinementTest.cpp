@@ -179,6 +179,44 @@ TEST(BoundaryRefinement, AUnionGivesBackThePointsOfALargeRegionsPlane) {
   EXPECT_EQ(refine(s, kRampMerged, 0.8, 0, off).labels, s.seg.labels);
 }
 
+TEST(BoundaryRefinement, AUnionTakesTheUnlabelledPointsItsPlaneDescribes) {
+  // The two top steps and the wall above 0.7 in no region (their small regions dropped by the
+  // filter). The ramp takes the step points within 1.25 times its RMS (about 0.045: its sawtooth
+  // is 0.077 deep) of its plane, reached step by step across the treads' edges; not the step
+  // corners nor the wall beyond that, and nothing with takeUnlabelled off.
+  Scene s = staircaseBesideAWall(0);
+  const Vec3 rampNormal = Vec3(0, -0.18, 0.3).normalized();
+  const double rampOffset = rampNormal.dot(Vec3(0, 0, 0.09));
+  const auto rampDistance = [&](const Vec3& p) { return std::abs(rampNormal.dot(p) - rampOffset); };
+  std::vector<int> labels = s.seg.labels;
+  const auto topSteps = [](const Vec3& p) { return p.x() < kSide && p.y() > 1.2 - 1e-9; };
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (topSteps(s.points[i]) || (s.points[i].x() == kSide && s.points[i].z() > 0.7))
+      labels[i] = -1;
+  s.seg = segmentationOf(labels, 2);
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  const Segmentation refined = refineRegionBoundaries(s.points, knn, s.seg, kRampMerged, 0.8, 0);
+  std::size_t near = 0, nearTaken = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const double d = rampDistance(s.points[i]);
+    if (labels[i] >= 0) {
+      EXPECT_EQ(refined.labels[i], labels[i]) << "the labelled points stay where they were";
+      continue;
+    }
+    if (d > 0.07) {
+      EXPECT_EQ(refined.labels[i], -1)
+          << "beyond the ramp's bound: x " << s.points[i].x() << " z " << s.points[i].z();
+    }
+    if (topSteps(s.points[i]) && d < 0.035) ++near, nearTaken += refined.labels[i] == 0;
+  }
+  EXPECT_GT(near, 200u);
+  EXPECT_GT(double(nearTaken), 0.9 * double(near)) << nearTaken << " of " << near;
+  BoundaryRefinementOptions off;
+  off.takeUnlabelled = false;
+  EXPECT_EQ(refineRegionBoundaries(s.points, knn, s.seg, kRampMerged, 0.8, 0, off).labels,
+            s.seg.labels);
+}
+
 TEST(BoundaryRefinement, TwoRegionsOfOnePlaneKeepTheirPoints) {
   // One flat floor cut in two regions, the second fitted a little tilted (its points 1e-3 t off
   // the first's plane at its far end): without a margin, and with every point allowed to move,

@@ -340,6 +340,12 @@ void addPlanesCommand(CLI::App& app) {
                   "its plane than their own region's, within this fraction of t of it (its "
                   "edges, which the robust fit gives to the surfaces it meets; 0 = as grown)")
       ->capture_default_str();
+  cmd->add_flag("--refine-unlabelled,!--no-refine-unlabelled",
+                args->detection.refinement.takeUnlabelled,
+                "with --refine-distance: a merged union also takes the points of no region next "
+                "to it that its plane describes as well as its own (the ends of a short "
+                "staircase, dropped with the small regions there)")
+      ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")

@@ -16,6 +16,71 @@ constexpr int kPasses = 3;  // plane fits: the first, then two refits
 // A large region's tolerance never goes below this share of t: an exact face (RMS 0, no noise)
 // still takes back points lying on its plane up to rounding.
 constexpr double kMinRelativeTolerance = 1e-3;
+
+// The unions take the unlabelled points next to them, round after round (each round decides on
+// the labels it began with), while a point lies within the distance of the union's own farthest
+// point to the union's plane; among several unions, the nearest plane (ties: the first union).
+void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& knn,
+                          const std::vector<std::uint8_t>& takes, std::vector<int>& labels,
+                          std::vector<std::vector<Index>>& regions, double noiseFloor,
+                          double tolerance) {
+  const std::size_t n = labels.size();
+  std::vector<PlaneFit> planes(regions.size());
+  std::vector<double> bound(regions.size(), -1.0);  // < 0: takes nothing
+  tbb::parallel_for(std::size_t(0), regions.size(), [&](std::size_t r) {
+    if (!takes[r] || regions[r].size() < 3) return;
+    planes[r] = fitPlane(positions, regions[r]);
+    if (!planes[r].valid) return;
+    bound[r] = planeDescribesBound(planes[r].rms, noiseFloor, tolerance);
+  });
+  const auto nextToTaker = [&](Index i) {
+    for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+      const int r = labels[knn.neighbors[e]];
+      if (r >= 0 && bound[std::size_t(r)] >= 0) return true;
+    }
+    return false;
+  };
+  std::vector<Index> frontier;
+  for (std::size_t i = 0; i < n; ++i)
+    if (labels[i] < 0 && nextToTaker(Index(i))) frontier.push_back(Index(i));
+  std::vector<std::uint8_t> queued(n, 0);
+  std::vector<std::uint8_t> touched(regions.size(), 0);
+  std::vector<int> target;
+  while (!frontier.empty()) {
+    target.assign(frontier.size(), -1);
+    tbb::parallel_for(std::size_t(0), frontier.size(), [&](std::size_t f) {
+      const Index i = frontier[f];
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+        const int r = labels[knn.neighbors[e]];
+        if (r < 0 || bound[std::size_t(r)] < 0) continue;
+        const PlaneFit& plane = planes[std::size_t(r)];
+        const double d = std::abs(plane.normal.dot(positions[i]) - plane.offset);
+        if (d <= bound[std::size_t(r)] && (d < best || (d == best && r < target[f])))
+          best = d, target[f] = r;
+      }
+    });
+    std::vector<Index> moved;
+    for (std::size_t f = 0; f < frontier.size(); ++f) {
+      if (target[f] < 0) continue;
+      labels[frontier[f]] = target[f];
+      regions[std::size_t(target[f])].push_back(frontier[f]);
+      touched[std::size_t(target[f])] = 1;
+      moved.push_back(frontier[f]);
+    }
+    std::vector<Index> next;
+    for (const Index i : moved)
+      for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+        const Index j = knn.neighbors[e];
+        if (labels[j] < 0 && !queued[j]) queued[j] = 1, next.push_back(j);
+      }
+    for (const Index i : next) queued[i] = 0;
+    std::sort(next.begin(), next.end());
+    frontier = std::move(next);
+  }
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    if (touched[r]) std::sort(regions[r].begin(), regions[r].end());
+}
 }  // namespace
 
 void validate(const BoundaryRefinementOptions& options) {
@@ -143,6 +208,11 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
     for (std::size_t i = 0; i < n; ++i)
       if (labels[i] >= 0) regions[std::size_t(labels[i])].push_back(Index(i));
   }
+
+  if (options.takeUnlabelled)
+    takeUnlabelledPoints(positions, knn, takes, labels, regions,
+                         std::max(options.noiseFactor * noiseRms, kMinRelativeTolerance * t),
+                         kPlaneDescribesTolerance);
 
   // The regions in their order, the emptied ones dropped.
   Segmentation refined;
