@@ -11,6 +11,7 @@
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
 //                     [--robust-iterations N] [--max-step F] [--max-rms F] [--merge-rms F]
 //                     [--merge-width F] [--refine-distance F] [--refine-gain F] [--refine-offset F]
+//                     [--no-refine-unlabelled]
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
 // --max-step F / --max-rms F / --merge-rms F / --merge-width F set PlaneDetectionOptions
 // (growing.maxStep, planarity.maxRelativeRms, merging.maxRelativeRms, merging.minRelativeWidth;
@@ -216,6 +217,8 @@ int main(int argc, char** argv) {
       detection.planarity.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--merge-rms" && i + 1 < argc) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
+    } else if (a == "--no-refine-unlabelled") {
+      detection.refinement.takeUnlabelled = false;
     } else if (a == "--refine-distance" && i + 1 < argc) {
       detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
     } else if (a == "--refine-gain" && i + 1 < argc) {

@@ -172,6 +172,20 @@ def test_planes_merge_options_are_checked_before_any_work(data):
         assert "Options::" not in str(e.value)
 
 
+def test_planes_refine_unlabelled_is_the_cli_flag_and_labels_more(data, tmp_path):
+    # Merged unions take the points of no region that their plane describes: on the house, some
+    # are labelled with it and none is unlabelled that was labelled without it.
+    cloud = ss.read(str(data / "house.ply"))
+    with_fill = ss.planes(cloud.points, cloud.normals, scales=20)
+    without = ss.planes(cloud.points, cloud.normals, scales=20, refine_unlabelled=False)
+    assert (with_fill.membership >= 0).sum() > (without.membership >= 0).sum()
+    assert np.all(with_fill.membership[without.membership >= 0] >= 0)
+    cli("planes", data / "house.ply", "-o", tmp_path / "p", "--scales", 20,
+        "--no-refine-unlabelled")
+    np.testing.assert_array_equal(ss.read_planes(str(tmp_path / "p")).membership,
+                                  without.membership)
+
+
 def test_stack_in_memory_equals_the_stack_on_disk_and_the_export(data, tmp_path):
     cloud = ss.read(str(data / "sphere.ply"))
     cli("scales", data / "sphere.ply", "-o", tmp_path / "s.stack", "--scales", 4, "--encoding",
