@@ -17,7 +17,8 @@
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]
 //                     [--scales M (50)] [--resolution R (128): the peers' mesh grid]
 //                     [--no-peers] [--threads T] [--relax-iterations I (5)]
-//                     [--relax-max-solve N (100000)]: the relaxations' options
+//                     [--relax-max-solve N (100000)] [--relax-large-spheres]: the relaxations'
+//                     options
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
@@ -173,7 +174,7 @@ int main(int argc, char** argv) {
   std::vector<double> noises{0, 1e-3};
   int scales = 50, resolution = 128, threads = 0, relaxIterations = 5;
   std::size_t relaxMaxSolve = RelaxationOptions{}.maxSolvePoints;
-  bool peers = true;
+  bool peers = true, largeSpheres = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--points" && i + 1 < argc) {
@@ -196,11 +197,13 @@ int main(int argc, char** argv) {
       relaxMaxSolve = std::stoul(argv[++i]);
     } else if (a == "--no-peers") {
       peers = false;
+    } else if (a == "--relax-large-spheres") {
+      largeSpheres = true;
     } else {
       std::fprintf(stderr,
                    "usage: bench_parametrize [--points N] [--shapes a,b] [--noise 0,0.001] "
                    "[--scales M] [--resolution R] [--no-peers] [--threads T] "
-                   "[--relax-iterations I] [--relax-max-solve N]\n");
+                   "[--relax-iterations I] [--relax-max-solve N] [--relax-large-spheres]\n");
       return 2;
     }
   }
@@ -246,6 +249,7 @@ int main(int argc, char** argv) {
         RelaxationOptions relax;
         relax.iterations = relaxIterations;
         relax.maxSolvePoints = relaxMaxSolve;
+        relax.largeSpheres = largeSpheres;
         relax.rigid = v.rigid;
         relax.rounds = v.rounds;
         const RelaxationResult r =

@@ -152,7 +152,8 @@ def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
 
 def parametrize(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
                 domain: str = ..., k: int = ..., tmax: float = ..., alpha: float = ...,
-                relax: int = ..., rigid: bool = ..., threads: Optional[int] = ...,
+                relax: int = ..., relax_rounds: int = ..., rigid: bool = ...,
+                relax_large_spheres: bool = ..., threads: Optional[int] = ...,
                 progress: Progress = ...) -> Dict[str, object]:
     """Meshless parametrization (Sec. 4.3): a dict with domain ("plane" | "sphere"), uv (N, 2)
     or direction (N, 3) with longitude and latitude, valid, fold, overlap, local_scale,

@@ -287,7 +287,8 @@ TEST(Parametrization, RelaxationLowersTheDistortionWithoutFolds) {
   EXPECT_EQ(relaxedRound.defects.folds + relaxedRound.defects.overlaps, 0u);
   EXPECT_LT(medianAt16(closed, relaxedRound.domain, false) - 1,
             0.5 * (medianAt16(closed, round.domain, false) - 1));
-  // Not above maxSolvePoints (no subsample for spheres yet): said, not warned about.
+  // Not above maxSolvePoints unless asked (ALargeSphereIsRelaxedOnASubsampleWhenAsked): said, not
+  // warned about.
   ParametrizationOptions small = fewScales();
   small.relaxation.maxSolvePoints = 1000;
   const Parametrization large = parametrize(closed.positions, closed.normals, small);
@@ -349,6 +350,38 @@ TEST(Parametrization, ALargeCloudIsRelaxedOnASubsample) {
   ASSERT_EQ(a.domain.uv.size(), b.domain.uv.size());
   for (std::size_t i = 0; i < a.domain.uv.size(); ++i)
     ASSERT_EQ(a.domain.uv[i], b.domain.uv[i]) << i;
+}
+
+TEST(Parametrization, ALargeSphereIsRelaxedOnASubsampleWhenAsked) {
+  const Cloud c = shape(ParamShape::Blob, 12000);
+  ParametrizationOptions thesisOptions = fewScales(), sub = fewScales();
+  thesisOptions.relaxation.iterations = 0;
+  sub.relaxation.maxSolvePoints = 3000;
+  sub.relaxation.largeSpheres = true;
+  const Parametrization thesis = parametrize(c.positions, c.normals, thesisOptions);
+  const Parametrization full = parametrize(c.positions, c.normals, fewScales());
+  const Parametrization p = parametrize(c.positions, c.normals, sub);
+  ASSERT_EQ(p.domain.kind, DomainKind::Sphere);
+  ASSERT_TRUE(p.relaxation.applied) << p.relaxation.reason;
+  EXPECT_LE(p.relaxation.solvedPoints, 3000u);
+  EXPECT_GT(p.relaxation.solvedPoints, 1500u);
+  EXPECT_EQ(p.defects.folds + p.defects.overlaps, 0u);
+  // Every direction a unit vector, with its longitude and latitude.
+  for (std::size_t i = 0; i < c.positions.size(); ++i) {
+    const Vec3& d = p.domain.direction[i];
+    ASSERT_NEAR(d.norm(), 1, 1e-12) << i;
+    ASSERT_NEAR(p.domain.latitude[i], std::asin(d.z()) * 180 / kPi, 1e-9) << i;
+  }
+  // The areas come much closer to the surface's, nearly as close as with the whole system.
+  const double ours = medianAt16(c, p.domain, false) - 1;
+  EXPECT_LT(ours, 0.5 * (medianAt16(c, thesis.domain, false) - 1));
+  EXPECT_LT(ours, 2 * (medianAt16(c, full.domain, false) - 1) + 1e-3);
+  // Identical for any thread count, the placement and the smoothing on the sphere included.
+  ParametrizationOptions one = sub, two = sub;
+  one.flattening.threads = 1;
+  two.flattening.threads = 2;
+  EXPECT_EQ(parametrize(c.positions, c.normals, one).domain.direction,
+            parametrize(c.positions, c.normals, two).domain.direction);
 }
 
 TEST(Parametrization, RelaxationReportsProgressAndCanBeCancelled) {

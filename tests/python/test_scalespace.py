@@ -654,6 +654,9 @@ def test_parametrize_relaxation_options_equal_the_cli(tmp_path):
     default = ss.parametrize(cloud.points, cloud.normals, scales=15)
     assert default["relaxed"]
     assert not np.allclose(default["uv"], maps["thesis"]) and not np.allclose(default["uv"], maps["conformal"])
+    # Large spheres only: a plane domain of 4000 points is relaxed the same either way.
+    same = ss.parametrize(cloud.points, cloud.normals, scales=15, relax_large_spheres=True)
+    np.testing.assert_array_equal(same["uv"], default["uv"])
     with pytest.raises(ss.OptionError, match="relax_rounds"):
         ss.parametrize(cloud.points, cloud.normals, relax_rounds=0)
     bad = subprocess.run([CLI, "parametrize", str(tmp_path / "r.ply"), "--relax-rounds", "0", "-o",

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/Parallel.hpp"
@@ -331,15 +332,18 @@ std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, OffsetOf o
 /// Local-global iterations whose global step is `sweeps` damped Jacobi sweeps of the system from
 /// the current map instead of a solve: after the placement from a subsample, they remove the
 /// error finer than the samples' spacing (a smoother's job: a two-grid scheme), at the cost of a
-/// few passes over the edges. Deterministic (sequential accumulation).
+/// few passes over the edges. Deterministic (sequential accumulation). Generic in the domain:
+/// `offsetOf(i, e)` reads a neighbour's offset in i's tangent frame of the domain (the local
+/// step's input), `lift(i, r)` is the domain offset a tangent offset r asks of a neighbour of i
+/// (the plane's r itself; a sphere's chord) and `project()` puts the points back on the domain
+/// after each sweep (and refreshes what offsetOf and lift read).
 constexpr int kSmoothingIterations = 2, kSmoothingSweeps = 3;
 
+template <class Point, class OffsetOf, class Lift, class Project>
 void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, int iterations,
-                   int sweeps, std::vector<Vec2>& uv) {
-  Vec2 centroid;
-  const double size = spread(uv, centroid);
+                   int sweeps, std::vector<Point>& x, OffsetOf offsetOf, Lift lift,
+                   Project project) {
   std::vector<Eigen::Matrix2d> similarity(g.n, Eigen::Matrix2d::Identity());
-  const auto offsetOf = planeOffsets(g, uv);
   fitSimilarities(g, offsetOf, options.rigid, similarity);
   const std::vector<double> rho =
       options.rounds > 1 ? robustWeights(g, offsetOf, similarity, options.maxDownweight)
@@ -354,21 +358,33 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
       diagonal[j] += w;
     }
   constexpr double kDamping = 0.7;
-  std::vector<Vec2> sum(g.n);
+  std::vector<Point> sum(g.n);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     if (iteration > 0) fitSimilarities(g, offsetOf, options.rigid, similarity);
     for (int sweep = 0; sweep < sweeps; ++sweep) {
-      // Row m of L u = rhs solved for u_m: u_m = (rhs_m + sum_{edges m-j} w u_j) / L_mm.
-      std::fill(sum.begin(), sum.end(), Vec2::Zero());
+      // Row m of L x = rhs solved for x_m: x_m = (rhs_m + sum_{edges m-j} w x_j) / L_mm.
+      std::fill(sum.begin(), sum.end(), Point::Zero());
       forEachTargetOffset(g, rho, similarity,
                           [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
-                            sum[j] += w * (uv[i] + r);
-                            sum[i] += w * (uv[j] - r);
+                            const Point d = lift(i, r);
+                            sum[j] += w * (x[i] + d);
+                            sum[i] += w * (x[j] - d);
                           });
       for (std::size_t i = 0; i < g.n; ++i)
-        if (diagonal[i] > 0) uv[i] += kDamping * (sum[i] / diagonal[i] - uv[i]);
+        if (diagonal[i] > 0) x[i] += kDamping * (sum[i] / diagonal[i] - x[i]);
+      project();
     }
   }
+}
+
+/// The plane's smoothing keeps the domain's centroid, and its spread unless rigid.
+void smoothPlane(const RelaxationGraph& g, const RelaxationOptions& options,
+                 std::vector<Vec2>& uv) {
+  Vec2 centroid;
+  const double size = spread(uv, centroid);
+  smoothOnGraph(
+      g, options, kSmoothingIterations, kSmoothingSweeps, uv, planeOffsets(g, uv),
+      [](std::size_t, const Vec2& r) { return r; }, [] {});
   Vec2 c;
   const double s = spread(uv, c);
   const double factor = options.rigid || !(s > 0) ? 1.0 : size / s;
@@ -419,23 +435,24 @@ std::vector<Index> solveSubsample(const std::vector<Vec3>& positions, std::size_
   return sample;
 }
 
-/// Every point placed by the local maps of its 4 nearest samples: u = sum_s w_s predict(s, p -
+/// Every point placed by the local maps of its 4 nearest samples: x = sum_s w_s predict(s, p -
 /// p_s) / sum_s w_s, with the kernel of Eq. 1.6 over 1.5 x the 4th distance; the samples keep
-/// their own positions.
-template <class Predict>
-std::vector<Vec2> placeFromSamples(const std::vector<Vec3>& positions,
-                                   const std::vector<Index>& sample,
-                                   const std::vector<Vec3>& samplePositions,
-                                   const std::vector<Vec2>& samplePoints, Predict predict) {
+/// their own positions. Point: Vec2 (plane coordinates) or Vec3 (a sphere's points, which the
+/// caller puts back on it).
+template <class Predict, class Point = std::decay_t<std::invoke_result_t<Predict, Index, Vec3>>>
+std::vector<Point> placeFromSamples(const std::vector<Vec3>& positions,
+                                    const std::vector<Index>& sample,
+                                    const std::vector<Vec3>& samplePositions,
+                                    const std::vector<Point>& samplePoints, Predict predict) {
   const auto index = makeSpatialIndex(samplePositions);
-  std::vector<Vec2> out(positions.size());
+  std::vector<Point> out(positions.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<Neighbor> near;
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         index->knnSearch(positions[i], 4, near);
                         const double r2 = 2.25 * near.back().distSq;
-                        Vec2 sum = Vec2::Zero();
+                        Point sum = Point::Zero();
                         double total = 0;
                         for (const Neighbor& s : near) {
                           const double x = r2 > 0 ? 1 - s.distSq / r2 : 1;
@@ -505,24 +522,53 @@ std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec
   });
   const RelaxationGraph fine =
       gatherGraph(positions, normals, map, std::size_t(options.neighbors), mirror);
-  smoothOnGraph(fine, options, kSmoothingIterations, kSmoothingSweeps, map.uv);
+  smoothPlane(fine, options, map.uv);
   return {};
 }
 
+/// The points x_i = R d_i of a sphere domain put back on the sphere of radius R, and the tangent
+/// bases the local step reads there.
+struct SpherePoints {
+  double radius = 1;
+  std::vector<Vec3> x;
+  std::vector<Eigen::Matrix<double, 3, 2>> basis;
+  void project() {
+    parallelFor(x.size(), [&](std::size_t i) {
+      if (x[i].norm() > 0) x[i] = radius * x[i].normalized();
+      basis[i] = sphereBasis(x[i].normalized());
+    });
+  }
+};
+
 /// Relaxes the sphere directions of `map` (and its radius: the surface's units for rotations).
+/// Above maxSolvePoints, on a subsample: every other point is placed from the samples' local
+/// maps (in their tangent planes, then put back on the sphere) and smoothed at full resolution,
+/// as the plane's are.
 std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                         DomainMap& map, const RelaxationOptions& options,
                         const ProgressCallback& progress, std::size_t& solved) {
-  solved = positions.size();
-  RelaxationGraph graph = gatherGraph(positions, normals, map, std::size_t(options.neighbors), 1.0);
+  const SolveSet set = solveSetOf(positions, normals, options);
+  DomainMap solveDomain;
+  if (set.subsampled) {
+    solveDomain = map;
+    solveDomain.direction.clear();
+    for (Index i : set.sample) solveDomain.direction.push_back(map.direction[i]);
+  }
+  const std::vector<Vec3>& p = set.subsampled ? set.positions : positions;
+  const std::vector<Vec3>& m = set.subsampled ? set.normals : normals;
+  const DomainMap& d = set.subsampled ? solveDomain : map;
+  if (p.size() < std::size_t(options.neighbors) + 1) return "too few points";
+  solved = p.size();
+  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
   const double radius = map.radius > 0 ? map.radius : 1.0;
-  std::vector<Vec3> x(positions.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = radius * map.direction[i];
+  std::vector<Vec3> x(p.size());
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = radius * d.direction[i];
   const auto sphereOffsets = [&](std::size_t i, std::size_t e) -> Vec2 {
     return sphereBasis(x[i].normalized()).transpose() * (x[graph.neighbor[i * graph.k + e]] - x[i]);
   };
   // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
-  if (majorityDeterminantSign(localJacobians(graph, sphereOffsets)) < 0) mirrorGraph(graph);
+  const double mirror = majorityDeterminantSign(localJacobians(graph, sphereOffsets));
+  if (mirror < 0) mirrorGraph(graph);
 
   ProgressTracker tracker(progress, "relaxation",
                           std::size_t(options.iterations) * std::size_t(options.rounds));
@@ -530,15 +576,42 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
   std::string failure = relaxOnSphere(graph, options, x, similarity, tracker);
   if (!failure.empty()) return failure;
   tracker.finish();
+  if (set.subsampled) {
+    SpherePoints full;
+    full.radius = 0;
+    for (const Vec3& q : x) full.radius += q.norm();
+    full.radius /= double(x.size());
+    const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, sphereOffsets);
+    full.x = placeFromSamples(positions, set.sample, p, x, [&](Index s, const Vec3& offset) {
+      return Vec3(x[s] +
+                  sphereBasis(x[s].normalized()) * (jacobian[s] * (graph.toTangent[s] * offset)));
+    });
+    full.basis.resize(full.x.size());
+    full.project();
+    DomainMap fineMap = map;
+    for (std::size_t i = 0; i < full.x.size(); ++i) fineMap.direction[i] = full.x[i].normalized();
+    const RelaxationGraph fine =
+        gatherGraph(positions, normals, fineMap, std::size_t(options.neighbors), mirror);
+    smoothOnGraph(
+        fine, options, kSmoothingIterations, kSmoothingSweeps, full.x,
+        [&](std::size_t i, std::size_t e) -> Vec2 {
+          return full.basis[i].transpose() * (full.x[fine.neighbor[i * fine.k + e]] - full.x[i]);
+        },
+        [&](std::size_t i, const Vec2& r) -> Vec3 {
+          return full.basis[i] * r - (r.squaredNorm() / (2 * full.radius)) * full.x[i].normalized();
+        },
+        [&] { full.project(); });
+    x = std::move(full.x);
+  }
   constexpr double kDegrees = 180 / 3.14159265358979323846;
   double sum = 0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (!(x[i].norm() > 0)) return "the relaxation put a point at the sphere's centre";
     sum += x[i].norm();
-    const Vec3 d = x[i].normalized();
-    map.direction[i] = d;
-    map.longitude[i] = std::atan2(d.y(), d.x()) * kDegrees;
-    map.latitude[i] = std::asin(std::clamp(d.z(), -1.0, 1.0)) * kDegrees;
+    const Vec3 dir = x[i].normalized();
+    map.direction[i] = dir;
+    map.longitude[i] = std::atan2(dir.y(), dir.x()) * kDegrees;
+    map.latitude[i] = std::asin(std::clamp(dir.z(), -1.0, 1.0)) * kDegrees;
   }
   map.radius = sum / double(x.size());
   return {};
@@ -573,11 +646,10 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
     result.reason = options.iterations == 0 ? "no iteration asked" : "too few points";
     return result;
   }
-  // A sphere is not yet relaxed on a subsample: placed from its samples without the plane's
-  // smoothing pass, a 1M-point triaxial ellipsoid got folds (bench/README.md).
-  if (domain.kind == DomainKind::Sphere && n > options.maxSolvePoints) {
+  if (domain.kind == DomainKind::Sphere && n > options.maxSolvePoints && !options.largeSpheres) {
     result.reason = "a sphere domain is relaxed up to RelaxationOptions::maxSolvePoints = " +
-                    std::to_string(options.maxSolvePoints) + " points";
+                    std::to_string(options.maxSolvePoints) +
+                    " points unless RelaxationOptions::largeSpheres";
     return result;
   }
   // Progress: the relaxation [0, 0.6], the check after [0.6, 0.8], the one before (only when

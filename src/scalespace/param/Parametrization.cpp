@@ -38,9 +38,11 @@ Parametrization parametrize(const std::vector<Vec3>& positions, const std::vecto
     relaxation.defects = options.defects;
     result.relaxation = relaxConformally(positions, normals, result.domain, relaxation,
                                          subProgress(progress, 0.75, 1));
-    // A large sphere domain is left as the thesis maps it, said in the JSON, not warned about.
-    const bool largeSphere =
-        result.domain.kind == DomainKind::Sphere && positions.size() > relaxation.maxSolvePoints;
+    // A large sphere domain is left as the thesis maps it unless asked, said in the JSON, not
+    // warned about.
+    const bool largeSphere = result.domain.kind == DomainKind::Sphere &&
+                             positions.size() > relaxation.maxSolvePoints &&
+                             !relaxation.largeSpheres;
     if (!result.relaxation.applied && !largeSphere)
       result.warnings.push_back("relaxation not applied: " + result.relaxation.reason);
     else if (result.relaxation.applied && result.relaxation.roundsApplied < relaxation.rounds)
