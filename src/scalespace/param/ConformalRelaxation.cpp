@@ -487,20 +487,52 @@ SolveSet solveSetOf(const std::vector<Vec3>& positions, const std::vector<Vec3>&
   return set;
 }
 
+/// What the system is solved on: the points (a subsample above maxSolvePoints), the map
+/// restricted to them, and their graph.
+struct SolveSystem {
+  SolveSet set;
+  DomainMap domain;  // the map at the samples (subsampled only)
+  RelaxationGraph graph;
+  const std::vector<Vec3>& positions(const std::vector<Vec3>& all) const {
+    return set.subsampled ? set.positions : all;
+  }
+  const DomainMap& map(const DomainMap& all) const { return set.subsampled ? domain : all; }
+};
+
+/// Fills `system` and `solved` (its point count); false when it has too few points for the graph.
+bool buildSolveSystem(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                      const DomainMap& map, const RelaxationOptions& options, SolveSystem& system,
+                      std::size_t& solved) {
+  system.set = solveSetOf(positions, normals, options);
+  if (system.set.subsampled) {
+    system.domain.kind = map.kind;
+    system.domain.radius = map.radius;
+    system.domain.centre = map.centre;
+    system.domain.orientation = map.orientation;
+    for (Index i : system.set.sample) {
+      if (map.kind == DomainKind::Plane)
+        system.domain.uv.push_back(map.uv[i]);
+      else
+        system.domain.direction.push_back(map.direction[i]);
+    }
+  }
+  const std::vector<Vec3>& p = system.positions(positions);
+  if (p.size() < std::size_t(options.neighbors) + 1) return false;
+  solved = p.size();
+  system.graph = gatherGraph(p, system.set.subsampled ? system.set.normals : normals,
+                             system.map(map), std::size_t(options.neighbors), 1.0);
+  return true;
+}
+
 /// Relaxes the plane coordinates of `map`; returns why it could not, or an empty string.
 std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                        DomainMap& map, const RelaxationOptions& options,
                        const ProgressCallback& progress, std::size_t& solved) {
-  const SolveSet set = solveSetOf(positions, normals, options);
-  DomainMap solveDomain;
-  if (set.subsampled)
-    for (Index i : set.sample) solveDomain.uv.push_back(map.uv[i]);
-  const std::vector<Vec3>& p = set.subsampled ? set.positions : positions;
-  const std::vector<Vec3>& m = set.subsampled ? set.normals : normals;
-  const DomainMap& d = set.subsampled ? solveDomain : map;
-  if (p.size() < std::size_t(options.neighbors) + 1) return "too few points";
-  solved = p.size();
-  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
+  SolveSystem system;
+  if (!buildSolveSystem(positions, normals, map, options, system, solved)) return "too few points";
+  RelaxationGraph& graph = system.graph;
+  const std::vector<Vec3>& p = system.positions(positions);
+  const DomainMap& d = system.map(map);
   // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
   const double mirror = majorityDeterminantSign(localJacobians(graph, planeOffsets(graph, d.uv)));
   if (mirror < 0) mirrorGraph(graph);
@@ -512,12 +544,12 @@ std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec
   std::string failure = relaxOnGraph(graph, options, uv, similarity, tracker);
   if (!failure.empty()) return failure;
   tracker.finish();
-  if (!set.subsampled) {
+  if (!system.set.subsampled) {
     map.uv = std::move(uv);
     return {};
   }
   const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, planeOffsets(graph, uv));
-  map.uv = placeFromSamples(positions, set.sample, p, uv, [&](Index s, const Vec3& offset) {
+  map.uv = placeFromSamples(positions, system.set.sample, p, uv, [&](Index s, const Vec3& offset) {
     return Vec2(uv[s] + jacobian[s] * (graph.toTangent[s] * offset));
   });
   const RelaxationGraph fine =
@@ -547,19 +579,11 @@ struct SpherePoints {
 std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                         DomainMap& map, const RelaxationOptions& options,
                         const ProgressCallback& progress, std::size_t& solved) {
-  const SolveSet set = solveSetOf(positions, normals, options);
-  DomainMap solveDomain;
-  if (set.subsampled) {
-    solveDomain = map;
-    solveDomain.direction.clear();
-    for (Index i : set.sample) solveDomain.direction.push_back(map.direction[i]);
-  }
-  const std::vector<Vec3>& p = set.subsampled ? set.positions : positions;
-  const std::vector<Vec3>& m = set.subsampled ? set.normals : normals;
-  const DomainMap& d = set.subsampled ? solveDomain : map;
-  if (p.size() < std::size_t(options.neighbors) + 1) return "too few points";
-  solved = p.size();
-  RelaxationGraph graph = gatherGraph(p, m, d, std::size_t(options.neighbors), 1.0);
+  SolveSystem system;
+  if (!buildSolveSystem(positions, normals, map, options, system, solved)) return "too few points";
+  RelaxationGraph& graph = system.graph;
+  const std::vector<Vec3>& p = system.positions(positions);
+  const DomainMap& d = system.map(map);
   const double radius = map.radius > 0 ? map.radius : 1.0;
   std::vector<Vec3> x(p.size());
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = radius * d.direction[i];
@@ -576,13 +600,13 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
   std::string failure = relaxOnSphere(graph, options, x, similarity, tracker);
   if (!failure.empty()) return failure;
   tracker.finish();
-  if (set.subsampled) {
+  if (system.set.subsampled) {
     SpherePoints full;
     full.radius = 0;
     for (const Vec3& q : x) full.radius += q.norm();
     full.radius /= double(x.size());
     const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, sphereOffsets);
-    full.x = placeFromSamples(positions, set.sample, p, x, [&](Index s, const Vec3& offset) {
+    full.x = placeFromSamples(positions, system.set.sample, p, x, [&](Index s, const Vec3& offset) {
       return Vec3(x[s] +
                   sphereBasis(x[s].normalized()) * (jacobian[s] * (graph.toTangent[s] * offset)));
     });
