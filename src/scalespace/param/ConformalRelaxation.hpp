@@ -48,9 +48,9 @@ struct RelaxationOptions {
   /// drift: bench/README.md).
   bool rigid = true;
   /// A sphere domain above maxSolvePoints is relaxed too, on a subsample (placed from it and
-  /// smoothed at full resolution, as a plane's). Off by default: on a 1M-point triaxial
-  /// ellipsoid it costs 20 s (the flattening takes 45 s) and trades conformal for authalic
-  /// distortion (median eps_auth 1.31 -> 1.11, eps_conf 1.034 -> 1.054 at 16 neighbours).
+  /// smoothed at full resolution, as a plane's). Off by default: at 1M points it adds about half
+  /// the flattening's time, and it trades conformal for authalic distortion (docs/THESIS_NOTES.md,
+  /// "Relaxation").
   bool largeSpheres = false;
   /// The fold and overlap check of the map before and after (a relaxation that adds defects is
   /// not applied).

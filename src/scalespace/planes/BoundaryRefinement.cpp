@@ -18,8 +18,9 @@ constexpr int kPasses = 3;  // plane fits: the first, then two refits
 constexpr double kMinRelativeTolerance = 1e-3;
 
 // The unions take the unlabelled points next to them, round after round (each round decides on
-// the labels it began with), while a point lies within the distance of the union's own farthest
-// point to the union's plane; among several unions, the nearest plane (ties: the first union).
+// the labels it began with), while a point lies within planeDescribesBound of the union's plane
+// (`tolerance` times its RMS, or the noise floor); among several unions, the nearest plane (ties:
+// the first union).
 void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& knn,
                           const std::vector<std::uint8_t>& takes, std::vector<int>& labels,
                           std::vector<std::vector<Index>>& regions, double noiseFloor,

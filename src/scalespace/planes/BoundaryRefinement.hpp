@@ -40,11 +40,12 @@ struct BoundaryRefinementOptions {
   /// staircase's side under its sawtooth edge), which lie on that surface's plane. The same
   /// rule as the merging's join (planes/PlaneDescribes.hpp). 0: unions only take.
   double largeRegionTolerance = kPlaneDescribesTolerance;
-  /// After the moves, a union also takes the unlabelled points next to it (transitively) that lie
-  /// no farther from its plane than its own farthest point: the points of the small regions that
-  /// the filter dropped where the union meets other surfaces (the top tread of a short staircase,
-  /// where the kernel rounds the treads into the back face; the treads' ends next to its sides).
-  /// Its plane describes them as well as its own points. false: unlabelled points stay so.
+  /// After the moves, a union also takes the unlabelled points next to it (transitively) that its
+  /// plane describes as well as its own points (within planeDescribesBound of its RMS, or the
+  /// noise floor): the points of the small regions that the filter dropped where the union meets
+  /// other surfaces (the top tread of a short staircase, where the kernel rounds the treads into
+  /// the back face; the treads' ends next to its sides). Its own farthest point as the bound
+  /// took a staircase's sides too. false: unlabelled points stay so.
   bool takeUnlabelled = true;
 };
 
@@ -61,8 +62,8 @@ void validate(const BoundaryRefinementOptions& options);
 /// labels the round began with. A point only moves to a plane nearer than its own by a margin, so
 /// the rounds end; a region of fewer than 3 points has no plane (its points go to any union in
 /// reach).
-/// Then each union takes, in rounds, the unlabelled points next to it within its own farthest
-/// point's distance of its plane (takeUnlabelled); other unlabelled points stay unlabelled.
+/// Then each union takes, in rounds, the unlabelled points next to it that its plane describes
+/// (takeUnlabelled); other unlabelled points stay unlabelled.
 /// Regions keep their order, emptied ones are dropped, point
 /// lists increasing. Deterministic, the same for any thread count.
 /// `noiseRms` is the cloud's sensor noise (pointNoiseRms).
