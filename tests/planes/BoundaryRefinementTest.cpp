@@ -215,6 +215,17 @@ TEST(BoundaryRefinement, AUnionTakesTheUnlabelledPointsItsPlaneDescribes) {
   off.takeUnlabelled = false;
   EXPECT_EQ(refineRegionBoundaries(s.points, knn, s.seg, kRampMerged, 0.8, 0, off).labels,
             s.seg.labels);
+  // The union alone (the wall in no region either): it still takes the same step points.
+  std::vector<int> alone = labels;
+  for (int& l : alone)
+    if (l == 1) l = -1;
+  const Segmentation single =
+      refineRegionBoundaries(s.points, knn, segmentationOf(alone, 1), {O::merged}, 0.8, 0);
+  std::size_t singleTaken = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (topSteps(s.points[i]) && rampDistance(s.points[i]) < 0.035)
+      singleTaken += single.labels[i] == 0;
+  EXPECT_GT(double(singleTaken), 0.9 * double(near)) << singleTaken << " of " << near;
 }
 
 TEST(BoundaryRefinement, TwoRegionsOfOnePlaneKeepTheirPoints) {

@@ -175,11 +175,14 @@ std::vector<double> robustWeights(const RelaxationGraph& g, OffsetOf offsetOf,
 
 /// The rounds of local-global iterations: `step(solver, pin, rho, similarity)` is the global
 /// step of the domain at hand (a solve, then the domain's own constraint); it returns why it
-/// failed, or an empty string. `similarity` gets the final local similarities.
+/// failed, or an empty string. `similarity` gets the final local similarities. Progress: one
+/// step per iteration.
 template <class OffsetOf, class GlobalStep>
 std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& options,
-                        ProgressTracker& tracker, OffsetOf offsetOf, GlobalStep step,
+                        const ProgressCallback& progress, OffsetOf offsetOf, GlobalStep step,
                         std::vector<Eigen::Matrix2d>& similarity) {
+  ProgressTracker tracker(progress, "relaxation",
+                          std::size_t(options.iterations) * std::size_t(options.rounds));
   similarity.assign(g.n, Eigen::Matrix2d::Identity());
   std::vector<double> rho(g.n, 1.0);
   // The matrix's pattern does not change between rounds (every weight stays > 0): ordered once,
@@ -202,6 +205,7 @@ std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& optio
     }
   }
   fitSimilarities(g, offsetOf, options.rigid, similarity);
+  tracker.finish();
   return {};
 }
 
@@ -226,7 +230,7 @@ Eigen::Matrix<double, 3, 2> sphereBasis(const Vec3& d) {
 /// local similarities. Returns an empty string, or why the relaxation could not run.
 std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& options,
                          std::vector<Vec2>& uv, std::vector<Eigen::Matrix2d>& similarity,
-                         ProgressTracker& tracker) {
+                         const ProgressCallback& progress) {
   Vec2 centroid;
   const double size = spread(uv, centroid);
   const auto step = [&](const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver,
@@ -251,36 +255,56 @@ std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& opti
     for (std::size_t i = 0; i < g.n; ++i) uv[i] = centroid + (next[i] - c) * factor;
     return {};
   };
-  return relaxRounds(g, options, tracker, planeOffsets(g, uv), step, similarity);
+  return relaxRounds(g, options, progress, planeOffsets(g, uv), step, similarity);
 }
 
-/// The same on a sphere domain: the points x_i = R d_i in 3D; the local step reads the domain
-/// offsets in the sphere's tangent plane at d_i (basis E_i), the global step solves for 3D points
-/// with the chords whose tangent parts are S_i a_ij, which are then put back on the sphere (for
-/// rotations, of the radius their mean distance gives: the surface's units).
+/// The points x_i = R d_i of a sphere domain, on the sphere of radius R about the origin (the
+/// sphere's centre), with the tangent bases E_i at them that the local step reads offsets in.
+struct SpherePoints {
+  double radius = 1;
+  std::vector<Vec3> x;
+  std::vector<Eigen::Matrix<double, 3, 2>> basis;
+
+  SpherePoints() = default;
+  SpherePoints(const std::vector<Vec3>& directions, double r) : radius(r), x(directions.size()) {
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = r * directions[i];
+    basis.resize(x.size());
+    project();
+  }
+  /// Every point back on the sphere (a point at the centre stays there), its basis refreshed.
+  void project() {
+    parallelFor(x.size(), [&](std::size_t i) {
+      if (x[i].norm() > 0) x[i] = radius * x[i].normalized();
+      basis[i] = sphereBasis(x[i].normalized());
+    });
+  }
+  /// The offset of i's e-th neighbour in g, in i's tangent plane.
+  auto offsets(const RelaxationGraph& g) const {
+    return [this, &g](std::size_t i, std::size_t e) -> Vec2 {
+      return basis[i].transpose() * (x[g.neighbor[i * g.k + e]] - x[i]);
+    };
+  }
+  /// The chord of the sphere from x_i whose tangent part is r (it dips by |r|^2 / 2R below the
+  /// tangent plane): an exact sphere is then a fixed point.
+  Vec3 lift(std::size_t i, const Vec2& r) const {
+    return basis[i] * r - (r.squaredNorm() / (2 * radius)) * x[i].normalized();
+  }
+};
+
+/// The same on a sphere domain: the local step reads the domain offsets in the sphere's tangent
+/// planes, the global step solves for 3D points with the chords whose tangent parts are S_i a_ij,
+/// which are then put back on the sphere (for rotations, of the radius their mean distance
+/// gives: the surface's units).
 std::string relaxOnSphere(const RelaxationGraph& g, const RelaxationOptions& options,
-                          std::vector<Vec3>& x, std::vector<Eigen::Matrix2d>& similarity,
-                          ProgressTracker& tracker) {
-  std::vector<Eigen::Matrix<double, 3, 2>> basis(g.n);
-  const auto updateBases = [&] {
-    parallelFor(g.n, [&](std::size_t i) { basis[i] = sphereBasis(x[i].normalized()); });
-  };
-  updateBases();
-  double radius = 0;
-  for (const Vec3& p : x) radius += p.norm();
-  radius /= double(g.n);
-  const auto offsetOf = [&](std::size_t i, std::size_t e) -> Vec2 {
-    return basis[i].transpose() * (x[g.neighbor[i * g.k + e]] - x[i]);
-  };
+                          SpherePoints& sphere, std::vector<Eigen::Matrix2d>& similarity,
+                          const ProgressCallback& progress) {
   const auto step = [&](const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& solver,
                         double pin, const std::vector<double>& rho,
                         const std::vector<Eigen::Matrix2d>& s) -> std::string {
     Eigen::MatrixXd rhs(int(g.n), 3);
-    for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * x[i].transpose();
+    for (std::size_t i = 0; i < g.n; ++i) rhs.row(int(i)) = pin * sphere.x[i].transpose();
     forEachTargetOffset(g, rho, s, [&](std::size_t i, std::size_t j, double w, const Vec2& r) {
-      // The chord of the sphere whose tangent part is r (it dips by |r|^2 / 2R below the
-      // tangent plane): an exact sphere is then a fixed point.
-      const Vec3 lifted = basis[i] * r - (r.squaredNorm() / (2 * radius)) * x[i].normalized();
+      const Vec3 lifted = sphere.lift(i, r);
       rhs.row(int(j)) += w * lifted.transpose();
       rhs.row(int(i)) -= w * lifted.transpose();
     });
@@ -291,15 +315,12 @@ std::string relaxOnSphere(const RelaxationGraph& g, const RelaxationOptions& opt
     for (std::size_t i = 0; i < g.n; ++i) mean += solved.row(int(i)).norm();
     mean /= double(g.n);
     if (!(mean > 0) || !std::isfinite(mean)) return "the relaxation collapsed the domain";
-    if (options.rigid) radius = mean;
-    for (std::size_t i = 0; i < g.n; ++i) {
-      const Vec3 p = solved.row(int(i)).transpose();
-      if (p.norm() > 0) x[i] = radius * p.normalized();
-    }
-    updateBases();
+    if (options.rigid) sphere.radius = mean;
+    for (std::size_t i = 0; i < g.n; ++i) sphere.x[i] = solved.row(int(i)).transpose();
+    sphere.project();
     return {};
   };
-  return relaxRounds(g, options, tracker, offsetOf, step, similarity);
+  return relaxRounds(g, options, progress, sphere.offsets(g), step, similarity);
 }
 
 /// Per point the linear map (any 2 x 2) that best takes a_ij to y_ij: the relaxed map's
@@ -408,6 +429,15 @@ void mirrorGraph(RelaxationGraph& g) {
   for (auto& t : g.toTangent) t.row(1) = -t.row(1);
 }
 
+/// A mirrored map (most local maps reverse the orientation) is matched by anti-similarities:
+/// the graph is mirrored when it is. Returns the orientation (-1: mirrored).
+template <class OffsetOf>
+double orientGraph(RelaxationGraph& g, OffsetOf offsetOf) {
+  const double sign = majorityDeterminantSign(localJacobians(g, offsetOf));
+  if (sign < 0) mirrorGraph(g);
+  return sign;
+}
+
 /// About `target` points of the cloud, Poisson-disk spaced. The separation comes from the
 /// points' density (10 neighbours within the median 10-NN radius) and a random packing's count
 /// (about 0.7 area / separation^2); it is widened until the sample fits.
@@ -493,9 +523,6 @@ struct SolveSystem {
   SolveSet set;
   DomainMap domain;  // the map at the samples (subsampled only)
   RelaxationGraph graph;
-  const std::vector<Vec3>& positions(const std::vector<Vec3>& all) const {
-    return set.subsampled ? set.positions : all;
-  }
   const DomainMap& map(const DomainMap& all) const { return set.subsampled ? domain : all; }
 };
 
@@ -516,7 +543,7 @@ bool buildSolveSystem(const std::vector<Vec3>& positions, const std::vector<Vec3
         system.domain.direction.push_back(map.direction[i]);
     }
   }
-  const std::vector<Vec3>& p = system.positions(positions);
+  const std::vector<Vec3>& p = system.set.subsampled ? system.set.positions : positions;
   if (p.size() < std::size_t(options.neighbors) + 1) return false;
   solved = p.size();
   system.graph = gatherGraph(p, system.set.subsampled ? system.set.normals : normals,
@@ -531,46 +558,25 @@ std::string relaxPlane(const std::vector<Vec3>& positions, const std::vector<Vec
   SolveSystem system;
   if (!buildSolveSystem(positions, normals, map, options, system, solved)) return "too few points";
   RelaxationGraph& graph = system.graph;
-  const std::vector<Vec3>& p = system.positions(positions);
-  const DomainMap& d = system.map(map);
-  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
-  const double mirror = majorityDeterminantSign(localJacobians(graph, planeOffsets(graph, d.uv)));
-  if (mirror < 0) mirrorGraph(graph);
-
-  ProgressTracker tracker(progress, "relaxation",
-                          std::size_t(options.iterations) * std::size_t(options.rounds));
-  std::vector<Vec2> uv = d.uv;
+  std::vector<Vec2> uv = system.map(map).uv;
+  const double mirror = orientGraph(graph, planeOffsets(graph, uv));
   std::vector<Eigen::Matrix2d> similarity;
-  std::string failure = relaxOnGraph(graph, options, uv, similarity, tracker);
+  std::string failure = relaxOnGraph(graph, options, uv, similarity, progress);
   if (!failure.empty()) return failure;
-  tracker.finish();
   if (!system.set.subsampled) {
     map.uv = std::move(uv);
     return {};
   }
   const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, planeOffsets(graph, uv));
-  map.uv = placeFromSamples(positions, system.set.sample, p, uv, [&](Index s, const Vec3& offset) {
-    return Vec2(uv[s] + jacobian[s] * (graph.toTangent[s] * offset));
-  });
+  map.uv = placeFromSamples(positions, system.set.sample, system.set.positions, uv,
+                            [&](Index s, const Vec3& offset) {
+                              return Vec2(uv[s] + jacobian[s] * (graph.toTangent[s] * offset));
+                            });
   const RelaxationGraph fine =
       gatherGraph(positions, normals, map, std::size_t(options.neighbors), mirror);
   smoothPlane(fine, options, map.uv);
   return {};
 }
-
-/// The points x_i = R d_i of a sphere domain put back on the sphere of radius R, and the tangent
-/// bases the local step reads there.
-struct SpherePoints {
-  double radius = 1;
-  std::vector<Vec3> x;
-  std::vector<Eigen::Matrix<double, 3, 2>> basis;
-  void project() {
-    parallelFor(x.size(), [&](std::size_t i) {
-      if (x[i].norm() > 0) x[i] = radius * x[i].normalized();
-      basis[i] = sphereBasis(x[i].normalized());
-    });
-  }
-};
 
 /// Relaxes the sphere directions of `map` (and its radius: the surface's units for rotations).
 /// Above maxSolvePoints, on a subsample: every other point is placed from the samples' local
@@ -582,34 +588,21 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
   SolveSystem system;
   if (!buildSolveSystem(positions, normals, map, options, system, solved)) return "too few points";
   RelaxationGraph& graph = system.graph;
-  const std::vector<Vec3>& p = system.positions(positions);
-  const DomainMap& d = system.map(map);
-  const double radius = map.radius > 0 ? map.radius : 1.0;
-  std::vector<Vec3> x(p.size());
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = radius * d.direction[i];
-  const auto sphereOffsets = [&](std::size_t i, std::size_t e) -> Vec2 {
-    return sphereBasis(x[i].normalized()).transpose() * (x[graph.neighbor[i * graph.k + e]] - x[i]);
-  };
-  // A mirrored map (most local maps reverse the orientation) is matched by anti-similarities.
-  const double mirror = majorityDeterminantSign(localJacobians(graph, sphereOffsets));
-  if (mirror < 0) mirrorGraph(graph);
-
-  ProgressTracker tracker(progress, "relaxation",
-                          std::size_t(options.iterations) * std::size_t(options.rounds));
+  SpherePoints sphere(system.map(map).direction, map.radius > 0 ? map.radius : 1.0);
+  const double mirror = orientGraph(graph, sphere.offsets(graph));
   std::vector<Eigen::Matrix2d> similarity;
-  std::string failure = relaxOnSphere(graph, options, x, similarity, tracker);
+  std::string failure = relaxOnSphere(graph, options, sphere, similarity, progress);
   if (!failure.empty()) return failure;
-  tracker.finish();
   if (system.set.subsampled) {
+    const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, sphere.offsets(graph));
     SpherePoints full;
-    full.radius = 0;
-    for (const Vec3& q : x) full.radius += q.norm();
-    full.radius /= double(x.size());
-    const std::vector<Eigen::Matrix2d> jacobian = localJacobians(graph, sphereOffsets);
-    full.x = placeFromSamples(positions, system.set.sample, p, x, [&](Index s, const Vec3& offset) {
-      return Vec3(x[s] +
-                  sphereBasis(x[s].normalized()) * (jacobian[s] * (graph.toTangent[s] * offset)));
-    });
+    full.radius = sphere.radius;
+    full.x = placeFromSamples(
+        positions, system.set.sample, system.set.positions, sphere.x,
+        [&](Index s, const Vec3& offset) {
+          return Vec3(sphere.x[s] +
+                      sphere.basis[s] * (jacobian[s] * (graph.toTangent[s] * offset)));
+        });
     full.basis.resize(full.x.size());
     full.project();
     DomainMap fineMap = map;
@@ -617,27 +610,19 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
     const RelaxationGraph fine =
         gatherGraph(positions, normals, fineMap, std::size_t(options.neighbors), mirror);
     smoothOnGraph(
-        fine, options, kSmoothingIterations, kSmoothingSweeps, full.x,
-        [&](std::size_t i, std::size_t e) -> Vec2 {
-          return full.basis[i].transpose() * (full.x[fine.neighbor[i * fine.k + e]] - full.x[i]);
-        },
-        [&](std::size_t i, const Vec2& r) -> Vec3 {
-          return full.basis[i] * r - (r.squaredNorm() / (2 * full.radius)) * full.x[i].normalized();
-        },
-        [&] { full.project(); });
-    x = std::move(full.x);
+        fine, options, kSmoothingIterations, kSmoothingSweeps, full.x, full.offsets(fine),
+        [&](std::size_t i, const Vec2& r) { return full.lift(i, r); }, [&] { full.project(); });
+    sphere = std::move(full);
   }
   constexpr double kDegrees = 180 / 3.14159265358979323846;
-  double sum = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    if (!(x[i].norm() > 0)) return "the relaxation put a point at the sphere's centre";
-    sum += x[i].norm();
-    const Vec3 dir = x[i].normalized();
+  for (std::size_t i = 0; i < sphere.x.size(); ++i) {
+    if (!(sphere.x[i].norm() > 0)) return "the relaxation put a point at the sphere's centre";
+    const Vec3 dir = sphere.x[i].normalized();
     map.direction[i] = dir;
     map.longitude[i] = std::atan2(dir.y(), dir.x()) * kDegrees;
     map.latitude[i] = std::asin(std::clamp(dir.z(), -1.0, 1.0)) * kDegrees;
   }
-  map.radius = sum / double(x.size());
+  map.radius = sphere.radius;
   return {};
 }
 

@@ -19,12 +19,11 @@ constexpr double kMinRelativeTolerance = 1e-3;
 
 // The unions take the unlabelled points next to them, round after round (each round decides on
 // the labels it began with), while a point lies within planeDescribesBound of the union's plane
-// (`tolerance` times its RMS, or the noise floor); among several unions, the nearest plane (ties:
-// the first union).
+// (kPlaneDescribesTolerance times its RMS, or the noise floor); among several unions, the nearest
+// plane (ties: the first union).
 void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& knn,
                           const std::vector<std::uint8_t>& takes, std::vector<int>& labels,
-                          std::vector<std::vector<Index>>& regions, double noiseFloor,
-                          double tolerance) {
+                          std::vector<std::vector<Index>>& regions, double noiseFloor) {
   const std::size_t n = labels.size();
   std::vector<PlaneFit> planes(regions.size());
   std::vector<double> bound(regions.size(), -1.0);  // < 0: takes nothing
@@ -32,7 +31,7 @@ void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& kn
     if (!takes[r] || regions[r].size() < 3) return;
     planes[r] = fitPlane(positions, regions[r]);
     if (!planes[r].valid) return;
-    bound[r] = planeDescribesBound(planes[r].rms, noiseFloor, tolerance);
+    bound[r] = planeDescribesBound(planes[r].rms, noiseFloor);
   });
   const auto nextToTaker = [&](Index i) {
     for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
@@ -129,8 +128,10 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
   const double reach = options.maxRelativeDistance * t;
   const double margin = std::max(options.minRelativeGain * t, options.noiseFactor * noiseRms);
   const double minOffset = options.minRelativeOffset * t;
-  if (reach == 0 || regionCount < 2 ||
-      std::none_of(takes.begin(), takes.end(), [](std::uint8_t x) { return x != 0; }))
+  // A large region's tolerance, and the unions' bound on the unlabelled points they take.
+  const double noiseFloor = std::max(options.noiseFactor * noiseRms, kMinRelativeTolerance * t);
+  // (One region alone moves nothing, but a union still takes the unlabelled points.)
+  if (reach == 0 || std::none_of(takes.begin(), takes.end(), [](std::uint8_t x) { return x != 0; }))
     return segmentation;
 
   std::vector<int>& labels = segmentation.labels;
@@ -150,9 +151,7 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
     // since the points a region gave away had tilted and shifted its plane.
     tbb::parallel_for(std::size_t(0), regionCount, [&](std::size_t r) {
       planes[r] = fitPlane(positions, regions[r]);
-      tolerance[r] = planeDescribesBound(
-          planes[r].rms, std::max(options.noiseFactor * noiseRms, kMinRelativeTolerance * t),
-          options.largeRegionTolerance);
+      tolerance[r] = planeDescribesBound(planes[r].rms, noiseFloor, options.largeRegionTolerance);
     });
     // The points to look at: the labelled points next to a target's point in the first round,
     // then the moved points' neighbours and the moved points themselves.
@@ -211,9 +210,7 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
   }
 
   if (options.takeUnlabelled)
-    takeUnlabelledPoints(positions, knn, takes, labels, regions,
-                         std::max(options.noiseFactor * noiseRms, kMinRelativeTolerance * t),
-                         kPlaneDescribesTolerance);
+    takeUnlabelledPoints(positions, knn, takes, labels, regions, noiseFloor);
 
   // The regions in their order, the emptied ones dropped.
   Segmentation refined;
