@@ -10,15 +10,17 @@
 // at 16 and 64 neighbours, and the median stretch of the 16-neighbour local maps (the ratio of
 // their singular values, MapDefects::stretch). The mesh peers are scored on the mesh's vertices.
 //
-// Rows: "scalespace" is `parametrize`'s default (the flattening, then the rigid robust
-// relaxation of the domain), "thesis" the flattening alone (--relax 0), "+conformal" and
-// "+rigid-1round" the other relaxations (similarities; one plain least-squares round).
+// Rows: "scalespace" is `parametrize`'s default (the flattening, then the robust relaxation of
+// the domain: rigid on a plane, mostly conformal on a sphere), "thesis" the flattening alone
+// (--relax 0), "+conformal", "+rigid" and "+1round" the other relaxations (similarities,
+// rotations on both domains; one plain least-squares round).
 //
 //   bench_parametrize [--points N (100000)] [--shapes a,b,...] [--noise list (0,0.001)]
 //                     [--scales M (50)] [--resolution R (128): the peers' mesh grid]
 //                     [--no-peers] [--threads T] [--relax-iterations I (5)]
-//                     [--relax-max-solve N (100000)] [--relax-large-spheres]: the relaxations'
-//                     options
+//                     [--relax-max-solve N (100000)] [--relax-large-spheres]
+//                     [--rigidity R] [--sphere-rigidity R] (the "scalespace" and "+1round" rows;
+//                     default: the library's): the relaxations' options
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
@@ -175,6 +177,8 @@ int main(int argc, char** argv) {
   int scales = 50, resolution = 128, threads = 0, relaxIterations = 5;
   std::size_t relaxMaxSolve = RelaxationOptions{}.maxSolvePoints;
   bool peers = true, largeSpheres = false;
+  double rigidity = RelaxationOptions{}.rigidity,
+         sphereRigidity = RelaxationOptions{}.sphereRigidity;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--points" && i + 1 < argc) {
@@ -199,11 +203,16 @@ int main(int argc, char** argv) {
       peers = false;
     } else if (a == "--relax-large-spheres") {
       largeSpheres = true;
+    } else if (a == "--rigidity" && i + 1 < argc) {
+      rigidity = std::stod(argv[++i]);
+    } else if (a == "--sphere-rigidity" && i + 1 < argc) {
+      sphereRigidity = std::stod(argv[++i]);
     } else {
       std::fprintf(stderr,
                    "usage: bench_parametrize [--points N] [--shapes a,b] [--noise 0,0.001] "
                    "[--scales M] [--resolution R] [--no-peers] [--threads T] "
-                   "[--relax-iterations I] [--relax-max-solve N] [--relax-large-spheres]\n");
+                   "[--relax-iterations I] [--relax-max-solve N] [--relax-large-spheres] "
+                   "[--rigidity R] [--sphere-rigidity R]\n");
       return 2;
     }
   }
@@ -224,8 +233,8 @@ int main(int argc, char** argv) {
       for (std::size_t i = 0; i < cloud.size(); ++i) positions[i] = cloud.absolutePosition(i);
       const std::vector<Vec3>& normals = cloud.normals();
 
-      // The thesis' map (no relaxation), then the relaxations of a plane domain: the default
-      // (rigid, robust), the conformal one (similarities) and the plain least-squares one.
+      // The thesis' map (no relaxation), then the relaxations: the default (robust), the
+      // conformal one (similarities), the rigid one (rotations) and the plain least-squares one.
       ParametrizationOptions options;
       options.flattening.scaleCount = scales;
       options.relaxation.iterations = 0;
@@ -237,12 +246,14 @@ int main(int argc, char** argv) {
       const bool relaxable = relaxIterations > 0;
       struct Variant {
         const char* method;
-        bool rigid;
+        double rigidity, sphereRigidity;
         int rounds;
       };
-      const Variant variants[] = {{"scalespace", true, RelaxationOptions{}.rounds},
-                                  {"+conformal", false, RelaxationOptions{}.rounds},
-                                  {"+rigid-1round", true, 1}};
+      const int rounds = RelaxationOptions{}.rounds;
+      const Variant variants[] = {{"scalespace", rigidity, sphereRigidity, rounds},
+                                  {"+conformal", 0, 0, rounds},
+                                  {"+rigid", 1, 1, rounds},
+                                  {"+1round", rigidity, sphereRigidity, 1}};
       for (const Variant& v : variants) {
         if (!relaxable && v.method != variants[0].method) continue;
         DomainMap map = thesis.domain;
@@ -250,7 +261,8 @@ int main(int argc, char** argv) {
         relax.iterations = relaxIterations;
         relax.maxSolvePoints = relaxMaxSolve;
         relax.largeSpheres = largeSpheres;
-        relax.rigid = v.rigid;
+        relax.rigidity = v.rigidity;
+        relax.sphereRigidity = v.sphereRigidity;
         relax.rounds = v.rounds;
         const RelaxationResult r =
             relaxable ? relaxConformally(positions, normals, map, relax) : RelaxationResult{};

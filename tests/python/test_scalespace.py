@@ -641,7 +641,7 @@ def test_parametrize_relaxation_options_equal_the_cli(tmp_path):
     cli("generate", "relief", "-n", 4000, "-o", tmp_path / "r.ply")
     cloud = ss.read(str(tmp_path / "r.ply"))
     runs = {"thesis": (["--relax", 0], dict(relax=0)),
-            "conformal": (["--conformal", "--relax-rounds", 2], dict(rigid=False, relax_rounds=2))}
+            "conformal": (["--conformal", "--relax-rounds", 2], dict(rigidity=0, sphere_rigidity=0, relax_rounds=2))}
     maps = {}
     for name, (flags, kwargs) in runs.items():
         cli("parametrize", tmp_path / "r.ply", "--scales", 15, *flags, "-o", tmp_path / f"{name}.ply")

@@ -118,11 +118,26 @@ void addParametrizeCommand(CLI::App& app) {
                   "robust re-weighting rounds of the relaxation (1: plain least squares, which "
                   "spreads a bump's misfit as shear over the whole map)")
       ->capture_default_str();
-  cmd->add_flag("--rigid,!--conformal", args->options.relaxation.rigid,
-                "the relaxation's local maps: rotations (--rigid, as rigid as possible: keeps "
-                "lengths, so areas too, where the surface allows, and gives the domain the "
-                "surface's units; the default) or similarities (--conformal: angles only, areas "
-                "drift)");
+  cmd->add_option("--rigidity", args->options.relaxation.rigidity,
+                  "how rigid the relaxation's local maps are on a plane domain: 1, rotations (as "
+                  "rigid as possible: keeps lengths, so areas too, where the surface allows, and "
+                  "gives the domain the surface's units); 0, similarities (angles only, areas "
+                  "drift); between, a blend")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--sphere-rigidity", args->options.relaxation.sphereRigidity,
+                  "the same on a sphere domain (a closed surface cannot keep its lengths there: "
+                  "mostly conformal by default)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_flag_callback(
+      "--rigid",
+      [args] { args->options.relaxation.rigidity = args->options.relaxation.sphereRigidity = 1; },
+      "rotations on both domains: --rigidity 1 --sphere-rigidity 1");
+  cmd->add_flag_callback(
+      "--conformal",
+      [args] { args->options.relaxation.rigidity = args->options.relaxation.sphereRigidity = 0; },
+      "similarities on both domains: --rigidity 0 --sphere-rigidity 0");
   cmd->add_option("--flattened", args->flattened,
                   "also write the flowed points, on their sphere or plane, to this cloud");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
@@ -207,7 +222,8 @@ void addParametrizeCommand(CLI::App& app) {
                                  {"relaxation",
                                   {{"iterations", args->options.relaxation.iterations},
                                    {"rounds", args->options.relaxation.rounds},
-                                   {"rigid", args->options.relaxation.rigid},
+                                   {"rigidity", args->options.relaxation.rigidity},
+                                   {"sphere_rigidity", args->options.relaxation.sphereRigidity},
                                    {"solved_points", result.relaxation.solvedPoints},
                                    {"rounds_applied", result.relaxation.roundsApplied},
                                    {"applied", result.relaxation.applied},

@@ -119,11 +119,13 @@ void forEachTargetOffset(const RelaxationGraph& g, const std::vector<double>& rh
     }
 }
 
-/// The local step: per point the similarity (or rotation) best taking a_ij to the domain offset
-/// y_ij = offsetOf(i, e) of its e-th neighbour, in i's tangent frame of the domain. In complex
-/// form S_i = (a + ib) = sum w conj(x) y / sum w |x|^2.
+/// The local step: per point the similarity best taking a_ij to the domain offset y_ij =
+/// offsetOf(i, e) of its e-th neighbour, in i's tangent frame of the domain. In complex form
+/// S_i = (a + ib) = sum w conj(x) y / sum w |x|^2. With rigidity r > 0 its scale s becomes
+/// s^(1 - r): the rotation alone at r = 1 (as rigid as possible), a geometric blend of the
+/// conformal and the rigid targets between.
 template <class OffsetOf>
-void fitSimilarities(const RelaxationGraph& g, OffsetOf offsetOf, bool rigid,
+void fitSimilarities(const RelaxationGraph& g, OffsetOf offsetOf, double rigidity,
                      std::vector<Eigen::Matrix2d>& similarity) {
   parallelFor(g.n, [&](std::size_t i) {
     double a = 0, b = 0, norm = 0;
@@ -135,11 +137,12 @@ void fitSimilarities(const RelaxationGraph& g, OffsetOf offsetOf, bool rigid,
       b += w * (x.x() * y.y() - x.y() * y.x());
       norm += w * x.squaredNorm();
     }
-    if (rigid) {
-      // The rotation of the similarity (its angle), at unit scale: as rigid as possible.
+    if (rigidity > 0) {
       const double length = std::hypot(a, b);
-      a = length > 0 ? a / length : 1;
-      b = length > 0 ? b / length : 0;
+      const double scale =
+          rigidity < 1 && norm > 0 && length > 0 ? std::pow(length / norm, 1 - rigidity) : 1.0;
+      a = length > 0 ? scale * a / length : 1;
+      b = length > 0 ? scale * b / length : 0;
     } else if (norm > 0) {
       a /= norm;
       b /= norm;
@@ -178,7 +181,7 @@ std::vector<double> robustWeights(const RelaxationGraph& g, OffsetOf offsetOf,
 /// failed, or an empty string. `similarity` gets the final local similarities. Progress: one
 /// step per iteration.
 template <class OffsetOf, class GlobalStep>
-std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& options,
+std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& options, double rigidity,
                         const ProgressCallback& progress, OffsetOf offsetOf, GlobalStep step,
                         std::vector<Eigen::Matrix2d>& similarity) {
   ProgressTracker tracker(progress, "relaxation",
@@ -198,13 +201,13 @@ std::string relaxRounds(const RelaxationGraph& g, const RelaxationOptions& optio
     if (solver.info() != Eigen::Success)
       return "the k-NN graph's Laplacian could not be factorized";
     for (int iteration = 0; iteration < options.iterations; ++iteration) {
-      fitSimilarities(g, offsetOf, options.rigid, similarity);
+      fitSimilarities(g, offsetOf, rigidity, similarity);
       const std::string failure = step(solver, pin, rho, similarity);
       if (!failure.empty()) return failure;
       tracker.advance(1);
     }
   }
-  fitSimilarities(g, offsetOf, options.rigid, similarity);
+  fitSimilarities(g, offsetOf, rigidity, similarity);
   tracker.finish();
   return {};
 }
@@ -245,17 +248,17 @@ std::string relaxOnGraph(const RelaxationGraph& g, const RelaxationOptions& opti
     });
     const Eigen::MatrixXd solved = solver.solve(rhs);
     // The similarity energy has no scale of its own: keep the domain's spread and centroid
-    // (the rigid one takes the surface's lengths).
+    // (with some rigidity it takes the surface's lengths).
     std::vector<Vec2> next(g.n);
     for (std::size_t i = 0; i < g.n; ++i) next[i] = solved.row(int(i)).transpose();
     Vec2 c;
     const double spreadNow = spread(next, c);
     if (!(spreadNow > 0) || !std::isfinite(spreadNow)) return "the relaxation collapsed the domain";
-    const double factor = options.rigid ? 1.0 : size / spreadNow;
+    const double factor = options.rigidity > 0 ? 1.0 : size / spreadNow;
     for (std::size_t i = 0; i < g.n; ++i) uv[i] = centroid + (next[i] - c) * factor;
     return {};
   };
-  return relaxRounds(g, options, progress, planeOffsets(g, uv), step, similarity);
+  return relaxRounds(g, options, options.rigidity, progress, planeOffsets(g, uv), step, similarity);
 }
 
 /// The points x_i = R d_i of a sphere domain, on the sphere of radius R about the origin (the
@@ -315,12 +318,13 @@ std::string relaxOnSphere(const RelaxationGraph& g, const RelaxationOptions& opt
     for (std::size_t i = 0; i < g.n; ++i) mean += solved.row(int(i)).norm();
     mean /= double(g.n);
     if (!(mean > 0) || !std::isfinite(mean)) return "the relaxation collapsed the domain";
-    if (options.rigid) sphere.radius = mean;
+    if (options.sphereRigidity > 0) sphere.radius = mean;
     for (std::size_t i = 0; i < g.n; ++i) sphere.x[i] = solved.row(int(i)).transpose();
     sphere.project();
     return {};
   };
-  return relaxRounds(g, options, progress, sphere.offsets(g), step, similarity);
+  return relaxRounds(g, options, options.sphereRigidity, progress, sphere.offsets(g), step,
+                     similarity);
 }
 
 /// Per point the linear map (any 2 x 2) that best takes a_ij to y_ij: the relaxed map's
@@ -361,11 +365,11 @@ std::vector<Eigen::Matrix2d> localJacobians(const RelaxationGraph& g, OffsetOf o
 constexpr int kSmoothingIterations = 2, kSmoothingSweeps = 3;
 
 template <class Point, class OffsetOf, class Lift, class Project>
-void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, int iterations,
-                   int sweeps, std::vector<Point>& x, OffsetOf offsetOf, Lift lift,
+void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, double rigidity,
+                   int iterations, int sweeps, std::vector<Point>& x, OffsetOf offsetOf, Lift lift,
                    Project project) {
   std::vector<Eigen::Matrix2d> similarity(g.n, Eigen::Matrix2d::Identity());
-  fitSimilarities(g, offsetOf, options.rigid, similarity);
+  fitSimilarities(g, offsetOf, rigidity, similarity);
   const std::vector<double> rho =
       options.rounds > 1 ? robustWeights(g, offsetOf, similarity, options.maxDownweight)
                          : std::vector<double>(g.n, 1.0);
@@ -381,7 +385,7 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
   constexpr double kDamping = 0.7;
   std::vector<Point> sum(g.n);
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    if (iteration > 0) fitSimilarities(g, offsetOf, options.rigid, similarity);
+    if (iteration > 0) fitSimilarities(g, offsetOf, rigidity, similarity);
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       // Row m of L x = rhs solved for x_m: x_m = (rhs_m + sum_{edges m-j} w x_j) / L_mm.
       std::fill(sum.begin(), sum.end(), Point::Zero());
@@ -398,17 +402,17 @@ void smoothOnGraph(const RelaxationGraph& g, const RelaxationOptions& options, i
   }
 }
 
-/// The plane's smoothing keeps the domain's centroid, and its spread unless rigid.
+/// The plane's smoothing keeps the domain's centroid, and its spread without rigidity.
 void smoothPlane(const RelaxationGraph& g, const RelaxationOptions& options,
                  std::vector<Vec2>& uv) {
   Vec2 centroid;
   const double size = spread(uv, centroid);
   smoothOnGraph(
-      g, options, kSmoothingIterations, kSmoothingSweeps, uv, planeOffsets(g, uv),
+      g, options, options.rigidity, kSmoothingIterations, kSmoothingSweeps, uv, planeOffsets(g, uv),
       [](std::size_t, const Vec2& r) { return r; }, [] {});
   Vec2 c;
   const double s = spread(uv, c);
-  const double factor = options.rigid || !(s > 0) ? 1.0 : size / s;
+  const double factor = options.rigidity > 0 || !(s > 0) ? 1.0 : size / s;
   for (Vec2& p : uv) p = centroid + (p - c) * factor;
 }
 
@@ -610,8 +614,9 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
     const RelaxationGraph fine =
         gatherGraph(positions, normals, fineMap, std::size_t(options.neighbors), mirror);
     smoothOnGraph(
-        fine, options, kSmoothingIterations, kSmoothingSweeps, full.x, full.offsets(fine),
-        [&](std::size_t i, const Vec2& r) { return full.lift(i, r); }, [&] { full.project(); });
+        fine, options, options.sphereRigidity, kSmoothingIterations, kSmoothingSweeps, full.x,
+        full.offsets(fine), [&](std::size_t i, const Vec2& r) { return full.lift(i, r); },
+        [&] { full.project(); });
     sphere = std::move(full);
   }
   constexpr double kDegrees = 180 / 3.14159265358979323846;
@@ -636,6 +641,10 @@ void validateRelaxationOptions(const RelaxationOptions& options) {
     throw OptionError("RelaxationOptions::rounds must be in [1, 20]");
   if (!(options.maxDownweight >= 1) || !std::isfinite(options.maxDownweight))
     throw OptionError("RelaxationOptions::maxDownweight must be finite and >= 1");
+  if (!(options.rigidity >= 0 && options.rigidity <= 1))
+    throw OptionError("RelaxationOptions::rigidity must be in [0, 1]");
+  if (!(options.sphereRigidity >= 0 && options.sphereRigidity <= 1))
+    throw OptionError("RelaxationOptions::sphereRigidity must be in [0, 1]");
   if (options.maxSolvePoints < 1000)
     throw OptionError("RelaxationOptions::maxSolvePoints must be >= 1000");
   validateMapDefectOptions(options.defects);

@@ -42,11 +42,20 @@ struct RelaxationOptions {
   /// Above this many points the system is solved on a Poisson-disk subsample of about this
   /// size (>= 1000).
   std::size_t maxSolvePoints = 100000;
-  /// Rotations instead of similarities ("as rigid as possible"): the map then also keeps the
-  /// surface's lengths where it can, which lowers the authalic distortion as well, and gives the
-  /// domain the surface's units. false: similarities, the conformal energy alone (its areas
-  /// drift: bench/README.md).
-  bool rigid = true;
+  /// How rigid the local maps of a plane domain are: 1, rotations ("as rigid as possible": the
+  /// map also keeps the surface's lengths where it can, which lowers the authalic distortion as
+  /// well, and gives the domain the surface's units); 0, similarities (the conformal energy
+  /// alone: areas drift); between, a similarity whose scale s is pulled to s^(1 - rigidity).
+  /// A disk-like surface is nearly developable where it is not bumpy, so rotations keep both
+  /// angles and areas there.
+  double rigidity = 1.0;
+  /// The same for a sphere domain. A closed surface differs in Gauss curvature from the sphere
+  /// almost everywhere (an ellipsoid's poles and equator), so no map keeps lengths: rotations
+  /// keep the areas of close neighbours and push the mismatch into shear over a few dozen
+  /// neighbours, where the conformal distortion then exceeds the thesis map's. Mostly conformal
+  /// with a tenth of rigidity, both distortions stay below the thesis map's and the radial
+  /// projection's at 16 and 64 neighbours (bench/README.md, bench_parametrize).
+  double sphereRigidity = 0.1;
   /// A sphere domain above maxSolvePoints is relaxed too, on a subsample (placed from it and
   /// smoothed at full resolution, as a plane's). Off by default: at 1M points it adds about half
   /// the flattening's time, and it trades conformal for authalic distortion (docs/THESIS_NOTES.md,
@@ -58,7 +67,8 @@ struct RelaxationOptions {
 };
 
 /// OptionError naming the field unless iterations >= 0, 3 <= neighbors <= 64, 1 <= rounds <= 20,
-/// maxDownweight >= 1 (finite) and maxSolvePoints >= 1000.
+/// maxDownweight >= 1 (finite), rigidity and sphereRigidity are in [0, 1] and maxSolvePoints >=
+/// 1000.
 void validateRelaxationOptions(const RelaxationOptions& options);
 
 struct RelaxationResult {

@@ -38,8 +38,8 @@ PooledCloud cloudWithNormals(const Points& points, const py::handle& normals, Ca
 
 py::dict parametrizePy(const py::handle& points, const py::handle& normals, int scales,
                        const std::string& domain, int k, double tmax, double alpha, int relax,
-                       int relaxRounds, bool rigid, bool relaxLargeSpheres,
-                       std::optional<int> threads, py::object progress) {
+                       int relaxRounds, double rigidity, double sphereRigidity,
+                       bool relaxLargeSpheres, std::optional<int> threads, py::object progress) {
   ParametrizationOptions options;
   options.flattening.scaleCount = scales;
   options.flattening.K = k;
@@ -47,7 +47,8 @@ py::dict parametrizePy(const py::handle& points, const py::handle& normals, int 
   options.flattening.alpha = alpha;
   options.relaxation.iterations = relax;
   options.relaxation.rounds = relaxRounds;
-  options.relaxation.rigid = rigid;
+  options.relaxation.rigidity = rigidity;
+  options.relaxation.sphereRigidity = sphereRigidity;
   options.relaxation.largeSpheres = relaxLargeSpheres;
   options.domain.kind = parseDomainKind(domain);
   validateFlatteningOptions(options.flattening);
@@ -150,7 +151,8 @@ void bindParametrization(py::module_& m) {
   m.def("parametrize", &parametrizePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = 50, "domain"_a = "auto", "k"_a = 10, "tmax"_a = 0.0, "alpha"_a = 0.1,
         "relax"_a = RelaxationOptions{}.iterations, "relax_rounds"_a = RelaxationOptions{}.rounds,
-        "rigid"_a = RelaxationOptions{}.rigid,
+        "rigidity"_a = RelaxationOptions{}.rigidity,
+        "sphere_rigidity"_a = RelaxationOptions{}.sphereRigidity,
         "relax_large_spheres"_a = RelaxationOptions{}.largeSpheres, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Meshless parametrization (Sec. 4.3), as `scalespace parametrize`.
@@ -160,9 +162,10 @@ The points flow onto their APSS while the scale grows along `scales` linear per-
 sphere or plane. domain: "auto" (a plane when the points fit in a cap of 80 degrees), "plane"
 or "sphere". relax: local-global iterations per round of the relaxation of the domain (beyond
 the thesis, on by default, a sphere up to 100k points unless relax_large_spheres; 0 gives the thesis' map; not applied when
-it would add folds or overlaps); relax_rounds: its robust re-weighting rounds (1: plain least squares); rigid:
-rotations (keeps lengths, so areas too, where the surface allows) or, False, similarities
-(angles only). Without normals they are estimated and oriented,
+it would add folds or overlaps); relax_rounds: its robust re-weighting rounds (1: plain least squares); rigidity:
+how rigid the relaxation's local maps are on a plane domain (1: rotations, which keep lengths, so
+areas too, where the surface allows; 0: similarities, angles only; between: a blend);
+sphere_rigidity: the same on a sphere domain (mostly conformal by default). Without normals they are estimated and oriented,
 as the CLI does. Returns a dict: domain, uv (N, 2) or None, direction (N, 3), longitude and
 latitude (N,) in degrees or None, valid, fold, overlap (N,) uint8, local_scale (N,), flattened
 (N, 3) absolute, global_fit_is_plane, centre, radius, cap_degrees, one_to_one, folds, overlaps,
