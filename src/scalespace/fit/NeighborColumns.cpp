@@ -58,10 +58,12 @@ std::size_t gatherPortable(const SampleColumns& s, const Vec3& y, double t, Outp
 }
 
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
-/// Eight candidates at a time: the kept lanes are packed to the front (vcompresspd) and stored
-/// at the output's end. (Compressing in registers and storing whole vectors was slower here.)
-/// Gathering and filling the columns one candidate at a time (scalar code) was a large part of
-/// fitAt's own time in a robust stack's profile.
+/// Eight candidates at a time: the kept lanes are packed to the front of a register
+/// (vcompresspd) and the whole vector is stored at the output's end (the columns have 8 entries
+/// of slack); the next block overwrites the lanes past the kept ones. Compressing straight to
+/// memory is microcoded on AMD's Zen 4 and made the whole multi-scale stack 1.6 times slower
+/// there (bench/README.md, fit/NeighborColumns). Gathering and filling the columns one candidate
+/// at a time (scalar code) was a large part of fitAt's own time in a robust stack's profile.
 SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const Vec3& y, double t,
                                                   Outputs o) {
   const WeightKernel kernel(t);
@@ -82,14 +84,17 @@ SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const 
     if (!in) continue;
     // r < 1 on every kept lane: WeightKernel::value is (r - 1)^2 there.
     const __m512d rm1 = _mm512_sub_pd(_mm512_mul_pd(d2, invT2), one);
-    _mm512_mask_compressstoreu_pd(o.qx + kept, in, qx);
-    _mm512_mask_compressstoreu_pd(o.qy + kept, in, qy);
-    _mm512_mask_compressstoreu_pd(o.qz + kept, in, qz);
-    _mm512_mask_compressstoreu_pd(o.nx + kept, in, _mm512_maskz_loadu_pd(lanes, nx + k));
-    _mm512_mask_compressstoreu_pd(o.ny + kept, in, _mm512_maskz_loadu_pd(lanes, ny + k));
-    _mm512_mask_compressstoreu_pd(o.nz + kept, in, _mm512_maskz_loadu_pd(lanes, nz + k));
-    _mm512_mask_compressstoreu_pd(o.d2 + kept, in, d2);
-    _mm512_mask_compressstoreu_pd(o.w + kept, in, _mm512_mul_pd(rm1, rm1));
+    _mm512_storeu_pd(o.qx + kept, _mm512_maskz_compress_pd(in, qx));
+    _mm512_storeu_pd(o.qy + kept, _mm512_maskz_compress_pd(in, qy));
+    _mm512_storeu_pd(o.qz + kept, _mm512_maskz_compress_pd(in, qz));
+    _mm512_storeu_pd(o.nx + kept,
+                     _mm512_maskz_compress_pd(in, _mm512_maskz_loadu_pd(lanes, nx + k)));
+    _mm512_storeu_pd(o.ny + kept,
+                     _mm512_maskz_compress_pd(in, _mm512_maskz_loadu_pd(lanes, ny + k)));
+    _mm512_storeu_pd(o.nz + kept,
+                     _mm512_maskz_compress_pd(in, _mm512_maskz_loadu_pd(lanes, nz + k)));
+    _mm512_storeu_pd(o.d2 + kept, _mm512_maskz_compress_pd(in, d2));
+    _mm512_storeu_pd(o.w + kept, _mm512_maskz_compress_pd(in, _mm512_mul_pd(rm1, rm1)));
     kept += std::size_t(__builtin_popcount(in));
   }
   return kept;
@@ -100,7 +105,8 @@ SCALESPACE_TARGET_AVX512 std::size_t gatherAvx512(const SampleColumns& s, const 
 
 void gatherWithin(const SampleColumns& samples, const Vec3& y, double t, NeighborColumns& out,
                   SimdKernel kernel) {
-  out.reserve(samples.size());
+  // Slack of one vector: the AVX-512 gather stores eight lanes at the output's end.
+  out.reserve(samples.size() + 8);
   std::size_t kept = 0;
 #ifdef SCALESPACE_HAVE_AVX2_TARGET
   if (useAvx512(kernel))
