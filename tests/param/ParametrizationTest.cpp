@@ -311,7 +311,10 @@ TEST(Parametrization, RelaxationLowersTheDistortionWithoutFolds) {
   const Breaker breakers[] = {[](RelaxationOptions& o) { o.neighbors = 2; },
                               [](RelaxationOptions& o) { o.rounds = 0; },
                               [](RelaxationOptions& o) { o.maxDownweight = 0.5; },
-                              [](RelaxationOptions& o) { o.maxSolvePoints = 10; }};
+                              [](RelaxationOptions& o) { o.maxSolvePoints = 10; },
+                              [](RelaxationOptions& o) { o.rigidity = 1.5; },
+                              [](RelaxationOptions& o) { o.sphereRigidity = -0.1; },
+                              [](RelaxationOptions& o) { o.sphereRigidity = std::nan(""); }};
   for (Breaker bad : breakers) {
     RelaxationOptions options;
     bad(options);

@@ -659,6 +659,8 @@ def test_parametrize_relaxation_options_equal_the_cli(tmp_path):
     np.testing.assert_array_equal(same["uv"], default["uv"])
     with pytest.raises(ss.OptionError, match="relax_rounds"):
         ss.parametrize(cloud.points, cloud.normals, relax_rounds=0)
+    with pytest.raises(ss.OptionError, match="sphere_rigidity must be in"):
+        ss.parametrize(cloud.points, cloud.normals, sphere_rigidity=2)
     bad = subprocess.run([CLI, "parametrize", str(tmp_path / "r.ply"), "--relax-rounds", "0", "-o",
                           str(tmp_path / "x.ply"), "-q"], capture_output=True, text=True)
     assert bad.returncode == 2 and "--relax-rounds" in bad.stderr

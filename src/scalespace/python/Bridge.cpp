@@ -80,6 +80,8 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"DistortionOptions::neighbors", "scales_k"},
     {"RelaxationOptions::iterations", "relax"},
     {"RelaxationOptions::rounds", "relax_rounds"},
+    {"RelaxationOptions::rigidity", "rigidity"},
+    {"RelaxationOptions::sphereRigidity", "sphere_rigidity"},
     {"CylinderOptions::minAnisotropy", "min_anisotropy"},
     {"TubeFitOptions::minArcDegrees", "min_arc"},
     {"TubeFitOptions::maxRelativeRms", "max_rms"},
