@@ -650,10 +650,13 @@ void validateRelaxationOptions(const RelaxationOptions& options) {
   validateMapDefectOptions(options.defects);
 }
 
-RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
-                                  const std::vector<Vec3>& normals, DomainMap& domain,
-                                  const RelaxationOptions& options,
-                                  const ProgressCallback& progress) {
+namespace {
+
+/// relaxConformally with the defects of `domain` as given, when the caller knows them already
+/// (`knownBefore`, else null: checked when needed).
+RelaxationResult relaxChecked(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                              DomainMap& domain, const RelaxationOptions& options,
+                              const ProgressCallback& progress, const MapDefects* knownBefore) {
   const auto start = std::chrono::steady_clock::now();
   validateRelaxationOptions(options);
   const std::size_t n = positions.size();
@@ -684,8 +687,9 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
   // The map before is checked only when the relaxed one has defects: it cannot have fewer than
   // none (the check costs as much as the relaxation's solve at 1M points).
   if (after.folds + after.overlaps > 0) {
-    MapDefects before =
-        findMapDefects(positions, normals, domain, options.defects, subProgress(progress, 0.8, 1));
+    MapDefects before = knownBefore ? *knownBefore
+                                    : findMapDefects(positions, normals, domain, options.defects,
+                                                     subProgress(progress, 0.8, 1));
     if (after.folds + after.overlaps > before.folds + before.overlaps) {
       const std::string added = "would add folds or overlaps (" +
                                 std::to_string(after.folds + after.overlaps) + " points against " +
@@ -696,7 +700,7 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
         RelaxationOptions plain = options;
         plain.rounds = 1;
         RelaxationResult retry =
-            relaxConformally(positions, normals, domain, plain, subProgress(progress, 0.8, 1));
+            relaxChecked(positions, normals, domain, plain, subProgress(progress, 0.8, 1), &before);
         retry.reason =
             retry.applied ? "" : "the relaxation " + added + "; with one round, " + retry.reason;
         retry.seconds = secondsSince(start);
@@ -714,6 +718,15 @@ RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
   result.roundsApplied = options.rounds;
   result.seconds = secondsSince(start);
   return result;
+}
+
+}  // namespace
+
+RelaxationResult relaxConformally(const std::vector<Vec3>& positions,
+                                  const std::vector<Vec3>& normals, DomainMap& domain,
+                                  const RelaxationOptions& options,
+                                  const ProgressCallback& progress) {
+  return relaxChecked(positions, normals, domain, options, progress, nullptr);
 }
 
 }  // namespace scalespace
