@@ -112,8 +112,7 @@ void addParametrizeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--relax-large-spheres", args->options.relaxation.largeSpheres,
                 "relax a sphere domain of more than 100k points too, on a subsample (slower: "
-                "about +20 s at 1M points; lowers the authalic distortion more than the "
-                "conformal one)");
+                "about +15 s at 1M points)");
   cmd->add_option("--relax-rounds", args->options.relaxation.rounds,
                   "robust re-weighting rounds of the relaxation (1: plain least squares, which "
                   "spreads a bump's misfit as shear over the whole map)")

@@ -53,12 +53,13 @@ struct RelaxationOptions {
   /// almost everywhere (an ellipsoid's poles and equator), so no map keeps lengths: rotations
   /// keep the areas of close neighbours and push the mismatch into shear over a few dozen
   /// neighbours, where the conformal distortion then exceeds the thesis map's. Mostly conformal
-  /// with a tenth of rigidity, both distortions stay below the thesis map's and the radial
-  /// projection's at 16 and 64 neighbours (bench/README.md, bench_parametrize).
+  /// with a tenth of rigidity, both distortions stay below the radial projection's at 16 and 64
+  /// neighbours and, but for a near tie, below the thesis map's (bench/README.md,
+  /// bench_parametrize).
   double sphereRigidity = 0.1;
   /// A sphere domain above maxSolvePoints is relaxed too, on a subsample (placed from it and
-  /// smoothed at full resolution, as a plane's). Off by default: at 1M points it adds about half
-  /// the flattening's time, and it trades conformal for authalic distortion (docs/THESIS_NOTES.md,
+  /// smoothed at full resolution, as a plane's). Off by default: at 1M points it adds about a
+  /// third of the flattening's time, beyond the budget of a minute (docs/THESIS_NOTES.md,
   /// "Relaxation").
   bool largeSpheres = false;
   /// The fold and overlap check of the map before and after (a relaxation that adds defects is
