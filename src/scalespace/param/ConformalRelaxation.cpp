@@ -296,7 +296,7 @@ struct SpherePoints {
 
 /// The same on a sphere domain: the local step reads the domain offsets in the sphere's tangent
 /// planes, the global step solves for 3D points with the chords whose tangent parts are S_i a_ij,
-/// which are then put back on the sphere (for rotations, of the radius their mean distance
+/// which are then put back on the sphere (with any rigidity, of the radius their mean distance
 /// gives: the surface's units).
 std::string relaxOnSphere(const RelaxationGraph& g, const RelaxationOptions& options,
                           SpherePoints& sphere, std::vector<Eigen::Matrix2d>& similarity,
