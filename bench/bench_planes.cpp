@@ -11,7 +11,7 @@
 //                     [--scene tri|stairs|cubes] [--noise X] [--no-peers] [--robust-tolerance X]
 //                     [--robust-iterations N] [--max-step F] [--max-rms F] [--merge-rms F]
 //                     [--merge-width F] [--refine-distance F] [--refine-gain F] [--refine-offset F]
-//                     [--no-refine-unlabelled]
+//                     [--no-refine-unlabelled] [--fill-max-angle DEG]
 // --scene / --noise run one scene / noise level only, --no-peers skips the CGAL baselines,
 // --max-step F / --max-rms F / --merge-rms F / --merge-width F set PlaneDetectionOptions
 // (growing.maxStep, planarity.maxRelativeRms, merging.maxRelativeRms, merging.minRelativeWidth;
@@ -219,6 +219,8 @@ int main(int argc, char** argv) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--no-refine-unlabelled") {
       detection.refinement.takeUnlabelled = false;
+    } else if (a == "--fill-max-angle" && i + 1 < argc) {
+      detection.refinement.fillMaxAngleDegrees = std::atof(argv[++i]);
     } else if (a == "--refine-distance" && i + 1 < argc) {
       detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
     } else if (a == "--refine-gain" && i + 1 < argc) {

@@ -26,7 +26,7 @@
 //                            [--max-step F] [--max-rms F] [--merge-rms F] [--merge-deviation F]
 //                            [--merge-parallel DEG]
 //                            [--merge-width F] [--refine-distance F] [--refine-gain F]
-//                            [--no-refine-unlabelled]
+//                            [--no-refine-unlabelled] [--fill-max-angle DEG]
 //                            [--refine-offset F] [--planar-noise F]
 //                            (PlaneDetectionOptions; default: the library's)
 //                            [--no-robust] (the plain APSS stack)
@@ -524,6 +524,8 @@ int main(int argc, char** argv) {
       detection.merging.maxRelativeRms = std::atof(argv[++i]);
     } else if (a == "--no-refine-unlabelled") {
       detection.refinement.takeUnlabelled = false;
+    } else if (a == "--fill-max-angle" && hasValue) {
+      detection.refinement.fillMaxAngleDegrees = std::atof(argv[++i]);
     } else if (a == "--refine-distance" && hasValue) {
       detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
     } else if (a == "--planar-noise" && hasValue) {

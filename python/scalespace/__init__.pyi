@@ -90,6 +90,7 @@ def planes(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int
            merge_rms: float = ..., merge_deviation: float = ...,
            merge_parallel: float = ...,
            refine_distance: float = ..., refine_unlabelled: bool = ...,
+           fill_max_angle: float = ...,
            robust: bool = ..., stack: Optional[str] = ..., output: Optional[str] = ...,
            input: str = ..., threads: Optional[int] = ..., progress: Progress = ...) -> Planes: ...
 def read_planes(directory: str) -> Planes: ...

@@ -6,7 +6,9 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <random>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/planes/BoundaryRefinement.hpp"
@@ -228,6 +230,81 @@ TEST(BoundaryRefinement, AUnionTakesTheUnlabelledPointsItsPlaneDescribes) {
   EXPECT_GT(double(singleTaken), 0.9 * double(near)) << singleTaken << " of " << near;
 }
 
+TEST(BoundaryRefinement, TheFillPassesOverASideWithoutTakingIt) {
+  // The ramp (region 0) with the two top steps and the whole side wall in no region, and the
+  // riser up to the top steps removed: the top steps are reached only along the wall's strip
+  // within the ramp's band. The wall's points there are near the ramp's plane but on a surface
+  // at 90 degrees to it: the fill passes the band on through them and takes none.
+  Scene full = staircaseBesideAWall(0);
+  Scene s;
+  std::vector<int> labels;
+  const auto topSteps = [](const Vec3& p) { return p.x() < kSide && p.y() > 1.2 - 1e-9; };
+  for (std::size_t i = 0; i < full.points.size(); ++i) {
+    const Vec3& p = full.points[i];
+    if (p.x() < kSide && std::abs(p.y() - 1.2) < 1e-9) continue;  // the riser of step 4
+    s.points.push_back(p);
+    labels.push_back(p.x() == kSide || topSteps(p) ? -1 : 0);
+  }
+  s.seg = segmentationOf(labels, 1);
+  const Vec3 rampNormal = Vec3(0, -0.18, 0.3).normalized();
+  const double rampOffset = rampNormal.dot(Vec3(0, 0, 0.09));
+  const auto rampDistance = [&](const Vec3& p) { return std::abs(rampNormal.dot(p) - rampOffset); };
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  const auto count = [&](const Segmentation& refined) {
+    std::size_t near = 0, taken = 0, wall = 0, wallNear = 0;
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      if (s.points[i].x() == kSide) {
+        // At the wall's edge along the steps, the k-NN plane is the crease's: not counted.
+        double toSteps = INFINITY;
+        for (const Vec3& q : s.points)
+          if (q.x() < kSide) toSteps = std::min(toSteps, (q - s.points[i]).norm());
+        wall += refined.labels[i] == 0 && toSteps > 2 * kSpacing;
+        wallNear += rampDistance(s.points[i]) < 0.035;
+      } else if (topSteps(s.points[i]) && rampDistance(s.points[i]) < 0.035) {
+        ++near, taken += refined.labels[i] == 0;
+      }
+    }
+    EXPECT_GT(near, 200u);
+    EXPECT_GT(wallNear, 50u) << "the wall has a strip within the ramp's band";
+    return std::array<std::size_t, 3>{near, taken, wall};
+  };
+  const auto [near, taken, wall] =
+      count(refineRegionBoundaries(s.points, knn, s.seg, {O::merged}, 0.8, 0));
+  EXPECT_EQ(wall, 0u) << "the wall's points off its edge stay unlabelled";
+  EXPECT_GT(double(taken), 0.9 * double(near)) << taken << " of " << near;
+  BoundaryRefinementOptions byDistance;
+  byDistance.fillMaxAngleDegrees = 90;
+  const auto [near90, taken90, wall90] =
+      count(refineRegionBoundaries(s.points, knn, s.seg, {O::merged}, 0.8, 0, byDistance));
+  EXPECT_GT(wall90, 20u) << "by distance alone the fill takes the wall's strip";
+  EXPECT_GT(double(taken90), 0.9 * double(near90));
+}
+
+TEST(BoundaryRefinement, TheFillTakesAFloorNoisierThanItsSampling) {
+  // A floor sampled every 0.01 with noise of 0.03 across it (a scan's near floor): each point's
+  // k-NN plane is the noise's, in any direction, but the neighbours spread across the floor by
+  // the noise only, so the union (the left half) still takes the right half's points its plane
+  // describes.
+  Scene s;
+  std::vector<int> labels;
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.03);
+  for (int a = 0; a < 120; ++a)
+    for (int b = 0; b < 60; ++b) {
+      s.points.emplace_back(0.01 * a, 0.01 * b, noise(random));
+      labels.push_back(a < 60 ? 0 : -1);
+    }
+  s.seg = segmentationOf(labels, 1);
+  const KnnGraph knn = buildKnnGraph(s.points, 10);
+  const Segmentation refined = refineRegionBoundaries(s.points, knn, s.seg, {O::merged}, 0.5, 0.03);
+  std::size_t within = 0, taken = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (labels[i] < 0 && std::abs(s.points[i].z()) < 0.06)
+      ++within, taken += refined.labels[i] == 0;
+  EXPECT_GT(within, 3000u);
+  EXPECT_GT(double(taken), 0.98 * double(within)) << taken << " of " << within;
+}
+
 TEST(BoundaryRefinement, TwoRegionsOfOnePlaneKeepTheirPoints) {
   // One flat floor cut in two regions, the second fitted a little tilted (its points 1e-3 t off
   // the first's plane at its far end): without a margin, and with every point allowed to move,
@@ -299,6 +376,11 @@ TEST(BoundaryRefinement, BadOptionsAndInputsNameWhatIsWrong) {
   o = {};
   o.largeRegionTolerance = -1;
   EXPECT_NE(message(o, kRampMerged, 0.8).find("largeRegionTolerance"), std::string::npos);
+  for (const double angle : {0.0, -5.0, 91.0, double(NAN)}) {
+    o = {};
+    o.fillMaxAngleDegrees = angle;
+    EXPECT_NE(message(o, kRampMerged, 0.8).find("fillMaxAngleDegrees"), std::string::npos);
+  }
   EXPECT_NE(message({}, {O::merged}, 0.8).find("origin"), std::string::npos);
   EXPECT_NE(message({}, kRampMerged, 0).find("scale"), std::string::npos);
 }

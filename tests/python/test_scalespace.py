@@ -166,7 +166,8 @@ def test_planes_merge_options_are_checked_before_any_work(data):
     for kwargs, name in [({"merge_rms": -1}, "merge_rms"),
                          ({"merge_deviation": float("nan")}, "merge_deviation"),
                          ({"merge_parallel": 90}, "merge_parallel"),
-                         ({"refine_distance": -0.1}, "refine_distance")]:
+                         ({"refine_distance": -0.1}, "refine_distance"),
+                         ({"fill_max_angle": 0}, "fill_max_angle")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.planes(cloud.points, **kwargs)
         assert "Options::" not in str(e.value)

@@ -346,6 +346,11 @@ void addPlanesCommand(CLI::App& app) {
                 "to it that its plane describes as well as its own (the ends of a short "
                 "staircase, dropped with the small regions there)")
       ->capture_default_str();
+  cmd->add_option("--fill-max-angle", args->detection.refinement.fillMaxAngleDegrees,
+                  "with --refine-unlabelled: ... but not a point whose own surface (the plane of "
+                  "its neighbours) turns more than this many degrees from the union's plane (a "
+                  "staircase's sides); 90 = by distance alone")
+      ->capture_default_str();
   cmd->add_flag("--no-robust{false}", args->robust,
                 "plain APSS for the stack instead of the robust one of Sec. 2.3 (faster)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)")

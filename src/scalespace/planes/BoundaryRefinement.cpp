@@ -2,9 +2,12 @@
 
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <optional>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/fit/PointSetPlane.hpp"
@@ -17,13 +20,50 @@ constexpr int kPasses = 3;  // plane fits: the first, then two refits
 // still takes back points lying on its plane up to rounding.
 constexpr double kMinRelativeTolerance = 1e-3;
 
+// A point's k-NN (itself included): the plane they fit and their covariance.
+struct Neighbourhood {
+  Vec3 normal = Vec3::Zero();  // of the k-NN's plane
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+Neighbourhood neighbourhoodOf(const std::vector<Vec3>& positions, const KnnGraph& knn, Index i) {
+  Vec3 mean = positions[i];
+  for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e)
+    mean += positions[knn.neighbors[e]];
+  const double count = double(knn.offsets[i + 1] - knn.offsets[i] + 1);
+  mean /= count;
+  Eigen::Matrix3d c = (positions[i] - mean) * (positions[i] - mean).transpose();
+  for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
+    const Vec3 d = positions[knn.neighbors[e]] - mean;
+    c += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(c);
+  Neighbourhood h;
+  h.covariance = c / count;
+  h.normal = eigen.eigenvectors().col(0);
+  return h;
+}
+
+// Whether the point's own surface crosses the plane of unit normal `normal`: its k-NN plane turns
+// more than acos(minCos) from it and the neighbours spread across it by more than minSpread (RMS).
+// Where the sensor noise exceeds the sampling (the near floor of a scan), the k-NN plane is the
+// noise's and any direction; such neighbours spread across the plane no more than the noise.
+bool crosses(const Neighbourhood& h, const Vec3& normal, double minCos, double minSpread) {
+  if (std::abs(h.normal.dot(normal)) >= minCos) return false;
+  return normal.dot(h.covariance * normal) > minSpread * minSpread;
+}
+
 // The unions take the unlabelled points next to them, round after round (each round decides on
 // the labels it began with), while a point lies within planeDescribesBound of the union's plane
 // (kPlaneDescribesTolerance times its RMS, or the noise floor); among several unions, the nearest
-// plane (ties: the first union).
+// plane (ties: the first union). A point whose own surface crosses the union's plane (crosses(),
+// the fill's angle) is not taken but passes the union's band on (a bridge): the strip of a
+// staircase's side within the ramp's band is the side's, yet the top tread lies beyond it.
 void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& knn,
                           const std::vector<std::uint8_t>& takes, std::vector<int>& labels,
-                          std::vector<std::vector<Index>>& regions, double noiseFloor) {
+                          std::vector<std::vector<Index>>& regions, double noiseFloor,
+                          double maxAngleDegrees) {
+  const double minCos =
+      maxAngleDegrees >= 90 ? -1.0 : std::cos(maxAngleDegrees * std::acos(-1.0) / 180);
   const std::size_t n = labels.size();
   std::vector<PlaneFit> planes(regions.size());
   std::vector<double> bound(regions.size(), -1.0);  // < 0: takes nothing
@@ -45,34 +85,50 @@ void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& kn
     if (labels[i] < 0 && nextToTaker(Index(i))) frontier.push_back(Index(i));
   std::vector<std::uint8_t> queued(n, 0);
   std::vector<std::uint8_t> touched(regions.size(), 0);
-  std::vector<int> target;
+  // bridge[i]: the union whose band reached the unlabelled point i, whose own surface turns away
+  // from the union's plane; the band goes on through it, the point stays unlabelled.
+  std::vector<int> bridge(n, -1);
+  const auto bandOf = [&](Index j) { return labels[j] >= 0 ? labels[j] : bridge[j]; };
+  std::vector<int> target, crossing;
   while (!frontier.empty()) {
     target.assign(frontier.size(), -1);
+    crossing.assign(frontier.size(), -1);
     tbb::parallel_for(std::size_t(0), frontier.size(), [&](std::size_t f) {
       const Index i = frontier[f];
-      double best = std::numeric_limits<double>::infinity();
+      std::optional<Neighbourhood> around;  // computed for the first plane in reach
+      double best = std::numeric_limits<double>::infinity(), bestCrossing = best;
       for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
-        const int r = labels[knn.neighbors[e]];
+        const int r = bandOf(knn.neighbors[e]);
         if (r < 0 || bound[std::size_t(r)] < 0) continue;
         const PlaneFit& plane = planes[std::size_t(r)];
         const double d = std::abs(plane.normal.dot(positions[i]) - plane.offset);
-        if (d <= bound[std::size_t(r)] && (d < best || (d == best && r < target[f])))
+        if (d > bound[std::size_t(r)]) continue;
+        if (minCos >= 0 && !around) around = neighbourhoodOf(positions, knn, i);
+        if (minCos >= 0 && crosses(*around, plane.normal, minCos, noiseFloor)) {
+          if (d < bestCrossing || (d == bestCrossing && r < crossing[f]))
+            bestCrossing = d, crossing[f] = r;
+        } else if (d < best || (d == best && r < target[f])) {
           best = d, target[f] = r;
+        }
       }
     });
     std::vector<Index> moved;
     for (std::size_t f = 0; f < frontier.size(); ++f) {
-      if (target[f] < 0) continue;
-      labels[frontier[f]] = target[f];
-      regions[std::size_t(target[f])].push_back(frontier[f]);
-      touched[std::size_t(target[f])] = 1;
-      moved.push_back(frontier[f]);
+      if (target[f] >= 0) {
+        labels[frontier[f]] = target[f];
+        regions[std::size_t(target[f])].push_back(frontier[f]);
+        touched[std::size_t(target[f])] = 1;
+        moved.push_back(frontier[f]);
+      } else if (crossing[f] >= 0) {
+        bridge[frontier[f]] = crossing[f];
+        moved.push_back(frontier[f]);
+      }
     }
     std::vector<Index> next;
     for (const Index i : moved)
       for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
         const Index j = knn.neighbors[e];
-        if (labels[j] < 0 && !queued[j]) queued[j] = 1, next.push_back(j);
+        if (labels[j] < 0 && bridge[j] < 0 && !queued[j]) queued[j] = 1, next.push_back(j);
       }
     for (const Index i : next) queued[i] = 0;
     std::sort(next.begin(), next.end());
@@ -94,6 +150,8 @@ void validate(const BoundaryRefinementOptions& options) {
     throw OptionError("BoundaryRefinementOptions::noiseFactor must be finite and >= 0");
   if (!(options.largeRegionTolerance >= 0) || !std::isfinite(options.largeRegionTolerance))
     throw OptionError("BoundaryRefinementOptions::largeRegionTolerance must be finite and >= 0");
+  if (!(options.fillMaxAngleDegrees > 0 && options.fillMaxAngleDegrees <= 90))
+    throw OptionError("BoundaryRefinementOptions::fillMaxAngleDegrees must be in (0, 90]");
 }
 
 Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const KnnGraph& knn,
@@ -210,7 +268,8 @@ Segmentation refineRegionBoundaries(const std::vector<Vec3>& positions, const Kn
   }
 
   if (options.takeUnlabelled)
-    takeUnlabelledPoints(positions, knn, takes, labels, regions, noiseFloor);
+    takeUnlabelledPoints(positions, knn, takes, labels, regions, noiseFloor,
+                         options.fillMaxAngleDegrees);
 
   // The regions in their order, the emptied ones dropped.
   Segmentation refined;

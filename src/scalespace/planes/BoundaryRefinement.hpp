@@ -47,6 +47,15 @@ struct BoundaryRefinementOptions {
   /// the back face; the treads' ends next to its sides). Its own farthest point as the bound
   /// took a staircase's sides too. false: unlabelled points stay so.
   bool takeUnlabelled = true;
+  /// ... but not a point whose own surface (the plane of its k-NN) turns more than this from the
+  /// union's plane, unless its neighbours spread across that plane no more than the noise floor
+  /// (where the noise exceeds the sampling, as on a scan's near floor, the k-NN plane is the
+  /// noise's). Within the band of a staircase's mean ramp lies a diagonal strip of each of its
+  /// vertical sides (at 90 degrees; treads and risers meet the ramp at its slope and at 90 minus
+  /// it, so 75 keeps the risers of ramps steeper than 15 degrees). Such a point still passes the
+  /// union's band on to the points beyond it (the top tread, which the kernel rounded into the
+  /// back face, is reached only past the sides' strips). 90: no test (by distance alone).
+  double fillMaxAngleDegrees = 75.0;
 };
 
 /// OptionError naming the field unless every bound is finite and >= 0.

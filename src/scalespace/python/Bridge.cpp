@@ -51,6 +51,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"RegionMergeOptions::maxRelativeDeviation", "merge_deviation"},
     {"RegionMergeOptions::parallelDegrees", "merge_parallel"},
     {"BoundaryRefinementOptions::maxRelativeDistance", "refine_distance"},
+    {"BoundaryRefinementOptions::fillMaxAngleDegrees", "fill_max_angle"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},
     {"RenderOptions::up", "up"},

@@ -169,8 +169,8 @@ class Planes {
 std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& normals, int scales,
                                  double alpha, double angle, double maxStep, double maxRms,
                                  double mergeRms, double mergeDeviation, double mergeParallel,
-                                 double refineDistance, bool refineUnlabelled, bool robust,
-                                 const std::optional<std::string>& stack,
+                                 double refineDistance, bool refineUnlabelled, double fillMaxAngle,
+                                 bool robust, const std::optional<std::string>& stack,
                                  const std::optional<std::string>& output, const std::string& input,
                                  std::optional<int> threads, py::object progress) {
   // `scalespace planes`' options and checks, before any work.
@@ -187,6 +187,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   options.merging.parallelDegrees = mergeParallel;
   options.refinement.maxRelativeDistance = refineDistance;
   options.refinement.takeUnlabelled = refineUnlabelled;
+  options.refinement.fillMaxAngleDegrees = fillMaxAngle;
   options.growing.maxAngleDegrees = angle;
   validateScaleSpaceOptions(stackOptions);
   validatePlaneDetectionOptions(options);
@@ -288,6 +289,7 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
         "merge_parallel"_a = PlaneDetectionOptions{}.merging.parallelDegrees,
         "refine_distance"_a = PlaneDetectionOptions{}.refinement.maxRelativeDistance,
         "refine_unlabelled"_a = PlaneDetectionOptions{}.refinement.takeUnlabelled,
+        "fill_max_angle"_a = PlaneDetectionOptions{}.refinement.fillMaxAngleDegrees,
         "robust"_a = true, "stack"_a = py::none(), "output"_a = py::none(), "input"_a = "",
         "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Multi-scale planes by persistence (Chapter 2), as `scalespace planes`.
@@ -304,7 +306,8 @@ large region next to it and within merge_deviation t of its plane, which that re
 take, is undone (5; 0: kept); refine_distance: a merged region takes the neighbouring
 points nearer its plane than their own region's, its plane within refine_distance t (0.3; 0: its
 edges as grown); refine_unlabelled: it also takes the points of no region next to it that its
-plane describes as well as its own (True; False: they stay unlabelled); robust: the robust APSS of Sec. 2.3. stack: a stack folder
+plane describes as well as its own (True; False: they stay unlabelled), except where their own
+surface turns more than fill_max_angle degrees from its plane (75; 90: by distance alone); robust: the robust APSS of Sec. 2.3. stack: a stack folder
 computed from these points instead of computing one. output: also write the result folder
 (input: the cloud file to record in it).)doc");
   m.def(
