@@ -2,10 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <optional>
 
@@ -20,26 +18,18 @@ constexpr int kPasses = 3;  // plane fits: the first, then two refits
 // still takes back points lying on its plane up to rounding.
 constexpr double kMinRelativeTolerance = 1e-3;
 
-// A point's k-NN (itself included): the plane they fit and their covariance.
+// The plane of a point's k-NN (itself included) and their spread across another plane: the
+// point's own surface at the finest scale there is.
 struct Neighbourhood {
-  Vec3 normal = Vec3::Zero();  // of the k-NN's plane
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  std::vector<Index> points;
+  PlaneFit plane;
 };
 Neighbourhood neighbourhoodOf(const std::vector<Vec3>& positions, const KnnGraph& knn, Index i) {
-  Vec3 mean = positions[i];
-  for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e)
-    mean += positions[knn.neighbors[e]];
-  const double count = double(knn.offsets[i + 1] - knn.offsets[i] + 1);
-  mean /= count;
-  Eigen::Matrix3d c = (positions[i] - mean) * (positions[i] - mean).transpose();
-  for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e) {
-    const Vec3 d = positions[knn.neighbors[e]] - mean;
-    c += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(c);
   Neighbourhood h;
-  h.covariance = c / count;
-  h.normal = eigen.eigenvectors().col(0);
+  h.points.push_back(i);
+  for (std::size_t e = knn.offsets[i]; e < knn.offsets[i + 1]; ++e)
+    h.points.push_back(knn.neighbors[e]);
+  h.plane = fitPlane(positions, h.points);
   return h;
 }
 
@@ -47,9 +37,12 @@ Neighbourhood neighbourhoodOf(const std::vector<Vec3>& positions, const KnnGraph
 // more than acos(minCos) from it and the neighbours spread across it by more than minSpread (RMS).
 // Where the sensor noise exceeds the sampling (the near floor of a scan), the k-NN plane is the
 // noise's and any direction; such neighbours spread across the plane no more than the noise.
-bool crosses(const Neighbourhood& h, const Vec3& normal, double minCos, double minSpread) {
-  if (std::abs(h.normal.dot(normal)) >= minCos) return false;
-  return normal.dot(h.covariance * normal) > minSpread * minSpread;
+bool crosses(const std::vector<Vec3>& positions, const Neighbourhood& h, const Vec3& normal,
+             double minCos, double minSpread) {
+  if (!h.plane.valid || std::abs(h.plane.normal.dot(normal)) >= minCos) return false;
+  double sum = 0;
+  for (const Index j : h.points) sum += std::pow(normal.dot(positions[j] - h.plane.centroid), 2);
+  return sum > minSpread * minSpread * double(h.points.size());
 }
 
 // The unions take the unlabelled points next to them, round after round (each round decides on
@@ -104,7 +97,7 @@ void takeUnlabelledPoints(const std::vector<Vec3>& positions, const KnnGraph& kn
         const double d = std::abs(plane.normal.dot(positions[i]) - plane.offset);
         if (d > bound[std::size_t(r)]) continue;
         if (minCos >= 0 && !around) around = neighbourhoodOf(positions, knn, i);
-        if (minCos >= 0 && crosses(*around, plane.normal, minCos, noiseFloor)) {
+        if (minCos >= 0 && crosses(positions, *around, plane.normal, minCos, noiseFloor)) {
           if (d < bestCrossing || (d == bestCrossing && r < crossing[f]))
             bestCrossing = d, crossing[f] = r;
         } else if (d < best || (d == best && r < target[f])) {
