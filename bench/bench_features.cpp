@@ -7,8 +7,9 @@
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
-//                  [--no-visibility] (NormalOrientationOptions::acrossWeight and ::visibility
-//                  of the estimated normals)
+//                  [--no-visibility] [--sheet-normals X (0.05; 0: PCA)]
+//                  (NormalOrientationOptions::acrossWeight and ::visibility of the estimated
+//                  normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
@@ -382,12 +383,15 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 // Clouds.
 
 double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
-bool visibility = NormalOrientationOptions{}.visibility;        // --no-visibility
+double sheetNormals = 0.05;  // --sheet-normals, as `scalespace features` (kFeatureSheetNormals)
+bool visibility = NormalOrientationOptions{}.visibility;  // --no-visibility
 
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
 void estimateOrientedNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationResult est = estimateNormals(cloud.positions(), *index);
+  NormalEstimationOptions estimation;
+  estimation.sheetTolerance = sheetNormals;
+  NormalEstimationResult est = estimateNormals(cloud.positions(), *index, estimation);
   NormalOrientationOptions orientation;
   orientation.acrossWeight = acrossWeight;
   orientation.visibility = visibility;
@@ -1155,6 +1159,8 @@ int main(int argc, char** argv) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
     } else if (a == "--across-weight" && hasValue) {
       acrossWeight = std::atof(argv[++i]);
+    } else if (a == "--sheet-normals" && hasValue) {
+      sheetNormals = std::atof(argv[++i]);
     } else if (a == "--no-visibility") {
       visibility = false;
     } else if (a == "--mesh-normals") {

@@ -116,19 +116,22 @@ def test_curvature_without_normals_equals_the_cli(data, tmp_path):
 def test_estimate_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)
-    # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone
-    for weight, visibility in ((1, True), (0, True), (0, False)):
+    # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone, sheets
+    for weight, visibility, sheet in ((1, True, 0), (0, True, 0), (0, False, 0), (0, True, 0.05)):
         flag = "--visibility" if visibility else "--no-visibility"
         cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight,
-            flag)
+            flag, "--sheet", sheet)
         expected = columns(tmp_path / "n.ply")
         normals, reliable = ss.estimate_normals(points, across_weight=weight,
-                                                visibility=visibility)
+                                                visibility=visibility, sheet=sheet)
         for c, name in enumerate(("nx", "ny", "nz")):
             np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
         np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)
     with pytest.raises(ValueError, match="acrossWeight"):
         ss.estimate_normals(points, across_weight=-1)
+    with pytest.raises(ss.OptionError, match="sheet") as e:
+        ss.estimate_normals(points, sheet=-1)
+    assert "Options::" not in str(e.value)
 
 
 def test_planes_and_segments_equal_the_cli(data, tmp_path):

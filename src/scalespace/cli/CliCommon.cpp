@@ -60,14 +60,15 @@ PointCloud loadCloud(const InputOptions& input, bool quiet) {
   return cloud;
 }
 
-void ensureNormals(PointCloud& cloud, bool quiet) {
+void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation) {
   if (cloud.hasNormals()) return;
   if (!quiet)
     std::fprintf(stderr,
-                 "input has no normals: estimating (PCA, 10 neighbours) and orienting (MST)\n");
+                 "input has no normals: estimating (%s, %zu neighbours) and orienting (MST)\n",
+                 estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k);
   auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationResult est =
-      estimateNormals(cloud.positions(), *index, {}, makeProgressBar(quiet));
+      estimateNormals(cloud.positions(), *index, estimation, makeProgressBar(quiet));
   orientNormals(cloud.positions(), est.normals, *index, {}, est.valid, makeProgressBar(quiet));
   cloud.setNormals(std::move(est.normals));
 }

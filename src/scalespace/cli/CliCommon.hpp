@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/PointCloud.hpp"
 
 namespace scalespace::cli {
@@ -32,9 +33,9 @@ PointCloud loadResultInput(const std::string& recorded, const std::string& overr
                            const std::string& directory, const std::string& what,
                            std::size_t pointCount, const std::string& output, bool quiet);
 
-/// Estimates (PCA, 10 neighbours) and orients (MST) normals when the cloud has none; says so on
-/// stderr unless quiet. The APSS fits need oriented normals.
-void ensureNormals(PointCloud& cloud, bool quiet);
+/// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST) normals when the
+/// cloud has none; says so on stderr unless quiet. The APSS fits need oriented normals.
+void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation = {});
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {

@@ -175,6 +175,7 @@ struct NormalArgs {
   std::vector<std::string> orient{"mst"};
   double acrossWeight = NormalOrientationOptions{}.acrossWeight;
   bool visibility = NormalOrientationOptions{}.visibility;
+  double sheet = NormalEstimationOptions{}.sheetTolerance;
 };
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
@@ -184,6 +185,11 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                  "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z) or "
                  "'viewpoint X Y Z' (towards a scanner position, in file coordinates)")
       ->expected(1, 4);
+  cmd.add_option("--sheet", a.sheet,
+                 "the plane of the neighbours within this x the k-th neighbour's distance (or 8 "
+                 "noise RMS) of one through the point and two neighbours instead of the PCA "
+                 "plane: one side's at a crease or across a thin part (0 = PCA; features: 0.05)")
+      ->capture_default_str();
   cmd.add_option("--across-weight", a.acrossWeight,
                  "mst: extra cost of a graph edge across a thin part (offset along both normals), "
                  "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
@@ -238,6 +244,7 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
   const auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationOptions eo;
   eo.k = a.k;
+  eo.sheetTolerance = a.sheet;
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
   NormalOrientationResult ori =
       orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid, progress);

@@ -211,6 +211,7 @@ void addFeaturesCommand(CLI::App& app) {
     std::string output, linesOutput;
     FeatureCurveOptions features;
     std::size_t samplesPerVertex = 100;
+    double sheetNormals = kFeatureSheetNormals;
     bool ascii = false, quiet = false;
     int threads = 0;
   };
@@ -273,6 +274,11 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--mesh-samples", args->samplesPerVertex,
                   "mesh inputs: sample this many points per vertex by area (Sec. 3.4.1: 100)")
       ->capture_default_str();
+  cmd->add_option("--sheet-normals", args->sheetNormals,
+                  "a cloud without normals: estimate each as the plane of the neighbours within "
+                  "this x the 10th neighbour's distance (or 8 noise RMS) of one through the "
+                  "point and two neighbours, one side's at a crease (0: PCA)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
@@ -313,7 +319,9 @@ void addFeaturesCommand(CLI::App& app) {
       result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
-      ensureNormals(cloud, args->quiet);
+      NormalEstimationOptions estimation;
+      estimation.sheetTolerance = args->sheetNormals;
+      ensureNormals(cloud, args->quiet, estimation);
       result = detectFeatureCurves(cloud, options, progress);
     }
     PointCloud& out = mesh ? targets : cloud;

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@ namespace {
 struct LocalNormal {
   Vec3 normal = Vec3::UnitZ();
   double surfaceVariation = 1.0 / 3.0;
+  double rms = 0.0;  // of the neighbours' distances to the plane
   bool valid = false;
 };
 
@@ -51,8 +53,48 @@ LocalNormal fitPlane(const std::vector<Vec3>& points, const std::vector<Neighbor
   }
   r.normal = normal.normalized();
   r.surfaceVariation = lambda(0) / sum;
+  r.rms = std::sqrt(lambda(0));
   r.valid = true;
   return r;
+}
+
+// NormalEstimationOptions::sheetTolerance: the plane through the point and two neighbours that the
+// most neighbours lie within `band` of (ties: the smaller sum of their distances), refitted to
+// them. Pairs whose offsets are nearly parallel (sine below 0.3) span no plane. `fallback` when no
+// pair does or the inliers are degenerate.
+Vec3 sheetNormal(const std::vector<Vec3>& points, std::size_t i, const std::vector<Neighbor>& nbrs,
+                 double band, double colinearity, const Vec3& fallback,
+                 std::vector<Neighbor>& inliers) {
+  const Vec3& p = points[i];
+  std::size_t bestCount = 0;
+  double bestSum = 0;
+  Vec3 best = fallback;
+  for (std::size_t a = 0; a < nbrs.size(); ++a) {
+    if (nbrs[a].index == i) continue;
+    const Vec3 u = points[nbrs[a].index] - p;
+    for (std::size_t b = a + 1; b < nbrs.size(); ++b) {
+      if (nbrs[b].index == i) continue;
+      const Vec3 v = points[nbrs[b].index] - p;
+      Vec3 normal = u.cross(v);
+      const double norm = normal.norm();
+      if (!(norm > 0.3 * u.norm() * v.norm())) continue;
+      normal /= norm;
+      std::size_t count = 0;
+      double sum = 0;
+      for (const Neighbor& m : nbrs) {
+        const double d = std::abs(normal.dot(points[m.index] - p));
+        if (d <= band) ++count, sum += d;
+      }
+      if (count > bestCount || (count == bestCount && sum < bestSum))
+        bestCount = count, bestSum = sum, best = normal;
+    }
+  }
+  if (bestCount == 0) return fallback;
+  inliers.clear();
+  for (const Neighbor& m : nbrs)
+    if (std::abs(best.dot(points[m.index] - p)) <= band) inliers.push_back(m);
+  const LocalNormal refit = fitPlane(points, inliers, colinearity);
+  return refit.valid ? refit.normal : best;
 }
 
 }  // namespace
@@ -70,6 +112,10 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
   if (index.size() != points.size())
     throw OptionError("estimateNormals: the index holds " + std::to_string(index.size()) +
                       " points but " + std::to_string(points.size()) + " were given");
+  if (!(options.sheetTolerance >= 0) || !std::isfinite(options.sheetTolerance))
+    throw OptionError("NormalEstimationOptions::sheetTolerance must be finite and >= 0");
+  if (!(options.sheetNoiseFactor >= 0) || !std::isfinite(options.sheetNoiseFactor))
+    throw OptionError("NormalEstimationOptions::sheetNoiseFactor must be finite and >= 0");
   const std::size_t n = points.size();
   NormalEstimationResult result;
   result.normals.assign(n, Vec3::UnitZ());
@@ -79,27 +125,61 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
   // Queries along the Morton curve walk the same branches of the index one after another (a
   // scan's points may come in any order); each point's result is its own, so nothing changes.
   const std::vector<Index> order = spatialOrder(points);
-  ProgressTracker tracker(progress, "normal estimation", n);
-  tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
+  const bool sheets = options.sheetTolerance > 0;
+  ProgressTracker tracker(progress, "normal estimation", sheets ? 2 * n : n);
+  tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch, inlierScratch;
+  const auto neighbours = [&](std::size_t i, std::vector<Neighbor>& nbrs) {
+    if (options.radius > 0.0)
+      index.radiusSearch(points[i], options.radius, nbrs);
+    else
+      index.knnSearch(points[i], options.k, nbrs);
+  };
+  std::vector<double> rms(n, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       if (tracker.cancelled()) return;
                       std::vector<Neighbor>& nbrs = scratch.local();
                       for (std::size_t v = range.begin(); v != range.end(); ++v) {
                         const std::size_t i = order[v];
-                        if (options.radius > 0.0)
-                          index.radiusSearch(points[i], options.radius, nbrs);
-                        else
-                          index.knnSearch(points[i], options.k, nbrs);
+                        neighbours(i, nbrs);
                         const LocalNormal r = fitPlane(points, nbrs, options.colinearity);
                         result.normals[i] = r.normal;
                         result.surfaceVariation[i] = r.surfaceVariation;
                         result.valid[i] = r.valid ? 1 : 0;
+                        rms[i] = r.rms;
                       }
                       tracker.advance(range.size());
                     });
-  tracker.finish();
   for (std::uint8_t v : result.valid) result.invalidCount += v ? 0 : 1;
+  std::vector<double> validRms;
+  validRms.reserve(n - result.invalidCount);
+  for (std::size_t i = 0; i < n; ++i)
+    if (result.valid[i]) validRms.push_back(rms[i]);
+  if (!validRms.empty()) {
+    std::nth_element(validRms.begin(), validRms.begin() + validRms.size() / 2, validRms.end());
+    result.noiseRms = validRms[validRms.size() / 2];
+  }
+  if (sheets) {
+    const double noiseBand = options.sheetNoiseFactor * result.noiseRms;
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 1024),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          if (tracker.cancelled()) return;
+          std::vector<Neighbor>& nbrs = scratch.local();
+          for (std::size_t v = range.begin(); v != range.end(); ++v) {
+            const std::size_t i = order[v];
+            if (!result.valid[i]) continue;
+            neighbours(i, nbrs);
+            double farthest = 0;
+            for (const Neighbor& m : nbrs) farthest = std::max(farthest, m.distSq);
+            const double band = std::max(options.sheetTolerance * std::sqrt(farthest), noiseBand);
+            result.normals[i] = sheetNormal(points, i, nbrs, band, options.colinearity,
+                                            result.normals[i], inlierScratch.local());
+          }
+          tracker.advance(range.size());
+        });
+  }
+  tracker.finish();
   return result;
 }
 

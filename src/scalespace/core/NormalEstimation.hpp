@@ -20,6 +20,17 @@ struct NormalEstimationOptions {
   /// A neighbourhood is degenerate (normal flagged invalid) when it has fewer than 3 distinct
   /// points or is colinear: middle eigenvalue <= colinearity * largest eigenvalue.
   double colinearity = 1e-8;
+  /// Sheet normals (not in Hoppe 1992; 0: the PCA normal of every neighbourhood). Of the planes
+  /// through the point and two of its neighbours, the one that the most neighbours lie within a
+  /// band of (half-width sheetTolerance times the distance to the farthest neighbour, or
+  /// sheetNoiseFactor times the cloud's noise, noiseRms below, whichever is larger), refitted to
+  /// those neighbours: at a crease, the plane of the side the point is on rather than the average
+  /// of both; on a part thinner than the sampling (a blade's rim), the plane of its own side
+  /// rather than one tilted through both. Under noise the band holds the neighbourhood and the
+  /// normal is the PCA one (8: with 4 the noisy CAD clouds and the real table scan lost to PCA;
+  /// docs/THESIS_NOTES.md, "Feature curves", sheet normals).
+  double sheetTolerance = 0.0;
+  double sheetNoiseFactor = 8.0;
 };
 
 struct NormalEstimationResult {
@@ -29,13 +40,17 @@ struct NormalEstimationResult {
   std::vector<double> surfaceVariation;
   std::vector<std::uint8_t> valid;  // 0 = degenerate neighbourhood (see the options)
   std::size_t invalidCount = 0;
+  /// The median over the valid points of the RMS distance of their neighbourhood to its PCA
+  /// plane: the sensor noise where the surface is smooth at the neighbourhood's size.
+  double noiseRms = 0.0;
 };
 
 /// Estimates one normal per point of `points` using `index` (built on the same points).
 /// Reorder the points with spatialOrder() first: on points in random order this is much faster
 /// (bench/bench_spatial_index.cpp measures both orders).
 /// Parallel and deterministic (each point is computed independently). Throws OptionError for
-/// k < 3 (radius == 0) or a negative/non-finite radius, Cancelled if `progress` returns false.
+/// k < 3 (radius == 0), a negative/non-finite radius or sheet option, Cancelled if `progress`
+/// returns false.
 NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const SpatialIndex& index,
                                        const NormalEstimationOptions& options = {},
                                        const ProgressCallback& progress = {});

@@ -28,6 +28,12 @@
 
 namespace scalespace {
 
+/// NormalEstimationOptions::sheetTolerance of the normals that `features` estimates for a cloud
+/// without any (CLI, Python): at a crease the plane of the side a point is on, so that the fits
+/// there do not mix both sides (bench_features: the clean CAD models' per-curve recall 0.85 ->
+/// 0.91; docs/THESIS_NOTES.md, "Feature curves").
+constexpr double kFeatureSheetNormals = 0.05;
+
 struct FeatureCurveOptions {
   /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance
   /// to the spacingNeighbors-th nearest neighbour (the thesis uses the median edge length of a

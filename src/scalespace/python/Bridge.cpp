@@ -52,6 +52,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"RegionMergeOptions::parallelDegrees", "merge_parallel"},
     {"BoundaryRefinementOptions::maxRelativeDistance", "refine_distance"},
     {"BoundaryRefinementOptions::fillMaxAngleDegrees", "fill_max_angle"},
+    {"NormalEstimationOptions::sheetTolerance", "sheet"},
     {"RegionGrowingOptions::maxAngleDegrees", "angle"},
     {"StackWriteOptions::encoding", "encoding"},
     {"RenderOptions::up", "up"},
@@ -384,7 +385,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress, double acrossWeight,
-                                            bool visibility) {
+                                            bool visibility, double sheetTolerance) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
   if (k >= cloud.size())
@@ -407,6 +408,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   const auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationOptions eo;
   eo.k = k;
+  eo.sheetTolerance = sheetTolerance;
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
   NormalOrientationResult ori =
       orientNormals(cloud.positions(), est.normals, *index, o, est.valid, progress);

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
@@ -144,7 +145,8 @@ std::vector<std::uint8_t> estimateAndOrient(
     PointCloud& cloud, std::size_t k = 10, const std::string& orient = "mst",
     const std::optional<Vec3>& viewpoint = std::nullopt, const ProgressCallback& progress = {},
     double acrossWeight = NormalOrientationOptions{}.acrossWeight,
-    bool visibility = NormalOrientationOptions{}.visibility);
+    bool visibility = NormalOrientationOptions{}.visibility,
+    double sheetTolerance = NormalEstimationOptions{}.sheetTolerance);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);

@@ -86,13 +86,14 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 }
 
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
-                    const py::handle& viewpoint, double acrossWeight, bool visibility,
+                    const py::handle& viewpoint, double acrossWeight, bool visibility, double sheet,
                     std::optional<int> threads, py::object progress) {
   PooledCloud cloud = makeCloud(asPoints(points), py::none());
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   Call call(std::move(progress), threads);
   std::vector<std::uint8_t> reliable = call([&] {
-    return estimateAndOrient(cloud, k, orient, view, call.progress(), acrossWeight, visibility);
+    return estimateAndOrient(cloud, k, orient, view, call.progress(), acrossWeight, visibility,
+                             sheet);
   });
   py::array_t<bool> reliableArray(py::ssize_t(reliable.size()));
   for (std::size_t i = 0; i < reliable.size(); ++i) reliableArray.mutable_data()[i] = reliable[i];
@@ -271,7 +272,8 @@ void bindClouds(py::module_& m) {
         "attributes"_a = py::none(), py::kw_only(), "ascii"_a = false);
   m.def("estimate_normals", &normalsPy, "points"_a, py::kw_only(), "k"_a = 10, "orient"_a = "mst",
         "viewpoint"_a = py::none(), "across_weight"_a = NormalOrientationOptions{}.acrossWeight,
-        "visibility"_a = NormalOrientationOptions{}.visibility, "threads"_a = py::none(),
+        "visibility"_a = NormalOrientationOptions{}.visibility,
+        "sheet"_a = NormalEstimationOptions{}.sheetTolerance, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Estimates (PCA over k neighbours) and orients normals, as `scalespace normals`.
 
@@ -279,7 +281,10 @@ orient: "mst" (Hoppe 1992 propagation, seeds towards +z) or "viewpoint" (towards
 viewpoint=(x, y, z), a scanner position in the points' coordinates). across_weight (mst): the
 extra cost of an edge across a thin part, so that its two sides are oriented apart (0: Hoppe's
 cost alone). visibility (mst): turn over the pieces of the tree that rays cast from the points
-show facing the inside of a closed surface (the two sides of thin parts, creases).
+show facing the inside of a closed surface (the two sides of thin parts, creases). sheet: the
+plane through the point and two neighbours that the most neighbours lie within sheet times the
+k-th neighbour's distance (or 8 noise RMS) of, refitted to them, instead of the PCA plane: one
+side's plane at a crease or on a part thinner than the sampling (0: PCA; features uses 0.05).
 Returns (normals (N, 3) float64, reliable (N,) bool: False where the orientation is a guess).)doc");
   m.def("curvature", &curvaturePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scale_k"_a = py::none(), "estimator"_a = "w3", "mls"_a = false,

@@ -169,7 +169,10 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   Call call(std::move(progress), threads);
   FeatureCurveResult result = call([&] {
     if (!mesh) {
-      if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+      if (!cloud.hasNormals())
+        estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress(),
+                          NormalOrientationOptions{}.acrossWeight,
+                          NormalOrientationOptions{}.visibility, kFeatureSheetNormals);
       return detectFeatureCurves(cloud, options, call.progress());
     }
     MeshFeatureCurves onMesh =
