@@ -246,3 +246,16 @@ TEST(NormalEstimation, SheetOptionsAreChecked) {
   bad.sheetNoiseFactor = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(estimateNormals(points, bad), OptionError);
 }
+
+TEST(NormalEstimation, SheetNormalsOfLargeNeighbourhoodsChooseAmongTheNearest) {
+  // k = 300: the candidate planes come from the 16 nearest neighbours (pairs x neighbours per
+  // point); every pair of all 300 would take about 4e10 steps here.
+  const auto points = testclouds::plane(3000, 1.0, 28);
+  NormalEstimationOptions options;
+  options.k = 300;
+  options.sheetTolerance = 0.05;
+  const auto r = estimateNormals(points, options);
+  const auto pca = estimateNormals(points);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    EXPECT_LT(angleDegrees(r.normals[i], pca.normals[i]), 1.0) << i;
+}

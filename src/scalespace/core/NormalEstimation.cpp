@@ -58,21 +58,30 @@ LocalNormal fitPlane(const std::vector<Vec3>& points, const std::vector<Neighbor
   return r;
 }
 
+// The planes a sheet normal chooses from pass through the point and two of its nearest this many
+// neighbours (120 pairs): a large k or radius costs pairs x neighbours, not neighbours cubed.
+constexpr std::size_t kSheetGenerators = 16;
+
 // NormalEstimationOptions::sheetTolerance: the plane through the point and two neighbours that the
 // most neighbours lie within `band` of (ties: the smaller sum of their distances), refitted to
 // them. Pairs whose offsets are nearly parallel (sine below 0.3) span no plane. `fallback` when no
-// pair does or the inliers are degenerate.
-Vec3 sheetNormal(const std::vector<Vec3>& points, std::size_t i, const std::vector<Neighbor>& nbrs,
+// pair does or the inliers are degenerate. `nbrs` is reordered (nearest first).
+Vec3 sheetNormal(const std::vector<Vec3>& points, std::size_t i, std::vector<Neighbor>& nbrs,
                  double band, double colinearity, const Vec3& fallback,
                  std::vector<Neighbor>& inliers) {
   const Vec3& p = points[i];
+  const std::size_t generators = std::min(nbrs.size(), kSheetGenerators + 1);  // + the point
+  const auto nearer = [](const Neighbor& x, const Neighbor& y) {
+    return x.distSq < y.distSq || (x.distSq == y.distSq && x.index < y.index);
+  };
+  std::partial_sort(nbrs.begin(), nbrs.begin() + std::ptrdiff_t(generators), nbrs.end(), nearer);
   std::size_t bestCount = 0;
   double bestSum = 0;
   Vec3 best = fallback;
-  for (std::size_t a = 0; a < nbrs.size(); ++a) {
+  for (std::size_t a = 0; a < generators; ++a) {
     if (nbrs[a].index == i) continue;
     const Vec3 u = points[nbrs[a].index] - p;
-    for (std::size_t b = a + 1; b < nbrs.size(); ++b) {
+    for (std::size_t b = a + 1; b < generators; ++b) {
       if (nbrs[b].index == i) continue;
       const Vec3 v = points[nbrs[b].index] - p;
       Vec3 normal = u.cross(v);
