@@ -137,6 +137,7 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("features " + c + " --min-scales 9 -o " + path("out.ply"), "--min-scales");
   refused("features " + c + " -o " + path("out.off"), "OFF and OBJ");
   refused("features " + c + " --mesh-samples 0 -o " + path("out.ply"), "--mesh-samples");
+  refused("features " + c + " --sheet-normals -1 -o " + path("out.ply"), "--sheet-normals");
   std::ofstream(path("bad.off")) << "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n";
   refused("features " + path("bad.off") + " -o " + path("out.ply"), "vertex 2", 1);
   std::ofstream(path("flat.off")) << "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n";

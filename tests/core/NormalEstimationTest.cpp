@@ -249,13 +249,42 @@ TEST(NormalEstimation, SheetOptionsAreChecked) {
 
 TEST(NormalEstimation, SheetNormalsOfLargeNeighbourhoodsChooseAmongTheNearest) {
   // k = 300: the candidate planes come from the 16 nearest neighbours (pairs x neighbours per
-  // point); every pair of all 300 would take about 4e10 steps here.
-  const auto points = testclouds::plane(3000, 1.0, 28);
+  // point); every pair of all 300 would take about 4e10 steps here. Near the edge each point's
+  // own face, which holds most of its 300 neighbours, still wins; farther, where a few of the
+  // other face's points tilt the PCA plane by less than the band, the PCA normal is kept.
+  const double spacing = 0.01;
+  const auto points = rightAngleEdge(spacing);
   NormalEstimationOptions options;
   options.k = 300;
+  const auto pca = estimateNormals(points, options);
   options.sheetTolerance = 0.05;
   const auto r = estimateNormals(points, options);
+  double worst = 0, worstPca = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    if (p.y() < 12 * spacing || p.y() > 27 * spacing || std::max(-p.x(), p.z()) < spacing) continue;
+    const Vec3 face = p.z() == 0 ? Vec3::UnitZ() : Vec3::UnitX();
+    worst = std::max(worst, angleDegrees(r.normals[i], face));
+    worstPca = std::max(worstPca, angleDegrees(pca.normals[i], face));
+  }
+  EXPECT_LT(worst, 1.0);
+  EXPECT_GT(worstPca, 10.0);
+}
+
+TEST(NormalEstimation, SheetNormalsOfSmoothSurfacesAreThePcaOnes) {
+  // On a sphere the plane with the most neighbours within the band is a tangent plane off the
+  // point; the PCA plane holds the neighbourhood within the band, so it is kept.
+  const auto points = testclouds::fibonacciSphere(20000);
+  NormalEstimationOptions sheet;
+  sheet.sheetTolerance = 0.05;
   const auto pca = estimateNormals(points);
+  EXPECT_EQ(estimateNormals(points, sheet).normals, pca.normals);
+  // A band too thin for the curvature: the planes are chosen, and tilt.
+  sheet.sheetTolerance = 1e-4;
+  sheet.sheetNoiseFactor = 0;
+  double worst = 0;
+  const auto thin = estimateNormals(points, sheet);
   for (std::size_t i = 0; i < points.size(); ++i)
-    EXPECT_LT(angleDegrees(r.normals[i], pca.normals[i]), 1.0) << i;
+    worst = std::max(worst, angleDegrees(thin.normals[i], pca.normals[i]));
+  EXPECT_GT(worst, 1.0);
 }

@@ -411,6 +411,14 @@ def test_render_lines_features(data):
         0.6, 8 * features["noise_rms"] / features["spacing"])
     with pytest.raises(ss.OptionError, match="noise_curvature must be finite and >= 0"):
         ss.features(cloud.points, noise_curvature=-1)
+    # Without normals, features estimates sheet normals (0.05) or, with sheet_normals=0, PCA ones,
+    # as estimate_normals does.
+    for sheet, result in ((0.05, features), (0, ss.features(cloud.points, sheet_normals=0))):
+        normals, _ = ss.estimate_normals(cloud.points, sheet=sheet)
+        np.testing.assert_array_equal(
+            result["curve_id"], ss.features(cloud.points, normals)["curve_id"])
+    with pytest.raises(ss.OptionError, match="sheet_normals must be finite and >= 0"):
+        ss.features(cloud.points, sheet_normals=-1)
 
 
 def test_any_layout_gives_the_same_result_and_inputs_stay_untouched():

@@ -289,6 +289,8 @@ void addFeaturesCommand(CLI::App& app) {
     validateFeatureCurveOptions(options);  // before the read
     if (args->samplesPerVertex < 1 || args->samplesPerVertex > 10000)
       throw OptionError("--mesh-samples must be in [1, 10000]");
+    if (!(args->sheetNormals >= 0) || !std::isfinite(args->sheetNormals))
+      throw OptionError("--sheet-normals must be finite and >= 0 (0: PCA normals)");
     std::vector<std::string> inputs{args->input.path};
     checkOutput(args->output, OutputKind::Cloud, inputs);
     if (!args->linesOutput.empty()) {

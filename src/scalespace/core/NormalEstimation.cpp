@@ -182,6 +182,11 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
             double farthest = 0;
             for (const Neighbor& m : nbrs) farthest = std::max(farthest, m.distSq);
             const double band = std::max(options.sheetTolerance * std::sqrt(farthest), noiseBand);
+            // A neighbourhood its PCA plane already holds within the band (a smooth surface, a
+            // curved one included) keeps the PCA normal: the plane with the most inliers there is
+            // one tangent off the point, tilted by the curvature (kitten.xyz: 1.4% of the normals
+            // more than 20 degrees off, against 0.04% with PCA).
+            if (rms[i] <= band) continue;
             result.normals[i] = sheetNormal(points, i, nbrs, band, options.colinearity,
                                             result.normals[i], inlierScratch.local());
           }

@@ -26,9 +26,9 @@ struct NormalEstimationOptions {
   /// sheetNoiseFactor times the cloud's noise, noiseRms below, whichever is larger), refitted to
   /// those neighbours: at a crease, the plane of the side the point is on rather than the average
   /// of both; on a part thinner than the sampling (a blade's rim), the plane of its own side
-  /// rather than one tilted through both. Under noise the band holds the neighbourhood and the
-  /// normal is the PCA one (8: with 4 the noisy CAD clouds and the real table scan lost to PCA;
-  /// docs/THESIS_NOTES.md, "Feature curves", sheet normals).
+  /// rather than one tilted through both. A neighbourhood whose PCA plane's RMS is within the
+  /// band (smooth, curved or noisy) keeps its PCA normal (8: with 4 the noisy CAD clouds and the
+  /// real table scan lost to PCA; docs/THESIS_NOTES.md, "Feature curves", sheet normals).
   double sheetTolerance = 0.0;
   double sheetNoiseFactor = 8.0;
 };
