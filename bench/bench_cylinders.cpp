@@ -7,6 +7,7 @@
 //                   [--scales M (ours: 8)] [--tmin T (ours: automatic)] [--seed S]
 //                   [--curved-seeds-first] (ours: CurvatureLineOptions::curvedSeedsFirst on,
 //                   the features' seed order; the cylinders' default is the random order)
+//                   [--one-curvature-sign] (ours: CylinderOptions::oneCurvatureSign on)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -265,11 +266,13 @@ int main(int argc, char** argv) {
       ours.tMin = std::stod(argv[++i]);
     else if (a == "--curved-seeds-first")
       ours.lines.curvedSeedsFirst = true;
+    else if (a == "--one-curvature-sign")
+      ours.oneCurvatureSign = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
                    "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
-                   "[--curved-seeds-first]\n");
+                   "[--curved-seeds-first] [--one-curvature-sign]\n");
       return 2;
     }
   }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "scalespace/core/Error.hpp"
@@ -204,6 +205,66 @@ TEST(Cylinders, PlanesAndBoxesAreNoCylinders) {
   const PointCloud box = generateScene(SceneKind::Box, scene);
   const CylinderDetection d = detectCylinders(box, atScales({0.03, 0.06, 0.12}));
   EXPECT_TRUE(d.components.empty()) << d.components.size() << " components on a box";
+}
+
+// Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and
+// the surface is their union's, a concave groove where they meet), with exact normals; which
+// cylinder each point lies on in `lobe`.
+PointCloud sampleTwinTubes(std::size_t count, double distance, std::vector<int>& lobe) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> p, n;
+  lobe.clear();
+  for (int k = 0; k < 2; ++k) {
+    const double y = (k == 0 ? -0.5 : 0.5) * distance;
+    for (std::size_t i = 0; i < count; ++i) {
+      const double theta = 2 * kPi * u(rng);
+      const Vec3 normal(0, std::cos(theta), std::sin(theta));
+      const Vec3 q = Vec3(6 * u(rng), y, 0) + normal;
+      if (std::hypot(q.y() + y, q.z()) < 1) continue;  // inside the other cylinder
+      p.push_back(q);
+      n.push_back(normal);
+      lobe.push_back(k);
+    }
+  }
+  PointCloud cloud;
+  cloud.setAbsolutePositions(p);
+  cloud.setNormals(std::move(n));
+  return cloud;
+}
+
+// Per lobe, its best IoU with one set of `labels` (-1: none).
+std::vector<double> bestIoUs(const std::vector<int>& labels, const std::vector<int>& lobe) {
+  std::vector<double> best(2, 0.0);
+  for (int k = 0; k < 2; ++k) {
+    std::map<int, std::size_t> common, size;
+    std::size_t lobeSize = 0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+      if (labels[i] >= 0) ++size[labels[i]];
+      if (lobe[i] != k) continue;
+      ++lobeSize;
+      if (labels[i] >= 0) ++common[labels[i]];
+    }
+    for (const auto& [label, c] : common)
+      best[std::size_t(k)] =
+          std::max(best[std::size_t(k)], double(c) / double(lobeSize + size[label] - c));
+  }
+  return best;
+}
+
+TEST(Cylinders, OneCurvatureSignStopsARegionAtAConcaveGroove) {
+  // At t = 0.3 the scale's normals turn smoothly across the groove between the lobes, so Eq.
+  // 3.10 alone grows one region over both (no tube, or one holding both: IoU about 0.5 with each
+  // lobe); keeping the seed's curvature sign, each lobe is its own tube (the strands of a noisy
+  // cable, bench_cylinders).
+  std::vector<int> lobe;
+  const PointCloud twins = sampleTwinTubes(10000, 1.6, lobe);
+  CylinderOptions options = atScales({0.3});
+  for (const double iou : bestIoUs(cylinderLabelsAtLevel(detectCylinders(twins, options), 0), lobe))
+    EXPECT_LT(iou, 0.6);
+  options.oneCurvatureSign = true;
+  for (const double iou : bestIoUs(cylinderLabelsAtLevel(detectCylinders(twins, options), 0), lobe))
+    EXPECT_GT(iou, 0.95);
 }
 
 TEST(Cylinders, SameResultForAnyThreadCount) {

@@ -332,6 +332,31 @@ def test_cylinders_without_normals_equal_the_cli(pipes, tmp_path):
                                   ss.read(str(tmp_path / "c" / "cloud.ply")).attributes["cylinder_id"])
 
 
+def test_cylinders_one_curvature_sign_equals_the_cli(tmp_path):
+    # Two overlapping unit cylinders: one_curvature_sign stops the regions at the groove between
+    # them (tests/features, OneCurvatureSignStopsARegionAtAConcaveGroove), as the CLI's flag does.
+    rng = np.random.default_rng(4)
+    points, normals = [], []
+    for y in (-0.8, 0.8):
+        theta = rng.uniform(0, 2 * np.pi, 8000)
+        n = np.stack([np.zeros_like(theta), np.cos(theta), np.sin(theta)], axis=1)
+        p = n + np.stack([rng.uniform(0, 6, 8000), np.full(8000, y), np.zeros(8000)], axis=1)
+        keep = np.hypot(p[:, 1] + y, p[:, 2]) >= 1
+        points.append(p[keep])
+        normals.append(n[keep])
+    points, normals = np.concatenate(points), np.concatenate(normals)
+    ss.write(str(tmp_path / "twins.ply"), points, normals)
+    cli("cylinders", tmp_path / "twins.ply", "-o", tmp_path / "c", "--scales", 1, "--tmin", 0.3,
+        "--tmax", 0.31, "--one-curvature-sign")
+    expected = json.loads((tmp_path / "c" / "components.json").read_text())["components"]
+    split = ss.cylinders(points, normals, scale_count=1, tmin=0.3, tmax=0.31,
+                         one_curvature_sign=True)
+    assert len(split) == len(expected) == 2
+    np.testing.assert_allclose(sorted(c["radius"] for c in split.components),
+                               sorted(c["radius"] for c in expected), rtol=1e-9)
+    assert len(ss.cylinders(points, normals, scale_count=1, tmin=0.3, tmax=0.31)) < 2
+
+
 def test_cylinders_bad_options_and_cancel(pipes):
     _, cloud, cylinders, _ = pipes
     p = cloud.points[::20]

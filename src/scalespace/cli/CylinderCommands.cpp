@@ -149,6 +149,9 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
       ->capture_default_str();
+  cmd->add_flag("--one-curvature-sign", args->cylinders.oneCurvatureSign,
+                "a region only grows over points curving the way its seed does, which stops it at "
+                "the groove between a noisy cable's strands; needs consistently oriented normals");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");

@@ -27,21 +27,29 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 /// Eq. 3.10 as the region grower's criterion: a neighbour joins when its anisotropy, line
-/// direction (unsigned) and normal are all within epsilon of the point it is reached from.
+/// direction (unsigned) and normal are all within epsilon of the point it is reached from; with
+/// CylinderOptions::oneCurvatureSign, and when it does not curve against the region's seed.
 struct AlignedLines {
   struct Payload {
-    float normal[3], direction[3], sigma;
+    float normal[3], direction[3], sigma, kappaT;  // kappaT: kappa1 t, signed
   };
   const LineAnisotropyField& field;
-  float epsilon;
+  float epsilon, t;
+  float signSlack;  // |kappa1| t below which a point's sign is not read; < 0: no sign test
   Payload payload(Index i) const {
     const Vec3& n = field.normal[i];
     const Vec3& v = field.direction[i];
     return {{float(n.x()), float(n.y()), float(n.z())},
             {float(v.x()), float(v.y()), float(v.z())},
-            field.sigma[i]};
+            field.sigma[i],
+            field.kappa1[i] * t};
   }
-  bool accept(const Payload&, const Payload& from, const Payload& to) const {
+  bool againstSeed(const Payload& seed, const Payload& to) const {
+    if (signSlack < 0 || std::abs(seed.kappaT) <= signSlack) return false;
+    return seed.kappaT > 0 ? to.kappaT < -signSlack : to.kappaT > signSlack;
+  }
+  bool accept(const Payload& seed, const Payload& from, const Payload& to) const {
+    if (againstSeed(seed, to)) return false;
     const float vv = from.direction[0] * to.direction[0] + from.direction[1] * to.direction[1] +
                      from.direction[2] * to.direction[2];
     const float nn = from.normal[0] * to.normal[0] + from.normal[1] * to.normal[1] +
@@ -211,8 +219,10 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
       return eligible[i] ? -double(field.sigma[i]) : std::numeric_limits<double>::quiet_NaN();
     });
-    Segmentation seg = growRegionsFromSeeds(graph, std::move(seeds), eligible,
-                                            AlignedLines{field, float(options.epsilon)});
+    Segmentation seg = growRegionsFromSeeds(
+        graph, std::move(seeds), eligible,
+        AlignedLines{field, float(options.epsilon), float(t),
+                     options.oneCurvatureSign ? float(options.tube.minCurvatureFactor) : -1.f});
     std::vector<TubeFit> tubes(seg.regions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, seg.regions.size(), 1),
                       [&](const auto& range) {

@@ -143,7 +143,8 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
                                        const std::optional<std::vector<double>>& scales,
                                        int scaleCount, double tmin, double tmax, double epsilon,
                                        double minAnisotropy, double minArc, double maxRms,
-                                       std::optional<int> threads, py::object progress) {
+                                       bool oneCurvatureSign, std::optional<int> threads,
+                                       py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -154,6 +155,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.minAnisotropy = minAnisotropy;
   options.tube.minArcDegrees = minArc;
   options.tube.maxRelativeRms = maxRms;
+  options.oneCurvatureSign = oneCurvatureSign;
   validateCylinderOptions(options);
   PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
@@ -212,7 +214,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
   m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0, "tmax"_a = 0.0,
         "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5, "min_arc"_a = 120.0, "max_rms"_a = 0.25,
-        "threads"_a = py::none(), "progress"_a = py::none(),
+        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
 Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube fitted to each
@@ -221,7 +224,10 @@ scales themselves (increasing), else scale_count log-spaced ones in [tmin, tmax]
 median distance to the 10th neighbour, a tenth of the diagonal). epsilon: the region growing
 tolerance of Eq. 3.10; min_anisotropy: the least sigma of a region's points; min_arc: degrees
 the points' normals must turn around the axis; max_rms: a tube's RMS distance to its surface
-over its radius. Without normals they are estimated (PCA, 10 neighbours) and oriented (MST), as
+over its radius. one_curvature_sign: a region only grows over points curving the way its seed
+does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
+normals; off: Eq. 3.10 alone). Without
+normals they are estimated (PCA, 10 neighbours) and oriented (MST), as
 the CLI does. Returns a Cylinders.)doc");
 }
 
