@@ -64,6 +64,9 @@ class Cloud:
     attributes: name -> (N,) array in the dtype the file stores (uint8 colours, float32, ...).
     format: the file's format as read ("ply (binary_little_endian)", ...).
     dropped: points skipped for NaN/Inf coordinates (read with drop_invalid=True).
+    viewpoint: (x, y, z) where the points were seen from, when the file says so (a PCD's
+    VIEWPOINT), else None: ``estimate_normals(points, viewpoint=cloud.viewpoint)`` orients each
+    part of a scan to face it, as the CLI does.
     """
 
     points: np.ndarray
@@ -71,6 +74,7 @@ class Cloud:
     attributes: Dict[str, np.ndarray] = field(default_factory=dict)
     format: str = ""
     dropped: int = 0
+    viewpoint: Optional[tuple] = None
 
     def __len__(self) -> int:
         return len(self.points)
@@ -81,7 +85,8 @@ def read(path: str, *, drop_invalid: bool = False, sample: int = 0, seed: int = 
     area with interpolated normals), LAS 1.0-1.4, PCD. Points with NaN/Inf coordinates raise
     FileError unless ``drop_invalid``. An empty file reads as an empty cloud."""
     d = _scalespace._read(str(path), drop_invalid=drop_invalid, sample=sample, seed=seed)
-    return Cloud(d["points"], d["normals"], dict(d["attributes"]), d["format"], d["dropped"])
+    return Cloud(d["points"], d["normals"], dict(d["attributes"]), d["format"], d["dropped"],
+                 d["viewpoint"])
 
 
 def write(path: str, points, normals=None, attributes: Optional[Mapping[str, np.ndarray]] = None,

@@ -141,6 +141,33 @@ TEST(NormalOrientation, VisibilityLeavesAnOpenSurfaceAsTheTreeOrientsIt) {
   EXPECT_GE(r.pieceCount, 1u);
 }
 
+TEST(NormalOrientation, FaceViewpointTurnsAScanTowardsItsScanner) {
+  // A terrain seen from below (a scan in a sensor's frame, its z pointing away from the ground):
+  // the +z seeds orient it away from the scanner; facing the viewpoint turns it over.
+  const auto points = noisyTerrain(20000, 36);
+  const auto estimate = estimateNormals(points);
+  const auto facingShare = [&](const Vec3& viewpoint, const NormalOrientationOptions& options) {
+    std::vector<Vec3> normals = estimate.normals;
+    orientNormals(points, normals, options, estimate.valid);
+    std::size_t facing = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      facing += normals[i].dot(viewpoint - points[i]) > 0 ? 1 : 0;
+    return double(facing) / double(points.size());
+  };
+  const Vec3 below(1, 1, -1.5);
+  NormalOrientationOptions face;
+  face.faceViewpoint = true;
+  face.viewpoint = below;
+  EXPECT_LT(facingShare(below, {}), 0.05);
+  EXPECT_GT(facingShare(below, face), 0.99);
+  // A viewpoint within the cloud's box, or farther from it than its diagonal, is no scanner's:
+  // the tree's +z orientation stays.
+  for (const Vec3& frameOrigin : {Vec3(1, 1, 0), Vec3(1, 1, -100)}) {
+    face.viewpoint = frameOrigin;
+    EXPECT_LT(facingShare(below, face), 0.05) << frameOrigin.transpose();
+  }
+}
+
 TEST(NormalOrientation, MstRestoresRandomlyFlippedNormalsOfTwoSpheres) {
   auto points = testclouds::sphere(5000, 1.0, 32);
   const auto second = testclouds::sphere(5000, 1.0, 33, Vec3(5, 0, 0));

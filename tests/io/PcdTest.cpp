@@ -151,6 +151,29 @@ TEST(Pcd, HeaderErrors) {
   expectError(head + "WIDTH 1\nDATA ascii\n1 nan 3\n", "ReadOptions::dropNonFinite");
 }
 
+TEST(Pcd, ViewpointIsReadAndWritten) {
+  const std::string head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\n";
+  const PointCloud cloud =
+      readPcd(head + "VIEWPOINT 0.5 -2 3.25 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n", "v.pcd");
+  ASSERT_TRUE(cloud.viewpoint());
+  EXPECT_EQ(*cloud.viewpoint(), Vec3(0.5, -2, 3.25));
+  EXPECT_FALSE(readPcd(head + "POINTS 1\nDATA ascii\n1 2 3\n", "v.pcd").viewpoint());
+  test::ScratchDir dir;
+  PointCloud moved = cloud;
+  moved.setViewpoint(Vec3(400000.125, 6000000.5, -7));
+  writeCloud(moved, dir.file("v.pcd"));
+  EXPECT_EQ(*readCloud(dir.file("v.pcd")).viewpoint(), *moved.viewpoint());
+  for (const char* bad :
+       {"VIEWPOINT 0 0 0\n", "VIEWPOINT 0 0 nan 1 0 0 0\n", "VIEWPOINT 0 0 0 1 0 0 x\n"}) {
+    try {
+      readPcd(head + bad + "POINTS 1\nDATA ascii\n1 2 3\n", "v.pcd");
+      FAIL() << bad;
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find("VIEWPOINT tx ty tz qw qx qy qz"), std::string::npos);
+    }
+  }
+}
+
 TEST(Pcd, EmptyCloud) {
   test::ScratchDir dir;
   writeCloud(PointCloud(), dir.file("e.pcd"));

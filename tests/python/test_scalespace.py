@@ -134,6 +134,29 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     assert "Options::" not in str(e.value)
 
 
+def test_a_pcd_viewpoint_orients_the_normals_as_the_cli_does(tmp_path):
+    # A terrain scanned from below (z away from the ground): its parts turn to face the PCD's
+    # VIEWPOINT (the +z seeds alone orient it away).
+    rng = np.random.default_rng(7)
+    a, b = rng.uniform(0, 2, 8000), rng.uniform(0, 2, 8000)
+    points = np.stack([a, b, 0.15 * np.sin(3 * a) * np.cos(2 * b)], axis=1).astype(np.float32)
+    header = ("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 8000\n"
+              "HEIGHT 1\nVIEWPOINT 1 1 -1.5 1 0 0 0\nPOINTS 8000\nDATA ascii\n")
+    (tmp_path / "t.pcd").write_text(header + "\n".join(" ".join(repr(float(v)) for v in p)
+                                                        for p in points) + "\n")
+    cloud = ss.read(str(tmp_path / "t.pcd"))
+    assert cloud.viewpoint == (1.0, 1.0, -1.5)
+    cli("normals", tmp_path / "t.pcd", "-o", tmp_path / "n.ply")
+    expected = columns(tmp_path / "n.ply")
+    normals, _ = ss.estimate_normals(cloud.points, viewpoint=cloud.viewpoint)
+    for c, name in enumerate(("nx", "ny", "nz")):
+        np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
+    towards = np.asarray(cloud.viewpoint) - cloud.points
+    assert (np.sum(normals * towards, axis=1) > 0).mean() > 0.99
+    plain, _ = ss.estimate_normals(cloud.points)
+    assert (np.sum(plain * towards, axis=1) > 0).mean() < 0.05
+
+
 def test_planes_and_segments_equal_the_cli(data, tmp_path):
     cli("planes", data / "house.ply", "-o", tmp_path / "planes", "--scales", 10)
     cli("segment", tmp_path / "planes", "--min-persistence", 2, "-o", tmp_path / "p.ply")

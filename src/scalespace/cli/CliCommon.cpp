@@ -60,16 +60,26 @@ PointCloud loadCloud(const InputOptions& input, bool quiet) {
   return cloud;
 }
 
+void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orientation) {
+  if (!cloud.viewpoint() || orientation.method != OrientationMethod::MinimumSpanningTree) return;
+  orientation.faceViewpoint = true;
+  orientation.viewpoint = *cloud.viewpoint() - cloud.origin();  // recentred, as the points
+}
+
 void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation) {
   if (cloud.hasNormals()) return;
   if (!quiet)
     std::fprintf(stderr,
-                 "input has no normals: estimating (%s, %zu neighbours) and orienting (MST)\n",
-                 estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k);
+                 "input has no normals: estimating (%s, %zu neighbours) and orienting (MST%s)\n",
+                 estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k,
+                 cloud.viewpoint() ? ", facing the file's viewpoint" : "");
   auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationResult est =
       estimateNormals(cloud.positions(), *index, estimation, makeProgressBar(quiet));
-  orientNormals(cloud.positions(), est.normals, *index, {}, est.valid, makeProgressBar(quiet));
+  NormalOrientationOptions orientation;
+  faceFileViewpoint(cloud, orientation);
+  orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid,
+                makeProgressBar(quiet));
   cloud.setNormals(std::move(est.normals));
 }
 

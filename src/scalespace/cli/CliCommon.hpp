@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/PointCloud.hpp"
 
 namespace scalespace::cli {
@@ -33,8 +34,14 @@ PointCloud loadResultInput(const std::string& recorded, const std::string& overr
                            const std::string& directory, const std::string& what,
                            std::size_t pointCount, const std::string& output, bool quiet);
 
-/// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST) normals when the
-/// cloud has none; says so on stderr unless quiet. The APSS fits need oriented normals.
+/// MST orientation of a cloud whose file gave a viewpoint (a PCD's VIEWPOINT): each component
+/// faces it (NormalOrientationOptions::faceViewpoint).
+void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orientation);
+
+/// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST, facing the file's
+/// viewpoint if any) normals when the cloud has none; says so on stderr unless quiet. The APSS
+/// fits need oriented normals.
+
 void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation = {});
 
 /// What a command writes, for checkOutput.

@@ -182,8 +182,9 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
   cmd.add_option("--k", a.k, "neighbours for PCA normals and the orientation graph")
       ->capture_default_str();
   cmd.add_option("--orient", a.orient,
-                 "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z) or "
-                 "'viewpoint X Y Z' (towards a scanner position, in file coordinates)")
+                 "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z, or each part "
+                 "facing a PCD's VIEWPOINT) or 'viewpoint X Y Z' (towards a scanner position, in "
+                 "file coordinates)")
       ->expected(1, 4);
   cmd.add_option("--sheet", a.sheet,
                  "the plane of the neighbours within this x the k-th neighbour's distance (or 8 "
@@ -214,6 +215,7 @@ NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointClou
   o.visibility = a.visibility;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {
     o.method = OrientationMethod::MinimumSpanningTree;
+    faceFileViewpoint(cloud, o);
   } else if (a.orient.size() == 4 && a.orient[0] == "viewpoint") {
     o.method = OrientationMethod::Viewpoint;
     Vec3 v;

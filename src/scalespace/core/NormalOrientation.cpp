@@ -222,6 +222,41 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   }
 }
 
+// NormalOrientationOptions::faceViewpoint: each piece of the tree (cut at its guesses: creases,
+// thin parts) whose normals face away from the viewpoint (mean cosine to it below -0.1: a piece
+// seen edge-on says nothing) is turned over. A component is left as the tree oriented it when
+// the viewpoint lies within its bounding box (a frame's origin inside an object or a scene is no
+// scanner looking at it from one side) or farther from the box than its diagonal (a default
+// VIEWPOINT at the origin of georeferenced points).
+void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
+                      const std::vector<std::uint8_t>& inGraph, DisjointSets& sets,
+                      const std::vector<Index>& piece, Index pieces, std::vector<Vec3>& oriented,
+                      std::vector<std::uint8_t>& flipped) {
+  const std::size_t n = points.size();
+  std::vector<double> facing(pieces, 0.0);
+  std::vector<std::size_t> count(pieces, 0);
+  std::vector<Vec3> lo(n, Vec3::Constant(std::numeric_limits<double>::infinity()));
+  std::vector<Vec3> hi(n, Vec3::Constant(-std::numeric_limits<double>::infinity()));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!inGraph[i]) continue;
+    const Index root = sets.find(Index(i));
+    const Vec3 towards = viewpoint - points[i];
+    const double norm = towards.norm() * oriented[i].norm();
+    if (norm > 0) facing[piece[i]] += oriented[i].dot(towards) / norm;
+    ++count[piece[i]];
+    lo[root] = lo[root].cwiseMin(points[i]);
+    hi[root] = hi[root].cwiseMax(points[i]);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!inGraph[i] || !(facing[piece[i]] < -0.1 * double(count[piece[i]]))) continue;
+    const Index root = sets.find(Index(i));
+    const Vec3 outside = (lo[root] - viewpoint).cwiseMax(viewpoint - hi[root]).cwiseMax(0.0);
+    if (outside.isZero() || outside.norm() > (hi[root] - lo[root]).norm()) continue;
+    oriented[i] = -oriented[i];
+    flipped[i] ^= 1;
+  }
+}
+
 void checkCancel(const ProgressCallback& progress, double fraction, const char* stage) {
   if (progress && !progress(fraction, stage)) throw Cancelled();
 }
@@ -407,6 +442,9 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
     }
   }
   checkCancel(progress, 1.0, "orientation tree");
+
+  if (options.faceViewpoint)
+    turnPiecesToFace(points, options.viewpoint, inGraph, sets, piece, pieces, oriented, flipped);
 
   if (options.visibility)
     correctByVisibility(points, oriented, index, inGraph, kthDistance, piece, pieces, options,

@@ -42,7 +42,8 @@ enum class OrientationMethod { MinimumSpanningTree, Viewpoint };
 struct NormalOrientationOptions {
   OrientationMethod method = OrientationMethod::MinimumSpanningTree;
   std::size_t k = 10;             // neighbours of the Riemannian graph (MST)
-  Vec3 viewpoint = Vec3::Zero();  // scanner position, same frame as the points (Viewpoint)
+  Vec3 viewpoint = Vec3::Zero();  // scanner position, same frame as the points (Viewpoint,
+                                  // faceViewpoint)
   double creaseThreshold = 0.3;   // MST: |cos| below which the propagated sign is unreliable
   /// MST (not in Hoppe 1992): an edge whose offset runs along both normals, between the two sides
   /// of a thin part (parallel sheets facing each other, where Hoppe's cost is 0 and the
@@ -62,6 +63,15 @@ struct NormalOrientationOptions {
   /// at 0.5 the rays leak through rotor's surface (bench_features) and its rims stay wrong.
   double visibilityCell = 0.7;
   double grazingThreshold = 0.05;  // Viewpoint: |cos| below which the sign is unreliable
+  /// MST (not in Hoppe 1992): after the propagation, each piece of the tree (cut where its sign
+  /// is a guess, as for the visibility correction) whose normals face away from `viewpoint` (a
+  /// scanner's position; mean cosine below -0.1) is turned over: a single scan's surfaces face
+  /// the scanner, whatever its frame's z (the table scan of python3-pcl, in the sensor's frame:
+  /// with +z seeds 85% of its normals faced away from the sensor, the floor's and the table
+  /// top's pointing down; 2.7% with this). Not where the viewpoint lies within a component's
+  /// bounding box or farther from it than its diagonal (a frame's origin, not a scanner). The
+  /// visibility correction runs after it.
+  bool faceViewpoint = false;
 };
 
 struct NormalOrientationResult {

@@ -159,7 +159,10 @@ PointCloud::Storage PointCloud::releaseStorage() {
 }
 
 PointCloud::PointCloud(const PointCloud& other)
-    : positions_(other.positions_), normals_(other.normals_), origin_(other.origin_) {
+    : positions_(other.positions_),
+      normals_(other.normals_),
+      origin_(other.origin_),
+      viewpoint_(other.viewpoint_) {
   attributes_.reserve(other.attributes_.size());
   for (const auto& a : other.attributes_)
     attributes_.push_back(std::make_unique<AttributeColumn>(*a));

@@ -119,6 +119,12 @@ class PointCloud {
   /// Sets positions already relative to `origin` (e.g. a subset of another cloud).
   void setRelativePositions(std::vector<Vec3> relative, const Vec3& origin);
 
+  /// Where the points were seen from (a scanner's position, absolute coordinates), when the
+  /// file says so (a PCD's VIEWPOINT): a single scan's surfaces face it, so estimated normals are
+  /// oriented to (NormalOrientationOptions::faceViewpoint).
+  const std::optional<Vec3>& viewpoint() const { return viewpoint_; }
+  void setViewpoint(std::optional<Vec3> viewpoint) { viewpoint_ = viewpoint; }
+
   bool hasNormals() const { return !normals_.empty(); }
   const std::vector<Vec3>& normals() const { return normals_; }
   std::vector<Vec3>& normals() { return normals_; }
@@ -151,6 +157,7 @@ class PointCloud {
   std::vector<Vec3> normals_;
   AttributeColumns::Storage attributes_;
   Vec3 origin_ = Vec3::Zero();
+  std::optional<Vec3> viewpoint_;
 };
 
 }  // namespace scalespace

@@ -34,6 +34,7 @@ struct PcdHeader {
   PcdData data = PcdData::Ascii;
   std::size_t dataOffset = 0;
   std::size_t dataLine = 0;
+  std::optional<Vec3> viewpoint;  // VIEWPOINT's translation
 };
 
 std::optional<ScalarType> pcdScalarType(char type, std::size_t size) {
@@ -91,9 +92,18 @@ PcdHeader parseHeader(std::string_view data, const std::string& file) {
       height = single();
     else if (key == "POINTS")
       points = single();
-    else if (key == "VIEWPOINT")
-      continue;
-    else if (key == "DATA") {
+    else if (key == "VIEWPOINT") {
+      // tx ty tz qw qx qy qz: the acquisition viewpoint in the points' frame; its position is
+      // what orients a scan's normals (PointCloud::viewpoint).
+      Vec3 position;
+      for (std::size_t k = 0; k < 7; ++k) {
+        const auto value = k < rest.size() ? parseNumber(rest[k]) : std::nullopt;
+        if (rest.size() != 7 || !value || !std::isfinite(*value))
+          throw FileError(file, where, "expected 'VIEWPOINT tx ty tz qw qx qy qz' (7 numbers)");
+        if (k < 3) position[Eigen::Index(k)] = *value;
+      }
+      header.viewpoint = position;
+    } else if (key == "DATA") {
       if (rest.size() != 1)
         throw FileError(file, where, "expected 'DATA ascii|binary|binary_compressed'");
       if (rest[0] == "ascii")
@@ -279,7 +289,9 @@ PointCloud readPcd(std::string_view data, const std::string& file, const ReadOpt
       }
       builder.addPoint(position, normal, values.data(), [&] { return lineWhere(lineNumber); });
     }
-    return builder.finish(report, "pcd (ascii)");
+    PointCloud cloud = builder.finish(report, "pcd (ascii)");
+    cloud.setViewpoint(header.viewpoint);
+    return cloud;
   }
 
   // Binary: records of pointSize bytes (point-major); binary_compressed: the LZF-compressed
@@ -330,7 +342,10 @@ PointCloud readPcd(std::string_view data, const std::string& file, const ReadOpt
     const std::size_t where = header.dataOffset + (fieldMajor ? 8 : i * header.pointSize);
     builder.addPoint(position, normal, values.data(), [&] { return byteWhere(where); });
   }
-  return builder.finish(report, fieldMajor ? "pcd (binary_compressed)" : "pcd (binary)");
+  PointCloud cloud =
+      builder.finish(report, fieldMajor ? "pcd (binary_compressed)" : "pcd (binary)");
+  cloud.setViewpoint(header.viewpoint);
+  return cloud;
 }
 
 }  // namespace scalespace

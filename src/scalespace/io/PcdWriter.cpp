@@ -1,3 +1,4 @@
+#include <cstdio>
 #include <vector>
 
 #include "scalespace/io/ByteReader.hpp"
@@ -54,7 +55,12 @@ void writePcd(const PointCloud& cloud, std::ostream& out, bool ascii) {
   for (ScalarType t : types) out << ' ' << pcdType(t);
   out << "\nCOUNT";
   for (std::size_t k = 0; k < types.size(); ++k) out << " 1";
-  out << "\nWIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
+  // The cloud's own viewpoint when it came with one, else PCL's default (the origin).
+  const Vec3 viewpoint = cloud.viewpoint().value_or(Vec3::Zero());
+  char position[96];
+  std::snprintf(position, sizeof position, "%.17g %.17g %.17g", viewpoint.x(), viewpoint.y(),
+                viewpoint.z());
+  out << "\nWIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT " << position << " 1 0 0 0\nPOINTS "
       << cloud.size() << "\nDATA " << (ascii ? "ascii" : "binary") << '\n';
 
   std::size_t rowSize = 0;

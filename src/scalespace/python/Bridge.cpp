@@ -396,8 +396,11 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   o.acrossWeight = acrossWeight;
   o.visibility = visibility;
   if (orient == "mst") {
-    if (viewpoint) throw OptionError("viewpoint goes with orient='viewpoint'");
     o.method = OrientationMethod::MinimumSpanningTree;
+    if (viewpoint) {  // each component faces it, as the CLI does with a PCD's VIEWPOINT
+      o.faceViewpoint = true;
+      o.viewpoint = *viewpoint - cloud.origin();
+    }
   } else if (orient == "viewpoint") {
     if (!viewpoint) throw OptionError("orient='viewpoint' needs viewpoint=(x, y, z)");
     o.method = OrientationMethod::Viewpoint;

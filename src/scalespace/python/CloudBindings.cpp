@@ -52,6 +52,12 @@ py::dict readCloudPy(const std::string& path, bool dropInvalid, std::size_t samp
   out["attributes"] = attributes;
   out["format"] = report.format;
   out["dropped"] = report.droppedNonFinite;
+  if (cloud.viewpoint()) {
+    const Vec3& v = *cloud.viewpoint();
+    out["viewpoint"] = py::make_tuple(v.x(), v.y(), v.z());
+  } else {
+    out["viewpoint"] = py::none();
+  }
   return out;
 }
 
@@ -277,8 +283,9 @@ void bindClouds(py::module_& m) {
         "progress"_a = py::none(),
         R"doc(Estimates (PCA over k neighbours) and orients normals, as `scalespace normals`.
 
-orient: "mst" (Hoppe 1992 propagation, seeds towards +z) or "viewpoint" (towards
-viewpoint=(x, y, z), a scanner position in the points' coordinates). across_weight (mst): the
+orient: "mst" (Hoppe 1992 propagation, seeds towards +z; with viewpoint=(x, y, z), each
+connected part instead faces it, as `scalespace` does with a PCD's VIEWPOINT: Cloud.viewpoint) or
+"viewpoint" (each normal towards viewpoint, a scanner position in the points' coordinates). across_weight (mst): the
 extra cost of an edge across a thin part, so that its two sides are oriented apart (0: Hoppe's
 cost alone). visibility (mst): turn over the pieces of the tree that rays cast from the points
 show facing the inside of a closed surface (the two sides of thin parts, creases). sheet: the
