@@ -267,6 +267,32 @@ TEST(Cylinders, OneCurvatureSignStopsARegionAtAConcaveGroove) {
     EXPECT_GT(iou, 0.95);
 }
 
+TEST(Cylinders, TheRepresentativeTubeFitsBestAmongTheLargeSets) {
+  // A noisy tube over four scales: the reported tube is, of the levels holding at least 80% of
+  // the component's largest set, the one with the lowest RMS over radius.
+  Tube tube;
+  tube.noise = 0.02;
+  const PointCloud cloud = sampleTube(tube, 12000);
+  const CylinderDetection d = detectCylinders(cloud, atScales({0.25, 0.4, 0.6, 0.9}));
+  ASSERT_FALSE(d.components.empty());
+  for (const CylinderComponent& c : d.components) {
+    const GraphComponent& g = d.graph.components[std::size_t(c.id)];
+    std::size_t largest = 0;
+    for (std::size_t k = 0; k < g.regionAt.size(); ++k)
+      largest = std::max(
+          largest,
+          d.graph.levels[std::size_t(g.birthLevel) + k].regions[std::size_t(g.regionAt[k])].size());
+    for (std::size_t k = 0; k < g.regionAt.size(); ++k) {
+      const std::size_t level = std::size_t(g.birthLevel) + k;
+      if (10 * d.graph.levels[level].regions[std::size_t(g.regionAt[k])].size() < 8 * largest)
+        continue;
+      const TubeFit& other = d.levels[level].tubes[std::size_t(g.regionAt[k])];
+      EXPECT_LE(c.tube.rms / c.tube.radius, other.rms / other.radius) << "level " << level;
+    }
+    EXPECT_NEAR(c.tube.radius, 1.0, 0.02);
+  }
+}
+
 TEST(Cylinders, SameResultForAnyThreadCount) {
   Tube tube;
   tube.noise = 0.01;

@@ -87,7 +87,8 @@ struct CylinderComponent {
   int birthLevel = 0, deathLevel = 0;
   double birthScale = 0, deathScale = 0;
   int persistence = 0;
-  /// The level where the component holds the most points (lowest on ties): its tube is reported.
+  /// Of the levels where the component holds at least 80% of its largest set, the one whose tube
+  /// fits best (lowest rms / radius; the lowest on ties): its tube is reported.
   int representativeLevel = 0;
   TubeFit tube;
 };
