@@ -256,8 +256,9 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
   if (!quiet)
     std::fprintf(stderr,
                  "normals: %zu estimated (k = %zu), %zu degenerate, %zu flipped, %zu without a "
-                 "reliable orientation (normal_reliable = 0)\n",
-                 cloud.size(), a.k, est.invalidCount, ori.flippedCount, ori.unreliableCount);
+                 "reliable orientation (normal_reliable = 0)%s\n",
+                 cloud.size(), a.k, est.invalidCount, ori.flippedCount, ori.unreliableCount,
+                 orientation.faceViewpoint ? "; the tree's parts face the file's VIEWPOINT" : "");
 }
 
 void addNormalsCommand(CLI::App& app) {
