@@ -23,6 +23,7 @@ class Cloud:
     attributes: Dict[str, np.ndarray] = ...
     format: str = ...
     dropped: int = ...
+    viewpoint: Optional[Tuple[float, float, float]] = ...
     def __len__(self) -> int: ...
 
 def read(path: str, *, drop_invalid: bool = ..., sample: int = ..., seed: int = ...) -> Cloud: ...
@@ -86,7 +87,8 @@ class Planes:
                         coverage_angle: float = ...) -> np.ndarray: ...
     def save(self, directory: str) -> None: ...
 
-def planes(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
+def planes(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
+           viewpoint: Optional[Sequence[float]] = ..., scales: int = ...,
            alpha: float = ..., angle: float = ..., max_step: float = ..., max_rms: float = ...,
            merge_rms: float = ..., merge_deviation: float = ...,
            merge_parallel: float = ...,
@@ -105,7 +107,8 @@ def lines(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scale: Optio
           gamma: float = ..., alpha: float = ..., robust: bool = ..., max_steps: int = ...,
           curved_seeds_first: bool = ..., threads: Optional[int] = ..., progress: Progress = ...) -> Dict[str, np.ndarray]: ...
 def read_mesh(path: str) -> Tuple[np.ndarray, np.ndarray]: ...
-def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,
+def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
+             viewpoint: Optional[Sequence[float]] = ..., scales: int = ...,
              spacing: float = ..., vote_threshold: float = ..., min_scales: int = ...,
              min_curvature: float = ..., noise_curvature: float = ...,
              salient_threshold: float = ..., min_extent: float = ..., join_gap: float = ...,
@@ -113,7 +116,7 @@ def features(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: i
              all_salient: bool = ..., salient_per_scale: bool = ..., beta: float = ..., gamma: float = ...,
              curved_seeds_first: bool = ...,
              with_lines: bool = ..., triangles: Optional[ArrayLike] = ...,
-             mesh_samples: int = ..., threads: Optional[int] = ...,
+             mesh_samples: int = ..., sheet_normals: float = ..., threads: Optional[int] = ...,
              progress: Progress = ...) -> Dict[str, object]: ...
 
 class Cylinders:
@@ -147,9 +150,11 @@ def release_buffers() -> int:
     ...
 
 def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
+              viewpoint: Optional[Sequence[float]] = ...,
               scales: Optional[Sequence[float]] = ..., scale_count: int = ..., tmin: float = ...,
               tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,
-              min_arc: float = ..., max_rms: float = ..., threads: Optional[int] = ...,
+              min_arc: float = ..., max_rms: float = ..., one_curvature_sign: bool = ...,
+              threads: Optional[int] = ...,
               progress: Progress = ...) -> Cylinders: ...
 
 def parametrize(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,

@@ -135,11 +135,12 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
 
 
 def test_a_pcd_viewpoint_orients_the_normals_as_the_cli_does(tmp_path):
-    # A terrain scanned from below (z away from the ground): its parts turn to face the PCD's
-    # VIEWPOINT (the +z seeds alone orient it away).
+    # A ridge scanned from below (z away from the ground): its parts turn to face the PCD's
+    # VIEWPOINT (the +z seeds alone orient it away), and the ridge, seen from the scanner, is a
+    # concave crease.
     rng = np.random.default_rng(7)
     a, b = rng.uniform(0, 2, 8000), rng.uniform(0, 2, 8000)
-    points = np.stack([a, b, 0.15 * np.sin(3 * a) * np.cos(2 * b)], axis=1).astype(np.float32)
+    points = np.stack([a, b, 0.6 * (1 - np.abs(a - 1))], axis=1).astype(np.float32)
     header = ("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 8000\n"
               "HEIGHT 1\nVIEWPOINT 1 1 -1.5 1 0 0 0\nPOINTS 8000\nDATA ascii\n")
     (tmp_path / "t.pcd").write_text(header + "\n".join(" ".join(repr(float(v)) for v in p)
@@ -155,6 +156,16 @@ def test_a_pcd_viewpoint_orients_the_normals_as_the_cli_does(tmp_path):
     assert (np.sum(normals * towards, axis=1) > 0).mean() > 0.99
     plain, _ = ss.estimate_normals(cloud.points)
     assert (np.sum(plain * towards, axis=1) > 0).mean() < 0.05
+    # features, planes and cylinders estimate the normals as the CLI does with viewpoint=.
+    cli("features", tmp_path / "t.pcd", "-o", tmp_path / "f.ply")
+    features = ss.features(cloud.points, viewpoint=cloud.viewpoint)
+    np.testing.assert_array_equal(features["convexity"],
+                                  ss.read(str(tmp_path / "f.ply")).attributes["convexity"])
+    sheets, _ = ss.estimate_normals(cloud.points, viewpoint=cloud.viewpoint, sheet=0.05)
+    np.testing.assert_array_equal(features["convexity"],
+                                  ss.features(cloud.points, sheets)["convexity"])
+    assert (features["convexity"] < 0).sum() > 100 and (features["convexity"] > 0).sum() == 0
+    assert (ss.features(cloud.points)["convexity"] > 0).sum() > 100
 
 
 def test_planes_and_segments_equal_the_cli(data, tmp_path):

@@ -140,6 +140,7 @@ class Cylinders {
 };
 
 std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handle& normals,
+                                       const py::handle& viewpoint,
                                        const std::optional<std::vector<double>>& scales,
                                        int scaleCount, double tmin, double tmax, double epsilon,
                                        double minAnisotropy, double minArc, double maxRms,
@@ -157,10 +158,11 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
   validateCylinderOptions(options);
+  const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   CylinderDetection detection = call([&] {
-    if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+    if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", view, call.progress());
     return detectCylinders(cloud, options, call.progress());
   });
   return std::make_unique<Cylinders>(std::move(detection), cloud.origin());
@@ -212,10 +214,10 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
                " points>";
       });
   m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
-        "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0, "tmax"_a = 0.0,
-        "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5, "min_arc"_a = 120.0, "max_rms"_a = 0.25,
-        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign, "threads"_a = py::none(),
-        "progress"_a = py::none(),
+        "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
+        "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5, "min_arc"_a = 120.0,
+        "max_rms"_a = 0.25, "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
+        "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
 Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube fitted to each

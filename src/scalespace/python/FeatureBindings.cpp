@@ -127,8 +127,9 @@ TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
   return mesh;
 }
 
-py::dict featuresPy(const py::handle& points, const py::handle& normals, int scales, double spacing,
-                    double voteThreshold, int minScales, double minCurvature, double noiseCurvature,
+py::dict featuresPy(const py::handle& points, const py::handle& normals,
+                    const py::handle& viewpoint, int scales, double spacing, double voteThreshold,
+                    int minScales, double minCurvature, double noiseCurvature,
                     double salientThreshold, double minExtent, double joinGap,
                     double centrelineReach, double bandHalfWidth, bool allSalient,
                     bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
@@ -156,6 +157,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
     throw OptionError("mesh_samples must be in [1, 10000]");
   if (!(sheetNormals >= 0) || !std::isfinite(sheetNormals))
     throw OptionError("sheet_normals must be finite and >= 0 (0: PCA normals)");
+  const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud;
   std::optional<TriangleMesh> mesh;
   std::vector<std::string> warnings;
@@ -172,7 +174,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals, int sca
   FeatureCurveResult result = call([&] {
     if (!mesh) {
       if (!cloud.hasNormals())
-        estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress(),
+        estimateAndOrient(cloud, 10, "mst", view, call.progress(),
                           NormalOrientationOptions{}.acrossWeight,
                           NormalOrientationOptions{}.visibility, sheetNormals);
       return detectFeatureCurves(cloud, options, call.progress());
@@ -241,17 +243,18 @@ alpha: pyramid radius / t. curved_seeds_first=False traces the seeds in the samp
 order (Sec. 3.3) instead of the most curved first. Returns a dict: vertices (V, 3) absolute,
 normal, tangent (V, 3), line_id, scale, k1, k2, k_gap, nu (V,), offsets (L + 1,: line l is
 vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it started from).)doc");
-  m.def(
-      "features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(), "scales"_a = 5,
-      "spacing"_a = 0.0, "vote_threshold"_a = 0.05, "min_scales"_a = 3, "min_curvature"_a = 0.6,
-      "noise_curvature"_a = 8.0, "salient_threshold"_a = 0.5, "min_extent"_a = 1.0,
-      "join_gap"_a = 1.5, "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
-      "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth, "all_salient"_a = false,
-      "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
-      "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
-      "triangles"_a = py::none(), "mesh_samples"_a = 100, "sheet_normals"_a = kFeatureSheetNormals,
-      "threads"_a = py::none(), "progress"_a = py::none(),
-      R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
+  m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
+        "viewpoint"_a = py::none(), "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05,
+        "min_scales"_a = 3, "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0,
+        "salient_threshold"_a = 0.5, "min_extent"_a = 1.0, "join_gap"_a = 1.5,
+        "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
+        "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth, "all_salient"_a = false,
+        "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
+        "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
+        "triangles"_a = py::none(), "mesh_samples"_a = 100,
+        "sheet_normals"_a = kFeatureSheetNormals, "threads"_a = py::none(),
+        "progress"_a = py::none(),
+        R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
 
 Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
 (e), max_vote, noise_rms (sigma read from the points), salient_curvature_floor (max(min_curvature,
@@ -266,7 +269,9 @@ triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_sa
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
 is estimated as the plane through the point and two neighbours that the most neighbours lie within
 sheet_normals times the 10th neighbour's distance (or 8 noise RMS) of, where the PCA plane does not
-hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...).)doc");
+hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...), and
+oriented (MST; each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the
+CLI does).)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {

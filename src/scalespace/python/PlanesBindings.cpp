@@ -166,11 +166,12 @@ class Planes {
   std::string input_;
 };
 
-std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& normals, int scales,
-                                 double alpha, double angle, double maxStep, double maxRms,
-                                 double mergeRms, double mergeDeviation, double mergeParallel,
-                                 double refineDistance, bool refineUnlabelled, double fillMaxAngle,
-                                 bool robust, const std::optional<std::string>& stack,
+std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& normals,
+                                 const py::handle& viewpoint, int scales, double alpha,
+                                 double angle, double maxStep, double maxRms, double mergeRms,
+                                 double mergeDeviation, double mergeParallel, double refineDistance,
+                                 bool refineUnlabelled, double fillMaxAngle, bool robust,
+                                 const std::optional<std::string>& stack,
                                  const std::optional<std::string>& output, const std::string& input,
                                  std::optional<int> threads, py::object progress) {
   // `scalespace planes`' options and checks, before any work.
@@ -192,6 +193,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
   validateScaleSpaceOptions(stackOptions);
   validatePlaneDetectionOptions(options);
   if (output) checkPlaneResultDestination(*output);
+  const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   std::vector<std::string> warnings;
@@ -201,7 +203,7 @@ std::unique_ptr<Planes> planesPy(const py::handle& points, const py::handle& nor
       const ScaleStackReader reader(*stack);
       detection = detectPlanesFromStack(cloud, reader, options, call.progress());
     } else {
-      if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", std::nullopt, call.progress());
+      if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", view, call.progress());
       StackPlaneDetection result =
           detectPlanesInCloud(cloud, stackOptions, options, call.progress());
       warnings =
@@ -281,8 +283,9 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
                " components, " + std::to_string(p.model().scales.size()) + " scales, " +
                std::to_string(p.pointCount()) + " points>";
       });
-  m.def("planes", &planesPy, "points"_a, "normals"_a = py::none(), py::kw_only(), "scales"_a = 50,
-        "alpha"_a = 0.1, "angle"_a = 5.0, "max_step"_a = PlaneDetectionOptions{}.growing.maxStep,
+  m.def("planes", &planesPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
+        "viewpoint"_a = py::none(), "scales"_a = 50, "alpha"_a = 0.1, "angle"_a = 5.0,
+        "max_step"_a = PlaneDetectionOptions{}.growing.maxStep,
         "max_rms"_a = PlaneDetectionOptions{}.planarity.maxRelativeRms,
         "merge_rms"_a = PlaneDetectionOptions{}.merging.maxRelativeRms,
         "merge_deviation"_a = PlaneDetectionOptions{}.merging.maxRelativeDeviation,
@@ -294,7 +297,8 @@ From planes(points) or read_planes(folder). Labels are (N,) int32 component ids,
         "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Multi-scale planes by persistence (Chapter 2), as `scalespace planes`.
 
-scales: M log-spaced scales; alpha: the stack's Poisson-disk factor; angle: region growing theta
+Without normals they are estimated and oriented (MST; each part facing viewpoint=(x, y, z) when
+given, e.g. Cloud.viewpoint of a PCD, as the CLI does). scales: M log-spaced scales; alpha: the stack's Poisson-disk factor; angle: region growing theta
 (degrees); max_step: the largest step (fraction of t) a region crosses along its seed's normal
 (0.05; 0: the angle alone, Sec. 2.3.1); max_rms: regions whose plane RMS exceeds this fraction of
 t and twice the noise are not planar, never linked to planar ones and their components flagged
