@@ -292,3 +292,29 @@ TEST_F(Cli, PlanesEstimateNormalsWhenMissingAndFindTheBoxFaces) {
   }
   EXPECT_GE(axisAligned, 6);
 }
+
+TEST_F(Cli, APcdViewpointIsShownAndTheEstimatedNormalsFaceIt) {
+  // A ground seen from below (a scan in its sensor's frame): `info` shows the PCD's VIEWPOINT,
+  // `normals` turns the tree's parts to face it (the +z seeds alone would point them up), and a
+  // PCD output keeps it.
+  std::vector<Vec3> ground;
+  for (int a = 0; a < 60; ++a)
+    for (int b = 0; b < 60; ++b)
+      ground.emplace_back(0.02 * a, 0.02 * b, 0.05 * std::sin(0.1 * a) * std::cos(0.15 * b));
+  PointCloud cloud;
+  cloud.setAbsolutePositions(ground);
+  cloud.setViewpoint(Vec3(0.6, 0.6, -1));
+  writeCloud(cloud, path("g.pcd"));
+  Result r = run("info " + path("g.pcd"));
+  EXPECT_NE(r.out.find("viewpoint   0.6 0.6 -1 (estimated normals face it)"), std::string::npos)
+      << r.out;
+  r = run("normals " + path("g.pcd") + " -o " + path("n.pcd"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("the tree's parts face the file's VIEWPOINT"), std::string::npos) << r.err;
+  const PointCloud out = readCloud(path("n.pcd"));
+  ASSERT_TRUE(out.viewpoint());
+  EXPECT_EQ(*out.viewpoint(), *cloud.viewpoint());
+  std::size_t down = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) down += out.normals()[i].z() < 0 ? 1 : 0;
+  EXPECT_EQ(down, out.size());
+}

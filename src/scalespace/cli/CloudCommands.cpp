@@ -72,6 +72,9 @@ void addInfoCommand(CLI::App& app) {
     } else {
       std::printf("normals     no\n");
     }
+    if (cloud.viewpoint())
+      std::printf("viewpoint   %.10g %.10g %.10g (estimated normals face it)\n",
+                  cloud.viewpoint()->x(), cloud.viewpoint()->y(), cloud.viewpoint()->z());
     std::printf("attributes  %zu\n", cloud.attributes().size());
     for (const AttributeColumn& a : cloud.attributes()) {
       double mn = 0, mx = 0;

@@ -223,6 +223,7 @@ PointCloud PointCloud::subset(const std::vector<Index>& indices) const {
   std::vector<Vec3> pos(indices.size());
   for (std::size_t k = 0; k < indices.size(); ++k) pos[k] = positions_.at(indices[k]);
   out.setRelativePositions(std::move(pos), origin_);
+  out.viewpoint_ = viewpoint_;
   if (hasNormals()) {
     std::vector<Vec3> nrm(indices.size());
     for (std::size_t k = 0; k < indices.size(); ++k) nrm[k] = normals_[indices[k]];
