@@ -34,8 +34,8 @@ PointCloud loadResultInput(const std::string& recorded, const std::string& overr
                            const std::string& directory, const std::string& what,
                            std::size_t pointCount, const std::string& output, bool quiet);
 
-/// MST orientation of a cloud whose file gave a viewpoint (a PCD's VIEWPOINT): each component
-/// faces it (NormalOrientationOptions::faceViewpoint).
+/// MST orientation of a cloud whose file gave a viewpoint (a PCD's VIEWPOINT): each piece of the
+/// tree faces it (NormalOrientationOptions::faceViewpoint).
 void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orientation);
 
 /// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST, facing the file's

@@ -68,7 +68,7 @@ struct NormalOrientationOptions {
   /// scanner's position; mean cosine below -0.1) is turned over: a single scan's surfaces face
   /// the scanner, whatever its frame's z (the table scan of python3-pcl, in the sensor's frame:
   /// with +z seeds 85% of its normals faced away from the sensor, the floor's and the table
-  /// top's pointing down; 2.7% with this). Not where the viewpoint lies within a component's
+  /// top's pointing down; 6.0% with this). Not where the viewpoint lies within a component's
   /// bounding box or farther from it than its diagonal (a frame's origin, not a scanner). The
   /// visibility correction runs after it.
   bool faceViewpoint = false;

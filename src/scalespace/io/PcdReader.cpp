@@ -95,14 +95,13 @@ PcdHeader parseHeader(std::string_view data, const std::string& file) {
     else if (key == "VIEWPOINT") {
       // tx ty tz qw qx qy qz: the acquisition viewpoint in the points' frame; its position is
       // what orients a scan's normals (PointCloud::viewpoint).
-      Vec3 position;
-      for (std::size_t k = 0; k < 7; ++k) {
-        const auto value = k < rest.size() ? parseNumber(rest[k]) : std::nullopt;
-        if (rest.size() != 7 || !value || !std::isfinite(*value))
-          throw FileError(file, where, "expected 'VIEWPOINT tx ty tz qw qx qy qz' (7 numbers)");
-        if (k < 3) position[Eigen::Index(k)] = *value;
-      }
-      header.viewpoint = position;
+      std::vector<double> values;
+      for (const std::string_view token : rest)
+        if (const auto value = parseNumber(token); value && std::isfinite(*value))
+          values.push_back(*value);
+      if (rest.size() != 7 || values.size() != 7)
+        throw FileError(file, where, "expected 'VIEWPOINT tx ty tz qw qx qy qz' (7 numbers)");
+      header.viewpoint = Vec3(values[0], values[1], values[2]);
     } else if (key == "DATA") {
       if (rest.size() != 1)
         throw FileError(file, where, "expected 'DATA ascii|binary|binary_compressed'");
