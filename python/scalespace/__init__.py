@@ -91,7 +91,7 @@ def read(path: str, *, drop_invalid: bool = False, sample: int = 0, seed: int = 
 
 def write(path: str, points, normals=None, attributes: Optional[Mapping[str, np.ndarray]] = None,
           *, ascii: bool = False) -> None:
-    """Writes a cloud (by extension: .ply .xyz .txt .csv .pts .las .pcd), atomically.
+    """Writes a cloud (by extension: .ply .xyz .txt .csv .pts .pwn .las .pcd), atomically.
 
     ``points`` may be a :class:`Cloud` (then normals and attributes come from it). Attribute
     dtypes are kept (int8..uint32, float32, float64; bool as uint8). ascii: PLY/PCD as text."""

@@ -13,6 +13,7 @@ TEST(CloudIO, FormatFromExtensionIsCaseInsensitive) {
   EXPECT_EQ(formatFromPath("x.txt"), CloudFormat::Xyz);
   EXPECT_EQ(formatFromPath("x.CSV"), CloudFormat::Xyz);
   EXPECT_EQ(formatFromPath("x.pts"), CloudFormat::Xyz);
+  EXPECT_EQ(formatFromPath("x.PWN"), CloudFormat::Xyz);
   EXPECT_EQ(formatFromPath("x.off"), CloudFormat::Off);
   EXPECT_EQ(formatFromPath("x.OBJ"), CloudFormat::Obj);
   EXPECT_EQ(formatFromPath("x.las"), CloudFormat::Las);
@@ -70,6 +71,46 @@ TEST(CloudIO, FailedWriteKeepsThePreviousFile) {
   EXPECT_THROW(writeCloud(bad, path), Error);
   EXPECT_EQ(readCloud(path).size(), 1u);
   EXPECT_EQ(dir.entryCount(), 1u);
+}
+
+// CGAL's points with normals (libcgal-demo's oni.pwn, sphere926.pwn): six headerless columns,
+// read as positions and normals; written the same way, without the attributes, and only for a
+// cloud that has normals.
+TEST(CloudIO, PwnIsPointsWithNormals) {
+  test::ScratchDir dir;
+  const std::string path = dir.file("oni.pwn");
+  test::writeText(path,
+                  "-0.120621 -0.048544 -0.228788 -0.518633 -0.562817 -0.643628\n"
+                  "2.81733 0 -9.59493 0.281727 4.34882e-019 -0.959495\n");
+  const PointCloud read = readCloud(path);
+  ASSERT_EQ(read.size(), 2u);
+  ASSERT_TRUE(read.hasNormals());
+  EXPECT_TRUE(read.attributes().empty());
+  EXPECT_EQ(read.absolutePosition(1), Vec3(2.81733, 0, -9.59493));
+  EXPECT_EQ(read.normals()[0], Vec3(-0.518633, -0.562817, -0.643628));
+
+  PointCloud withAttribute = read;
+  withAttribute.addAttribute("curve_id", ScalarType::Int32);
+  const std::string out = dir.file("out.pwn");
+  writeCloud(withAttribute, out);
+  const std::string text = test::readText(out);
+  EXPECT_EQ(text.rfind("-0.120621 -0.048544 -0.228788 -0.518633 -0.562817 -0.643628\n", 0), 0u)
+      << text;  // no header line
+  const PointCloud back = readCloud(out);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back.absolutePosition(1), read.absolutePosition(1));
+  EXPECT_EQ(back.normals(), read.normals());
+  EXPECT_TRUE(back.attributes().empty());
+
+  PointCloud bare;
+  bare.setAbsolutePositions({Vec3(1, 2, 3)});
+  try {
+    writeCloud(bare, dir.file("bare.pwn"));
+    FAIL();
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("normals"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(dir.entryCount(), 2u);  // oni.pwn and out.pwn: nothing left of bare.pwn
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ constexpr std::size_t kMaxMeshSamples = 100'000'000;
 void addInputOptions(CLI::App& command, InputOptions& input) {
   command
       .add_option("input", input.path,
-                  "input point cloud (.ply .xyz .txt .csv .off .obj .las .pcd)")
+                  "input point cloud (.ply .xyz .txt .csv .pts .pwn .off .obj .las .pcd)")
       ->required()
       ->check(CLI::ExistingFile);
   command.add_flag("--drop-invalid", input.dropInvalid,
@@ -136,7 +136,7 @@ void checkOutput(const std::string& output, OutputKind kind,
                         kind == OutputKind::CylindersResult;
   switch (kind) {
     case OutputKind::Cloud: {
-      const char* const writable = "write .ply, .xyz, .txt, .csv, .pts, .las or .pcd";
+      const char* const writable = "write .ply, .xyz, .txt, .csv, .pts, .pwn, .las or .pcd";
       CloudFormat format;
       try {
         format = formatFromPath(output);

@@ -17,7 +17,7 @@ namespace scalespace {
 
 namespace {
 
-const char* const kSupported = ".ply .xyz .txt .csv .pts .off .obj .las .pcd";
+const char* const kSupported = ".ply .xyz .txt .csv .pts .pwn .off .obj .las .pcd";
 
 }  // namespace
 
@@ -25,7 +25,8 @@ CloudFormat formatFromPath(const std::string& path) {
   const std::string extension =
       io_detail::toLower(std::filesystem::path(path).extension().string());
   if (extension == ".ply") return CloudFormat::Ply;
-  if (extension == ".xyz" || extension == ".txt" || extension == ".csv" || extension == ".pts")
+  if (extension == ".xyz" || extension == ".txt" || extension == ".csv" || extension == ".pts" ||
+      extension == ".pwn")
     return CloudFormat::Xyz;
   if (extension == ".off") return CloudFormat::Off;
   if (extension == ".obj") return CloudFormat::Obj;
@@ -109,7 +110,7 @@ void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOpt
   if (format == CloudFormat::Off || format == CloudFormat::Obj)
     throw OptionError(path + ": cannot write ." + formatName(format) +
                       " (a point cloud has no faces); writable extensions: .ply .xyz .txt .csv "
-                      ".pts .las .pcd");
+                      ".pts .pwn .las .pcd");
   // Fail before creating any file when the cloud cannot be represented (bad attribute names...):
   // the writers check first and throw from inside writeFileAtomically, which cleans up.
   writeFileAtomically(path, [&](std::ostream& out) {
@@ -117,12 +118,15 @@ void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOpt
       case CloudFormat::Ply:
         writePly(cloud, out, options.ascii ? PlyEncoding::Ascii : PlyEncoding::BinaryLittleEndian);
         break;
-      case CloudFormat::Xyz:
-        writeXyz(cloud, out,
-                 io_detail::toLower(std::filesystem::path(path).extension().string()) == ".csv"
-                     ? ','
-                     : ' ');
+      case CloudFormat::Xyz: {
+        const std::string extension =
+            io_detail::toLower(std::filesystem::path(path).extension().string());
+        if (extension == ".pwn")
+          writePwn(cloud, out);
+        else
+          writeXyz(cloud, out, extension == ".csv" ? ',' : ' ');
         break;
+      }
       case CloudFormat::Las:
         writeLas(cloud, out, path);
         break;

@@ -3,6 +3,9 @@
 //
 //   .ply                     PLY ascii / binary_little_endian / binary_big_endian  (read, write)
 //   .xyz .txt .csv .pts      text columns "x y z [nx ny nz] [more]"               (read, write)
+//   .pwn                     CGAL's points with normals, "x y z nx ny nz"         (read, write)
+//                            (read as text columns; written without a header, positions and
+//                            normals only)
 //   .off .obj                triangle meshes: vertices or area-uniform samples     (read)
 //   .las                     LAS 1.0-1.4 uncompressed, point formats 0-3 and 6-8   (read, write)
 //                            written as LAS 1.2, or as LAS 1.4 with "extra bytes" holding the

@@ -146,6 +146,28 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
   return builder.finish(report, "xyz");
 }
 
+void writePwn(const PointCloud& cloud, std::ostream& out) {
+  if (!cloud.hasNormals())
+    throw OptionError(
+        "a .pwn file holds points with normals and this cloud has none: estimate them first "
+        "(`scalespace normals`) or write .xyz");
+  std::string line;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    line.clear();
+    const Vec3 p = cloud.absolutePosition(i);
+    for (int k = 0; k < 3; ++k) {
+      line += formatNumber(p[k]);
+      line += ' ';
+    }
+    for (int k = 0; k < 3; ++k) {
+      line += formatNumber(cloud.normals()[i][k]);
+      line += ' ';
+    }
+    line.back() = '\n';
+    out << line;
+  }
+}
+
 void writeXyz(const PointCloud& cloud, std::ostream& out, char separator) {
   checkAttributeNames(cloud, "XYZ", {"x", "y", "z"},
                       {"nx", "ny", "nz", "normal_x", "normal_y", "normal_z"},

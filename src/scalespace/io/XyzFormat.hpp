@@ -28,4 +28,9 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
 /// `separator` is ' ' or ','.
 void writeXyz(const PointCloud& cloud, std::ostream& out, char separator = ' ');
 
+/// CGAL's .pwn (points with normals, as its demos and read_points() take them): "x y z nx ny nz"
+/// per line, no header. A .pwn has no place for attributes: they are not written. Throws
+/// OptionError when the cloud has no normals.
+void writePwn(const PointCloud& cloud, std::ostream& out);
+
 }  // namespace scalespace
