@@ -81,7 +81,7 @@ class Cloud:
 
 
 def read(path: str, *, drop_invalid: bool = False, sample: int = 0, seed: int = 1) -> Cloud:
-    """Reads a cloud: PLY, XYZ/TXT/CSV/PTS, OFF/OBJ (vertices, or ``sample`` points drawn by
+    """Reads a cloud: PLY, XYZ/TXT/CSV/PTS, PWN (CGAL's points with normals), OFF/OBJ (vertices, or ``sample`` points drawn by
     area with interpolated normals), LAS 1.0-1.4, PCD. Points with NaN/Inf coordinates raise
     FileError unless ``drop_invalid``. An empty file reads as an empty cloud."""
     d = _scalespace._read(str(path), drop_invalid=drop_invalid, sample=sample, seed=seed)
@@ -94,7 +94,9 @@ def write(path: str, points, normals=None, attributes: Optional[Mapping[str, np.
     """Writes a cloud (by extension: .ply .xyz .txt .csv .pts .pwn .las .pcd), atomically.
 
     ``points`` may be a :class:`Cloud` (then normals and attributes come from it). Attribute
-    dtypes are kept (int8..uint32, float32, float64; bool as uint8). ascii: PLY/PCD as text."""
+    dtypes are kept (int8..uint32, float32, float64; bool as uint8). ascii: PLY/PCD as text.
+    .pwn (CGAL's points with normals) holds positions and normals only: it needs normals and
+    does not write the attributes."""
     if isinstance(points, Cloud):
         cloud = points
         points = cloud.points

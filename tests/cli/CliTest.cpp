@@ -318,3 +318,23 @@ TEST_F(Cli, APcdViewpointIsShownAndTheEstimatedNormalsFaceIt) {
   for (std::size_t i = 0; i < out.size(); ++i) down += out.normals()[i].z() < 0 ? 1 : 0;
   EXPECT_EQ(down, out.size());
 }
+
+TEST_F(Cli, PwnIsWrittenWhereNormalsAreTheResultAndRefusedWhereColumnsAre) {
+  // CGAL's points with normals: `normals` writes one that reads back with the same normals;
+  // `curvature`, whose result is columns a .pwn cannot hold, is refused before any work.
+  ASSERT_EQ(run("generate sphere -n 500 -q -o " + path("s.ply")).code, 0);
+  Result r = run("normals " + path("s.ply") + " -q -o " + path("s.pwn"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PointCloud pwn = readCloud(path("s.pwn")), ply = readCloud(path("s.ply"));
+  ASSERT_EQ(pwn.size(), ply.size());
+  ASSERT_TRUE(pwn.hasNormals());
+  EXPECT_TRUE(pwn.attributes().empty());
+  std::size_t outward = 0;
+  for (std::size_t i = 0; i < pwn.size(); ++i)
+    outward += pwn.normals()[i].dot(pwn.absolutePosition(i)) > 0 ? 1 : 0;
+  EXPECT_EQ(outward, pwn.size());
+  r = run("curvature " + path("s.pwn") + " --scale 0.3 -q -o " + path("c.pwn"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("a .pwn holds positions and normals only"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("c.pwn")));
+}

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "IoTestSupport.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/CloudIO.hpp"
@@ -110,7 +112,11 @@ TEST(CloudIO, PwnIsPointsWithNormals) {
   } catch (const OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("normals"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(dir.entryCount(), 2u);  // oni.pwn and out.pwn: nothing left of bare.pwn
+  EXPECT_THROW(writeCloud(bare, dir.file("new/folder/bare.pwn")), OptionError);
+  PointCloud nanNormal = read;
+  nanNormal.normals()[1].x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(writeCloud(nanNormal, dir.file("nan.pwn")), OptionError);
+  EXPECT_EQ(dir.entryCount(), 2u);  // oni.pwn and out.pwn: no file nor folder of the refused
 }
 
 }  // namespace

@@ -73,6 +73,23 @@ def test_round_trip_every_writable_format(tmp_path, name, ascii):
         assert cloud.attributes["curv"].dtype == np.float32
 
 
+def test_pwn_holds_positions_and_normals_only(tmp_path):
+    # CGAL's points with normals: headerless "x y z nx ny nz"; attributes are not written, and a
+    # cloud without normals is refused before any file is made.
+    points, normals = sphere_points(50), sphere_points(50, 3)
+    path = str(tmp_path / "s.pwn")
+    ss.write(path, points, normals, {"label": np.arange(50, dtype=np.int32)})
+    first = open(path).readline().split()
+    assert len(first) == 6 and abs(float(first[0]) - points[0, 0]) < 1e-12
+    back = ss.read(path)
+    np.testing.assert_allclose(back.points, points, atol=1e-12)
+    np.testing.assert_allclose(back.normals, normals, atol=1e-12)
+    assert back.attributes == {}
+    with pytest.raises(ss.OptionError, match="normals"):
+        ss.write(str(tmp_path / "bare.pwn"), points)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.pwn"]
+
+
 def test_write_a_cloud_object_and_read_meshes(tmp_path):
     cloud = ss.Cloud(sphere_points(100), None, {"flag": np.ones(100, bool)})
     ss.write(str(tmp_path / "c.ply"), cloud)

@@ -135,8 +135,11 @@ void checkOutput(const std::string& output, OutputKind kind,
   const bool isFolder = kind == OutputKind::Stack || kind == OutputKind::PlanesResult ||
                         kind == OutputKind::CylindersResult;
   switch (kind) {
-    case OutputKind::Cloud: {
-      const char* const writable = "write .ply, .xyz, .txt, .csv, .pts, .pwn, .las or .pcd";
+    case OutputKind::Cloud:
+    case OutputKind::PointsWithNormals: {
+      const char* const writable = kind == OutputKind::Cloud
+                                       ? "write .ply, .xyz, .txt, .csv, .pts, .las or .pcd"
+                                       : "write .ply, .xyz, .txt, .csv, .pts, .pwn, .las or .pcd";
       CloudFormat format;
       try {
         format = formatFromPath(output);
@@ -146,6 +149,11 @@ void checkOutput(const std::string& output, OutputKind kind,
       if (format == CloudFormat::Off || format == CloudFormat::Obj)
         throw OptionError("output " + output +
                           ": OFF and OBJ are meshes and cannot hold a point cloud; " + writable);
+      if (kind == OutputKind::Cloud && ext == ".pwn")
+        throw OptionError("output " + output +
+                          ": a .pwn holds positions and normals only, and this command's result "
+                          "is per-point columns; " +
+                          writable);
       break;
     }
     case OutputKind::Png:

@@ -46,13 +46,15 @@ void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions&
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {
-  Cloud,           // a point cloud in a writable format (.ply .xyz .txt .csv .pts .las .pcd)
-  Png,             // an image (.png)
-  Csv,             // a table (.csv)
-  Stack,           // a scale stack folder: replaces only an earlier stack
-  PlanesResult,    // the planes' folder: new, empty, or an earlier result
-  Lines,           // polylines (.ply with edges, .obj)
-  CylindersResult  // the cylinders' folder: new, empty, or an earlier result
+  Cloud,              // a point cloud whose result is per-point columns (.ply .xyz .txt .csv .pts
+                      // .las .pcd; not .pwn, which has no place for them)
+  PointsWithNormals,  // positions and normals are the result (`normals`, `generate`): .pwn too
+  Png,                // an image (.png)
+  Csv,                // a table (.csv)
+  Stack,              // a scale stack folder: replaces only an earlier stack
+  PlanesResult,       // the planes' folder: new, empty, or an earlier result
+  Lines,              // polylines (.ply with edges, .obj)
+  CylindersResult     // the cylinders' folder: new, empty, or an earlier result
 };
 
 /// Checks an output before any work, so that a long run never fails at its end: the output is

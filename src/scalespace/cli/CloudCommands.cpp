@@ -122,7 +122,9 @@ void addGenerateCommand(CLI::App& app) {
   cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
   cmd->add_flag("--one-sided", args->oneSided,
                 "pipes: keep what a scanner above the rack sees (each pipe a half-pipe)");
-  cmd->add_option("-o,--output", args->output, "output cloud (.ply .xyz .pcd .las)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "output cloud (.ply .xyz .pcd .las; .pwn: positions and normals only)")
+      ->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no messages on stderr");
   cmd->callback([args] {
     const auto start = Clock::now();
@@ -133,7 +135,7 @@ void addGenerateCommand(CLI::App& app) {
       throw OptionError("--points must be in [1, " + std::to_string(kMaxPoints) + "], got " +
                         std::to_string(args->options.pointCount));
     if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
-    checkOutput(args->output, OutputKind::Cloud, {});
+    checkOutput(args->output, OutputKind::PointsWithNormals, {});
     if (args->oneSided && args->shape != "pipes")
       throw OptionError("--one-sided applies to the pipes scene only");
     PointCloud cloud;
@@ -276,7 +278,10 @@ void addNormalsCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "normals", "estimate (PCA over k neighbours) and orient normals; replaces existing ones");
   addInputOptions(*cmd, args->input);
-  cmd->add_option("-o,--output", args->output, "output cloud")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "output cloud with the normals and normal_reliable (a .pwn, CGAL's points with "
+                  "normals, holds the positions and normals only)")
+      ->required();
   addNormalOptions(*cmd, args->normals);
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
@@ -284,7 +289,7 @@ void addNormalsCommand(CLI::App& app) {
   cmd->callback([args] {
     const auto start = Clock::now();
     ThreadScope threads(args->threads);
-    checkOutput(args->output, OutputKind::Cloud, {args->input.path});
+    checkOutput(args->output, OutputKind::PointsWithNormals, {args->input.path});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     estimateAndOrient(cloud, args->normals, makeProgressBar(args->quiet), args->quiet);
     writeCloud(cloud, args->output, WriteOptions{args->ascii});

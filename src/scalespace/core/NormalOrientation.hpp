@@ -28,13 +28,13 @@
 //    no say and the tree's sign stays. On a closed surface (at most 5% of the points that cast
 //    rays see out on both sides: a CAD part, an object scanned all round) the rays are trusted
 //    more: offsets along the normals within the noise do not cut the tree, a piece whose rays
-//    disagree is split where they do, a tenth of a piece's points voting against it suffice, and
-//    fragments smaller than k points do not vouch for a neighbour's sign. Open scans keep the
-//    cautious rules: there a floor under a table top looks like an inside (the real table scan
-//    without its viewpoint, with the closed rules: 49.6% of the normals facing away from the
-//    scanner, the scene split in two, against 84.9%, the scene turned as a whole). Components
-//    that faced a viewpoint (faceViewpoint) cast no rays: a scan's line of sight is better
-//    evidence.
+//    disagree is split where they do (unless the cloud is clean and flat-faced), a tenth of a
+//    piece's points voting against it suffice, and fragments smaller than k points do not vouch for
+//    a neighbour's sign. Open scans keep the cautious rules: there a floor under a table top looks
+//    like an inside (the real table scan without its viewpoint, with the closed rules: 49.6% of the
+//    normals facing away from the scanner, the scene split in two, against 84.9%, the scene turned
+//    as a whole). Components that faced a viewpoint (faceViewpoint) cast no rays: a scan's line of
+//    sight is better evidence.
 //  - Viewpoint: flipped so that n . (viewpoint - p) >= 0; unreliable when the view ray grazes the
 //    surface, |cos(n, viewpoint - p)| < grazingThreshold, or p == viewpoint.
 #include <cstdint>

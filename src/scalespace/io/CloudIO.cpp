@@ -111,6 +111,9 @@ void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOpt
     throw OptionError(path + ": cannot write ." + formatName(format) +
                       " (a point cloud has no faces); writable extensions: .ply .xyz .txt .csv "
                       ".pts .pwn .las .pcd");
+  const std::string extension =
+      io_detail::toLower(std::filesystem::path(path).extension().string());
+  if (extension == ".pwn") checkPwnWritable(cloud);  // before any folder or file is made
   // Fail before creating any file when the cloud cannot be represented (bad attribute names...):
   // the writers check first and throw from inside writeFileAtomically, which cleans up.
   writeFileAtomically(path, [&](std::ostream& out) {
@@ -119,8 +122,6 @@ void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOpt
         writePly(cloud, out, options.ascii ? PlyEncoding::Ascii : PlyEncoding::BinaryLittleEndian);
         break;
       case CloudFormat::Xyz: {
-        const std::string extension =
-            io_detail::toLower(std::filesystem::path(path).extension().string());
         if (extension == ".pwn")
           writePwn(cloud, out);
         else

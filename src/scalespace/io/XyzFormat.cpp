@@ -1,6 +1,7 @@
 #include "scalespace/io/XyzFormat.hpp"
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "scalespace/core/Error.hpp"
@@ -146,11 +147,20 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
   return builder.finish(report, "xyz");
 }
 
-void writePwn(const PointCloud& cloud, std::ostream& out) {
+void checkPwnWritable(const PointCloud& cloud) {
   if (!cloud.hasNormals())
     throw OptionError(
         "a .pwn file holds points with normals and this cloud has none: estimate them first "
         "(`scalespace normals`) or write .xyz");
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (!cloud.normals()[i].allFinite())
+      throw OptionError("the normal of point " + std::to_string(i) +
+                        " is NaN or infinite, which a .pwn cannot hold (its readers take such a "
+                        "line for garbage): re-estimate the normals or write .ply");
+}
+
+void writePwn(const PointCloud& cloud, std::ostream& out) {
+  checkPwnWritable(cloud);
   std::string line;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     line.clear();

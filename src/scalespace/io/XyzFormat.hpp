@@ -1,5 +1,6 @@
 #pragma once
-// Text columns (.xyz .txt .csv .pts): one point per line, "x y z [nx ny nz] [more columns]".
+// Text columns (.xyz .txt .csv .pts, and CGAL's .pwn): one point per line, "x y z [nx ny nz] [more
+// columns]".
 //
 // Fields are separated by whitespace, or by commas when the line holds a comma. Blank lines and
 // lines starting with '#' are skipped, and so is a first line holding a single integer (the
@@ -30,7 +31,8 @@ void writeXyz(const PointCloud& cloud, std::ostream& out, char separator = ' ');
 
 /// CGAL's .pwn (points with normals, as its demos and read_points() take them): "x y z nx ny nz"
 /// per line, no header. A .pwn has no place for attributes: they are not written. Throws
-/// OptionError when the cloud has no normals.
+/// OptionError (checkPwnWritable) when the cloud has no normals or a non-finite one.
 void writePwn(const PointCloud& cloud, std::ostream& out);
+void checkPwnWritable(const PointCloud& cloud);
 
 }  // namespace scalespace
