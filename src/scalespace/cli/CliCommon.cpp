@@ -137,9 +137,8 @@ void checkOutput(const std::string& output, OutputKind kind,
   switch (kind) {
     case OutputKind::Cloud:
     case OutputKind::PointsWithNormals: {
-      const char* const writable = kind == OutputKind::Cloud
-                                       ? "write .ply, .xyz, .txt, .csv, .pts, .las or .pcd"
-                                       : "write .ply, .xyz, .txt, .csv, .pts, .pwn, .las or .pcd";
+      const std::string writable = std::string("write .ply, .xyz, .txt, .csv, .pts, ") +
+                                   (kind == OutputKind::Cloud ? "" : ".pwn, ") + ".las or .pcd";
       CloudFormat format;
       try {
         format = formatFromPath(output);

@@ -132,6 +132,14 @@ Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented
   return pieces;
 }
 
+/// Points of each of the `pieces` pieces of the tree.
+std::vector<std::size_t> countMembers(const std::vector<Index>& piece, Index pieces,
+                                      const std::vector<Index>& treeOrder) {
+  std::vector<std::size_t> members(pieces, 0);
+  for (const Index v : treeOrder) ++members[piece[v]];
+  return members;
+}
+
 /// A piece whose rays disagree, one part saying it faces in and another that it faces out, joins
 /// two sides the cuts missed (a thin part's rim under noise). It is split at the tree edge that
 /// best separates them: the subtree whose net vote (against minus for) has the sign opposite to
@@ -216,14 +224,14 @@ constexpr double kEdgeWeight = 2.0;
 /// more of its five rays escape on that side than on the other; a piece is a candidate when its
 /// votes against its side are at least a quarter of its points (a tenth on a closed surface) and
 /// more than twice those for. On a closed surface (kClosedOpenShare) the tree is cut again with
-/// the noise taken into account (`noiseOffset`, acrossSheet) and its mixed pieces are split
-/// (splitMixedPieces()). Points whose component faced a viewpoint (`settled`) cast no votes: a
-/// scan's line of sight is better evidence than the rays.
+/// the noise taken into account (noiseOffset() of the points' off-plane `spread`, acrossSheet) and
+/// its mixed pieces are split (splitMixedPieces()). Points whose component faced a viewpoint
+/// (`settled`) cast no votes: a scan's line of sight is better evidence than the rays.
 void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& oriented,
                          const SpatialIndex& index, const std::vector<std::uint8_t>& inGraph,
                          const std::vector<std::uint8_t>& settled,
                          const std::vector<float>& kthDistance, const std::vector<Index>& parent,
-                         const std::vector<Index>& treeOrder, double noiseOffset,
+                         const std::vector<Index>& treeOrder, const std::vector<float>& spread,
                          std::vector<Index>& piece, Index pieces,
                          const NormalOrientationOptions& options, const ProgressCallback& progress,
                          std::vector<std::uint8_t>& flipped, NormalOrientationResult& result) {
@@ -241,10 +249,8 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   // Every point of a piece of fewer than 16 points casts rays; in larger ones one point in
   // `stride`, so that about kVoters points cast rays in all (the rays cost more than the rest of
   // the orientation: 460k points of the table scan, 3.1 s of rays from every point).
-  std::vector<std::size_t> members(pieces, 0);
-  std::size_t graphSize = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (inGraph[i] && piece[i] != kNone) ++members[piece[i]], ++graphSize;
+  std::vector<std::size_t> members = countMembers(piece, pieces, treeOrder);
+  const std::size_t graphSize = treeOrder.size();
   constexpr std::size_t kVoters = 100000;
   // Pieces of fewer than k points (noise and creases in a scan cut the tree into many) are left
   // as the tree oriented them: turned on a handful of votes they disagreed with their neighbours
@@ -277,11 +283,10 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   for (std::size_t i = 0; i < n; ++i) casters += casts[i], open += openBoth[i];
   const bool closed = casters > 0 && double(open) <= kClosedOpenShare * double(casters);
   result.closedSurface = closed;
+  const double noise = closed ? noiseOffset(spread) : 0.0;
   if (closed) {
-    pieces =
-        cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, noiseOffset, piece);
-    members.assign(pieces, 0);
-    for (const Index v : treeOrder) ++members[piece[v]];
+    pieces = cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, noise, piece);
+    members = countMembers(piece, pieces, treeOrder);
     // Not on flat-faced clean clouds (median off-plane spread under a thousandth of the spacing;
     // curvature or noise lift it above): there the cuts are where the sides meet, and a piece
     // whose rays disagree has rays that leak (clean rotor with sheet normals: 12.6% -> 13.8% of
@@ -289,13 +294,12 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
     // curved sphere_20k_normal it runs: 19.3% -> 16.5% against the file's normals. The points
     // that cast rays were chosen on the first cut's pieces: fragments of fewer than k points
     // there cast none, and their votes are left out of the pieces they join.
-    if (noiseOffset > 1e-3 * spacing[spacing.size() / 2]) {
+    if (noise > 1e-3 * spacing[spacing.size() / 2]) {
       std::vector<std::uint8_t> voted(n, 0);
       for (std::size_t i = 0; i < n; ++i)
         voted[i] = casts[i] && members[piece[i]] >= minPiece ? 1 : 0;
       splitMixedPieces(parent, treeOrder, vote, voted, minPiece, piece, pieces);
-      members.assign(pieces, 0);
-      for (const Index v : treeOrder) ++members[piece[v]];
+      members = countMembers(piece, pieces, treeOrder);
     }
     result.pieceCount = pieces;
   }
@@ -330,35 +334,35 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   // points do not speak: noise cuts a misoriented side into fragments that the tree oriented
   // alike, and their edges outvoted the rays (noisy rotor: no piece turned, 45% of the normals
   // against the mesh's).
-  const double edgeOffset = closed ? noiseOffset : 0.0;
   std::vector<std::uint16_t> agreeAt(n, 0), disagreeAt(n, 0);
   using Link = std::pair<Index, Index>;
   tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
   tbb::enumerable_thread_specific<std::vector<Link>> linkScratch;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n, 1024),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<Neighbor>& nbrs = scratch.local();
-        std::vector<Link>& links = linkScratch.local();
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
-          index.knnSearch(points[i], options.k + 1, nbrs);
-          for (const Neighbor& nb : nbrs) {
-            const Index j = nb.index;
-            if (j == i || !inGraph[j] || piece[j] == piece[i] || piece[j] == kNone) continue;
-            if (closed && members[piece[j]] < minPiece) continue;
-            if (acrossSheet(points[i], oriented[i], points[j], oriented[j], edgeOffset)) continue;
-            const double c =
-                oriented[i].dot(oriented[j]) / (oriented[i].norm() * oriented[j].norm());
-            if (c >= 0.5 && turn[piece[j]]) {
-              links.emplace_back(piece[i], piece[j]);
-              continue;
-            }
-            agreeAt[i] += c >= 0.5 ? 1 : 0;
-            disagreeAt[i] += c <= -0.5 ? 1 : 0;
-          }
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<Neighbor>& nbrs = scratch.local();
+                      std::vector<Link>& links = linkScratch.local();
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
+                        index.knnSearch(points[i], options.k + 1, nbrs);
+                        for (const Neighbor& nb : nbrs) {
+                          const Index j = nb.index;
+                          if (j == i || !inGraph[j] || piece[j] == piece[i] || piece[j] == kNone)
+                            continue;
+                          if (closed && members[piece[j]] < minPiece) continue;
+                          if (acrossSheet(points[i], oriented[i], points[j], oriented[j], noise))
+                            continue;
+                          const double c = oriented[i].dot(oriented[j]) /
+                                           (oriented[i].norm() * oriented[j].norm());
+                          if (c >= 0.5 && turn[piece[j]]) {
+                            links.emplace_back(piece[i], piece[j]);
+                            continue;
+                          }
+                          agreeAt[i] += c >= 0.5 ? 1 : 0;
+                          disagreeAt[i] += c <= -0.5 ? 1 : 0;
+                        }
+                      }
+                    });
   // Candidates that agree with each other along one surface are decided together: noise cuts a
   // misoriented side into many pieces, each agreeing with the next.
   DisjointSets groups(pieces);
@@ -509,7 +513,8 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
                           if (!usable(oriented[i])) continue;
                           index.knnSearch(points[i], k + 1, nbrs);
                           if (!nbrs.empty()) kthDistance[i] = float(std::sqrt(nbrs.back().distSq));
-                          if (inGraph[i]) spread[i] = offPlaneSpread(points, i, oriented[i], nbrs);
+                          if (inGraph[i] && options.visibility)
+                            spread[i] = offPlaneSpread(points, i, oriented[i], nbrs);
                           std::size_t slot = 0;
                           for (const Neighbor& nb : nbrs) {
                             const Index j = nb.index;
@@ -627,7 +632,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
 
   if (options.visibility)
     correctByVisibility(points, oriented, index, inGraph, settled, kthDistance, parent, treeOrder,
-                        noiseOffset(spread), piece, pieces, options, progress, flipped, result);
+                        spread, piece, pieces, options, progress, flipped, result);
 
   // 5. Points outside the graph follow their nearest graph neighbour; never reliable.
   for (std::size_t i = 0; i < n; ++i) {

@@ -147,6 +147,39 @@ PointCloud readXyz(std::string_view data, const std::string& file, const ReadOpt
   return builder.finish(report, "xyz");
 }
 
+namespace {
+
+/// One line per point: x y z, the normals if the cloud has them, then (withAttributes) every
+/// attribute column, shortest round-trip numbers.
+void writeRows(const PointCloud& cloud, std::ostream& out, char separator, bool withAttributes) {
+  const bool normals = cloud.hasNormals();
+  std::string line;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    line.clear();
+    const Vec3 p = cloud.absolutePosition(i);
+    for (int k = 0; k < 3; ++k) {
+      line += formatNumber(p[k]);
+      line += separator;
+    }
+    if (normals)
+      for (int k = 0; k < 3; ++k) {
+        line += formatNumber(cloud.normals()[i][k]);
+        line += separator;
+      }
+    if (withAttributes)
+      for (const auto& column : cloud.attributes()) {
+        // Text keeps no type: write the stored value with all its double digits, so it reads
+        // back (as float64) to exactly the same number.
+        line += formatNumber(toStoredValue(column.values[i], column.type));
+        line += separator;
+      }
+    line.back() = '\n';
+    out << line;
+  }
+}
+
+}  // namespace
+
 void checkPwnWritable(const PointCloud& cloud) {
   if (!cloud.hasNormals())
     throw OptionError(
@@ -157,25 +190,6 @@ void checkPwnWritable(const PointCloud& cloud) {
       throw OptionError("the normal of point " + std::to_string(i) +
                         " is NaN or infinite, which a .pwn cannot hold (its readers take such a "
                         "line for garbage): re-estimate the normals or write .ply");
-}
-
-void writePwn(const PointCloud& cloud, std::ostream& out) {
-  checkPwnWritable(cloud);
-  std::string line;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    line.clear();
-    const Vec3 p = cloud.absolutePosition(i);
-    for (int k = 0; k < 3; ++k) {
-      line += formatNumber(p[k]);
-      line += ' ';
-    }
-    for (int k = 0; k < 3; ++k) {
-      line += formatNumber(cloud.normals()[i][k]);
-      line += ' ';
-    }
-    line.back() = '\n';
-    out << line;
-  }
 }
 
 void writeXyz(const PointCloud& cloud, std::ostream& out, char separator) {
@@ -199,27 +213,12 @@ void writeXyz(const PointCloud& cloud, std::ostream& out, char separator) {
     line += column.name;
   }
   out << line << '\n';
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    line.clear();
-    const Vec3 p = cloud.absolutePosition(i);
-    for (int k = 0; k < 3; ++k) {
-      line += formatNumber(p[k]);
-      line += separator;
-    }
-    if (normals)
-      for (int k = 0; k < 3; ++k) {
-        line += formatNumber(cloud.normals()[i][k]);
-        line += separator;
-      }
-    for (const auto& column : cloud.attributes()) {
-      // Text keeps no type: write the stored value with all its double digits, so it reads back
-      // (as float64) to exactly the same number.
-      line += formatNumber(toStoredValue(column.values[i], column.type));
-      line += separator;
-    }
-    line.back() = '\n';
-    out << line;
-  }
+  writeRows(cloud, out, separator, /*withAttributes=*/true);
+}
+
+void writePwn(const PointCloud& cloud, std::ostream& out) {
+  checkPwnWritable(cloud);
+  writeRows(cloud, out, ' ', /*withAttributes=*/false);
 }
 
 }  // namespace scalespace
