@@ -8,6 +8,11 @@
 //                   [--curved-seeds-first] (ours: CurvatureLineOptions::curvedSeedsFirst on,
 //                   the features' seed order; the cylinders' default is the random order)
 //                   [--one-curvature-sign] (ours: CylinderOptions::oneCurvatureSign on)
+//                   [--estimate-normals] (every method gets normals estimated from the positions
+//                   as `scalespace cylinders` does for a file without them: PCA, oriented by the
+//                   MST with the visibility correction; the one-sided scan faces a scanner 5 m
+//                   up its view direction. Default: the scene's exact normals)
+//                   [--normal-k K] (with --estimate-normals: K neighbours, default 10 as the CLI)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -29,6 +34,8 @@
 #include <tuple>
 #include <vector>
 
+#include "scalespace/core/NormalEstimation.hpp"
+#include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/PipeScene.hpp"
 #include "scalespace/features/CylinderDetection.hpp"
 
@@ -240,11 +247,48 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
   return s;
 }
 
+// What a user without normals gets: the CLI's estimation and orientation (cli/ensureNormals), a
+// one-sided scan facing its scanner. Prints how many normals face away from the exact ones.
+void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k) {
+  const std::vector<Vec3> exact = cloud.normals();
+  NormalEstimationOptions estimation;
+  estimation.k = k;
+  NormalEstimationResult estimated = estimateNormals(cloud.positions(), estimation);
+  NormalOrientationOptions orientation;
+  if (scanner) orientation.faceViewpoint = true, orientation.viewpoint = *scanner;
+  orientNormals(cloud.positions(), estimated.normals, orientation, estimated.valid);
+  std::size_t against = 0, off = 0;
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    const double c = exact[i].dot(estimated.normals[i]);
+    against += c < 0;
+    off += std::abs(c) < std::cos(30 * 3.14159265358979323846 / 180);
+  }
+  std::printf("  estimated normals: %.2f%% against the exact ones, %.2f%% more than 30 deg off\n",
+              100.0 * double(against) / double(exact.size()),
+              100.0 * double(off) / double(exact.size()));
+  // Per object: the pipes by name, the planes (floor, wall, box) as one.
+  const auto& pipe = cloud.findAttribute("gt_pipe")->values;
+  std::map<int, std::pair<std::size_t, std::size_t>> per;  // pipe (-1: planes) -> (against, all)
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    auto& [a, all] = per[int(pipe[i])];
+    a += exact[i].dot(estimated.normals[i]) < 0;
+    ++all;
+  }
+  const std::vector<PipeTruth> truth = pipeSceneTruth();
+  std::printf("   against, per object:");
+  for (const auto& [p, counts] : per)
+    std::printf(" %s %.1f%%", p < 0 ? "planes" : truth[std::size_t(p)].name.c_str(),
+                100.0 * double(counts.first) / double(counts.second));
+  std::printf("\n");
+  cloud.setNormals(std::move(estimated.normals));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::size_t points = 1000000;
-  bool peers = true, cleanOnly = false;
+  bool peers = true, cleanOnly = false, estimate = false;
+  std::size_t normalK = NormalEstimationOptions{}.k;
   std::string only;  // "full" or "one-sided": that scan alone
   CylinderOptions ours;
   std::uint64_t seed = 1;
@@ -268,11 +312,16 @@ int main(int argc, char** argv) {
       ours.lines.curvedSeedsFirst = true;
     else if (a == "--one-curvature-sign")
       ours.oneCurvatureSign = true;
+    else if (a == "--estimate-normals")
+      estimate = true;
+    else if (a == "--normal-k" && i + 1 < argc)
+      normalK = std::stoul(argv[++i]);
     else {
-      std::fprintf(stderr,
-                   "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
-                   "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
-                   "[--curved-seeds-first] [--one-curvature-sign]\n");
+      std::fprintf(
+          stderr,
+          "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
+          "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
+          "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] [--normal-k K]\n");
       return 2;
     }
   }
@@ -288,9 +337,18 @@ int main(int argc, char** argv) {
       options.noise = noise;
       options.oneSided = oneSided;
       options.seed = seed;
-      const PointCloud cloud = generatePipeScene(options);
+      PointCloud cloud = generatePipeScene(options);
       std::printf("\n%s scan, noise %g of the diagonal (%zu points)\n",
                   oneSided ? "one-sided" : "full", noise, cloud.size());
+      if (estimate) {
+        Vec3 centre = Vec3::Zero();
+        for (const Vec3& p : cloud.positions()) centre += p;
+        centre /= double(cloud.size());
+        // Within the scene's diagonal of it: a viewpoint farther away is taken for a default
+        // VIEWPOINT at the origin of georeferenced points and ignored (core/NormalOrientation).
+        const Vec3 scanner = centre + 5 * options.oneSidedView.normalized();
+        estimateSceneNormals(cloud, oneSided ? &scanner : nullptr, normalK);
+      }
       std::vector<Method> methods{runOurs(cloud, ours)};
       if (peers) {
         // Mean spacing of an area-uniform sample: sqrt(area / n), the scene's area ~52 m^2.

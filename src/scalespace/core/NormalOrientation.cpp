@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -111,11 +112,12 @@ double noiseOffset(const std::vector<float>& spread) {
 }
 
 /// The tree cut where its sign decision is a guess: a crease (|cos| < creaseThreshold) or an edge
-/// across a thin part (acrossSheet with `minOffset`). `parent` and `treeOrder` are the tree
-/// (parents first); returns the number of pieces.
+/// across a thin part (acrossSheet with `minOffset` of the edge's child). `parent` and `treeOrder`
+/// are the tree (parents first); returns the number of pieces.
 Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented,
               const std::vector<Index>& parent, const std::vector<Index>& treeOrder,
-              double creaseThreshold, double minOffset, std::vector<Index>& piece) {
+              double creaseThreshold, const std::function<double(Index)>& minOffset,
+              std::vector<Index>& piece) {
   Index pieces = 0;
   for (const Index c : treeOrder) {
     const Index p = parent[c];
@@ -126,7 +128,7 @@ Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented
     const double cosine =
         std::abs(oriented[c].dot(oriented[p])) / (oriented[c].norm() * oriented[p].norm());
     const bool guess = cosine < creaseThreshold ||
-                       acrossSheet(points[p], oriented[p], points[c], oriented[c], minOffset);
+                       acrossSheet(points[p], oriented[p], points[c], oriented[c], minOffset(c));
     piece[c] = guess ? pieces++ : piece[p];
   }
   return pieces;
@@ -194,8 +196,9 @@ void splitMixedPieces(const std::vector<Index>& parent, const std::vector<Index>
 }
 
 /// The visibility correction trusts the rays more on a closed surface: there, a point's rays
-/// escape on one side at most. When no more than this share of the points that cast rays see
-/// out on both sides (3 of 5 rays each), the cloud is taken as closed. Measured: libcgal-demo's
+/// escape on one side at most. When no more than this share of the points of a component of the
+/// graph that cast rays see out on both sides (3 of 5 rays each), the component is taken as
+/// closed. Measured: libcgal-demo's
 /// CAD parts sampled (bench_features) 0.3-0.5%, noisy blade 2.5%, clean blade 6.9% (rays pass
 /// through its thin rim), kitten, ball, blobby, sphere_20k_normal 0-0.4%; open scans: the real
 /// table scan 38%, hippo1 99%, building 18%, spheres 17%, oni 11%.
@@ -223,9 +226,10 @@ constexpr double kEdgeWeight = 2.0;
 /// Visibility pass (file comment of the header). A point votes for its side when at least three
 /// more of its five rays escape on that side than on the other; a piece is a candidate when its
 /// votes against its side are at least a quarter of its points (a tenth on a closed surface) and
-/// more than twice those for. On a closed surface (kClosedOpenShare) the tree is cut again with
-/// the noise taken into account (noiseOffset() of the points' off-plane `spread`, acrossSheet) and
-/// its mixed pieces are split (splitMixedPieces()). Points whose component faced a viewpoint
+/// more than twice those for. On the closed components (kClosedOpenShare) the tree is cut again
+/// with the noise taken into account (noiseOffset() of the points' off-plane `spread`,
+/// acrossSheet) and the mixed pieces are split (splitMixedPieces()). Points whose component faced a
+/// viewpoint
 /// (`settled`) cast no votes: a scan's line of sight is better evidence than the rays.
 void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& oriented,
                          const SpatialIndex& index, const std::vector<std::uint8_t>& inGraph,
@@ -279,13 +283,34 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                       tracker.advance(range.size());
                     });
   tracker.finish();
-  std::size_t casters = 0, open = 0;
-  for (std::size_t i = 0; i < n; ++i) casters += casts[i], open += openBoth[i];
-  const bool closed = casters > 0 && double(open) <= kClosedOpenShare * double(casters);
-  result.closedSurface = closed;
-  const double noise = closed ? noiseOffset(spread) : 0.0;
-  if (closed) {
-    pieces = cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, noise, piece);
+  // Closed or open is decided per component of the graph: a scene holds closed objects (pipes
+  // floating above a floor, scanned all round) next to open sheets (the floor), and the floor's
+  // rays, out on both sides, must not deny the pipes the closed rules (pipe rack of
+  // bench_cylinders, noisy: the thin and the bent pipes 78% and 99% inward without).
+  std::vector<Index> component(n, kNone);
+  Index components = 0;
+  for (const Index c : treeOrder)
+    component[c] = parent[c] == kNone ? components++ : component[parent[c]];
+  std::vector<std::size_t> casters(components, 0), open(components, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (casts[i]) ++casters[component[i]], open[component[i]] += openBoth[i];
+  std::vector<std::uint8_t> closedComponent(components, 0);
+  bool anyClosed = false, anyOpen = false;
+  for (Index c = 0; c < components; ++c) {
+    if (casters[c] == 0) continue;
+    closedComponent[c] = double(open[c]) <= kClosedOpenShare * double(casters[c]) ? 1 : 0;
+    anyClosed = anyClosed || closedComponent[c];
+    anyOpen = anyOpen || !closedComponent[c];
+    result.closedComponents += closedComponent[c];
+  }
+  result.closedSurface = anyClosed && !anyOpen;
+  const auto isClosed = [&](std::size_t i) { return closedComponent[component[i]] != 0; };
+  const double noise = anyClosed ? noiseOffset(spread) : 0.0;
+  const auto noiseAt = [&](std::size_t i) { return isClosed(i) ? noise : 0.0; };
+  if (anyClosed) {
+    pieces = cutTree(
+        points, oriented, parent, treeOrder, options.creaseThreshold,
+        [&](Index c) { return noiseAt(c); }, piece);
     members = countMembers(piece, pieces, treeOrder);
     // Not on flat-faced clean clouds (median off-plane spread under a thousandth of the spacing;
     // curvature or noise lift it above): there the cuts are where the sides meet, and a piece
@@ -297,7 +322,7 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
     if (noise > 1e-3 * spacing[spacing.size() / 2]) {
       std::vector<std::uint8_t> voted(n, 0);
       for (std::size_t i = 0; i < n; ++i)
-        voted[i] = casts[i] && members[piece[i]] >= minPiece ? 1 : 0;
+        voted[i] = casts[i] && isClosed(i) && members[piece[i]] >= minPiece ? 1 : 0;
       splitMixedPieces(parent, treeOrder, vote, voted, minPiece, piece, pieces);
       members = countMembers(piece, pieces, treeOrder);
     }
@@ -321,10 +346,13 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   }
   // On a closed surface, a tenth: a thin part's rays pass through it and abstain (rotor with
   // sheet normals: a misoriented piece of 18,929 points, 1,483 votes against, 26 for).
-  const double share = closed ? 0.1 : 0.25;
+  std::vector<std::uint8_t> closedPiece(pieces, 0);
+  for (const Index v : treeOrder) closedPiece[piece[v]] = isClosed(v) ? 1 : 0;
   std::vector<std::uint8_t> turn(pieces, 0);
-  for (Index q = 0; q < pieces; ++q)
+  for (Index q = 0; q < pieces; ++q) {
+    const double share = closedPiece[q] ? 0.1 : 0.25;
     turn[q] = against[q] >= share * double(members[q]) && against[q] > 2 * along[q] ? 1 : 0;
+  }
   // The rays can be wrong where an object is open (a scan's missing base lets the inward rays
   // out) and its own parts hide the outside. The graph edges that join a piece to the rest along
   // one surface (not across a thin part, normals within 60 degrees) also speak for its sign: a
@@ -338,31 +366,30 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   using Link = std::pair<Index, Index>;
   tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
   tbb::enumerable_thread_specific<std::vector<Link>> linkScratch;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<Neighbor>& nbrs = scratch.local();
-                      std::vector<Link>& links = linkScratch.local();
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
-                        index.knnSearch(points[i], options.k + 1, nbrs);
-                        for (const Neighbor& nb : nbrs) {
-                          const Index j = nb.index;
-                          if (j == i || !inGraph[j] || piece[j] == piece[i] || piece[j] == kNone)
-                            continue;
-                          if (closed && members[piece[j]] < minPiece) continue;
-                          if (acrossSheet(points[i], oriented[i], points[j], oriented[j], noise))
-                            continue;
-                          const double c = oriented[i].dot(oriented[j]) /
-                                           (oriented[i].norm() * oriented[j].norm());
-                          if (c >= 0.5 && turn[piece[j]]) {
-                            links.emplace_back(piece[i], piece[j]);
-                            continue;
-                          }
-                          agreeAt[i] += c >= 0.5 ? 1 : 0;
-                          disagreeAt[i] += c <= -0.5 ? 1 : 0;
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<Neighbor>& nbrs = scratch.local();
+        std::vector<Link>& links = linkScratch.local();
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          if (!inGraph[i] || piece[i] == kNone || !turn[piece[i]]) continue;
+          index.knnSearch(points[i], options.k + 1, nbrs);
+          for (const Neighbor& nb : nbrs) {
+            const Index j = nb.index;
+            if (j == i || !inGraph[j] || piece[j] == piece[i] || piece[j] == kNone) continue;
+            if (isClosed(i) && members[piece[j]] < minPiece) continue;
+            if (acrossSheet(points[i], oriented[i], points[j], oriented[j], noiseAt(i))) continue;
+            const double c =
+                oriented[i].dot(oriented[j]) / (oriented[i].norm() * oriented[j].norm());
+            if (c >= 0.5 && turn[piece[j]]) {
+              links.emplace_back(piece[i], piece[j]);
+              continue;
+            }
+            agreeAt[i] += c >= 0.5 ? 1 : 0;
+            disagreeAt[i] += c <= -0.5 ? 1 : 0;
+          }
+        }
+      });
   // Candidates that agree with each other along one surface are decided together: noise cuts a
   // misoriented side into many pieces, each agreeing with the next.
   DisjointSets groups(pieces);
@@ -401,9 +428,12 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
 // thin parts) whose normals face away from the viewpoint (mean cosine to it below -0.1: a piece
 // seen edge-on says nothing) is turned over. A component is left as the tree oriented it when
 // the viewpoint lies within its bounding box (a frame's origin inside an object or a scene is no
-// scanner looking at it from one side) or farther from the box than its diagonal (a default
-// VIEWPOINT at the origin of georeferenced points). The points of the components it decides are
-// marked `settled`.
+// scanner looking at it from one side). No component is turned when the viewpoint lies farther
+// from the cloud's bounding box than its diagonal (a default VIEWPOINT at the origin of
+// georeferenced points); the cloud's box, not each component's: a scanner 5 m from a cable 4 m
+// long in a 7 m scene sees it (bench_cylinders --estimate-normals, one-sided: 37% of the cable's
+// normals faced away when the cable's own box decided). The points of the components it decides
+// are marked `settled`.
 void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
                       const std::vector<std::uint8_t>& inGraph, DisjointSets& sets,
                       const std::vector<Index>& piece, Index pieces, std::vector<Vec3>& oriented,
@@ -413,8 +443,11 @@ void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
   std::vector<std::size_t> count(pieces, 0);
   std::vector<Vec3> lo(n, Vec3::Constant(std::numeric_limits<double>::infinity()));
   std::vector<Vec3> hi(n, Vec3::Constant(-std::numeric_limits<double>::infinity()));
+  Vec3 cloudLo = Vec3::Constant(std::numeric_limits<double>::infinity()), cloudHi = -cloudLo;
   for (std::size_t i = 0; i < n; ++i) {
     if (!inGraph[i]) continue;
+    cloudLo = cloudLo.cwiseMin(points[i]);
+    cloudHi = cloudHi.cwiseMax(points[i]);
     const Index root = sets.find(Index(i));
     const Vec3 towards = viewpoint - points[i];
     const double norm = towards.norm() * oriented[i].norm();
@@ -423,11 +456,13 @@ void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
     lo[root] = lo[root].cwiseMin(points[i]);
     hi[root] = hi[root].cwiseMax(points[i]);
   }
+  const Vec3 outsideCloud = (cloudLo - viewpoint).cwiseMax(viewpoint - cloudHi).cwiseMax(0.0);
+  if (outsideCloud.norm() > (cloudHi - cloudLo).norm()) return;
   for (std::size_t i = 0; i < n; ++i) {
     if (!inGraph[i]) continue;
     const Index root = sets.find(Index(i));
     const Vec3 outside = (lo[root] - viewpoint).cwiseMax(viewpoint - hi[root]).cwiseMax(0.0);
-    if (outside.isZero() || outside.norm() > (hi[root] - lo[root]).norm()) continue;
+    if (outside.isZero()) continue;
     settled[i] = 1;
     if (!(facing[piece[i]] < -0.1 * double(count[piece[i]]))) continue;
     oriented[i] = -oriented[i];
@@ -622,8 +657,9 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
     treeOrder.insert(treeOrder.end(), queue.begin(), queue.end());
   }
   checkCancel(progress, 1.0, "orientation tree");
-  const Index pieces =
-      cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, 0.0, piece);
+  const Index pieces = cutTree(
+      points, oriented, parent, treeOrder, options.creaseThreshold, [](Index) { return 0.0; },
+      piece);
 
   std::vector<std::uint8_t> settled(n, 0);  // the viewpoint decided (turnPiecesToFace)
   if (options.faceViewpoint)

@@ -25,16 +25,16 @@
 //    inside of a closed surface, unless the graph edges that join it to the rest along one
 //    surface agree with its sign (each counts as two of the rays' votes). Where both sides are open
 //    (a single scan of a scene, an open sheet) or both closed (the inside of a room), the rays have
-//    no say and the tree's sign stays. On a closed surface (at most 5% of the points that cast
-//    rays see out on both sides: a CAD part, an object scanned all round) the rays are trusted
-//    more: offsets along the normals within the noise do not cut the tree, a piece whose rays
-//    disagree is split where they do (unless the cloud is clean and flat-faced), a tenth of a
-//    piece's points voting against it suffice, and fragments smaller than k points do not vouch for
-//    a neighbour's sign. Open scans keep the cautious rules: there a floor under a table top looks
-//    like an inside (the real table scan without its viewpoint, with the closed rules: 49.6% of the
-//    normals facing away from the scanner, the scene split in two, against 84.9%, the scene turned
-//    as a whole). Components that faced a viewpoint (faceViewpoint) cast no rays: a scan's line of
-//    sight is better evidence.
+//    no say and the tree's sign stays. On a closed surface (a component of the graph where at most
+//    5% of the points that cast rays see out on both sides: a CAD part, an object scanned all
+//    round, a pipe floating above an open floor) the rays are trusted more: offsets along the
+//    normals within the noise do not cut the tree, a piece whose rays disagree is split where they
+//    do (unless the cloud is clean and flat-faced), a tenth of a piece's points voting against it
+//    suffice, and fragments smaller than k points do not vouch for a neighbour's sign. Open scans
+//    keep the cautious rules: there a floor under a table top looks like an inside (the real table
+//    scan without its viewpoint, with the closed rules: 49.6% of the normals facing away from the
+//    scanner, the scene split in two, against 84.9%, the scene turned as a whole). Components that
+//    faced a viewpoint (faceViewpoint) cast no rays: a scan's line of sight is better evidence.
 //  - Viewpoint: flipped so that n . (viewpoint - p) >= 0; unreliable when the view ray grazes the
 //    surface, |cos(n, viewpoint - p)| < grazingThreshold, or p == viewpoint.
 #include <cstdint>
@@ -78,8 +78,8 @@ struct NormalOrientationOptions {
   /// the scanner, whatever its frame's z (the table scan of python3-pcl, in the sensor's frame:
   /// with +z seeds 85% of its normals faced away from the sensor, the floor's and the table
   /// top's pointing down; 6.0% with this). Not where the viewpoint lies within a component's
-  /// bounding box or farther from it than its diagonal (a frame's origin, not a scanner). The
-  /// visibility correction runs after it.
+  /// bounding box, nor anywhere when it lies farther from the cloud's box than the cloud's
+  /// diagonal (a frame's origin, not a scanner). The visibility correction runs after it.
   bool faceViewpoint = false;
 };
 
@@ -89,8 +89,10 @@ struct NormalOrientationResult {
   std::size_t componentCount = 0;   // MST: connected components of the graph (0 for Viewpoint)
   std::size_t pieceCount = 0;       // MST, visibility: pieces of the cut tree
   std::size_t piecesFlipped = 0;    // MST, visibility: pieces the rays turned over
-  /// MST, visibility: the rays found a closed surface (at most 5% of the points that cast rays
-  /// see out on both sides; file comment).
+  /// MST, visibility: the components of the graph the rays found closed (at most 5% of the points
+  /// that cast rays see out on both sides; file comment), and whether every component that cast
+  /// rays is (an object scanned all round, a CAD part).
+  std::size_t closedComponents = 0;
   bool closedSurface = false;
   std::vector<std::uint8_t> reliable;  // one per point, see the file comment
 };

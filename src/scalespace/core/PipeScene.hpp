@@ -4,7 +4,9 @@
 // of torus, straight), a tapering pipe (cone), a cable of three strands twisted around a common
 // axis (three thin tubes at a small scale, one thick tube at a large one), and what must not become
 // a cylinder: a floor, a wall and a box standing on the floor. Sampled uniformly by area with exact
-// outward normals.
+// outward normals. The cable's strands hide each other: no point is kept whose ray along its
+// normal meets another strand (the channel between them, the bottoms of their grooves), which no
+// scanner sees.
 //
 // Columns: "gt_pipe" (int32: PipeTruth::id, -1 on the floor, wall and box) and "gt_part" (int32:
 // for the bent pipe 0 / 1 / 2 = first straight / elbow / second straight, for the cable the strand
@@ -24,7 +26,8 @@ struct PipeSceneOptions {
   double noise = 0.0;
   std::uint64_t seed = 1;
   /// Keep only what a scanner above and in front of the rack sees (normals facing
-  /// oneSidedView): every pipe is seen from one side, a half-pipe (no occlusion is modelled).
+  /// oneSidedView): every pipe is seen from one side, a half-pipe (what hides a point from this
+  /// scanner is not modelled, only what hides it from every one: the cable's channel).
   bool oneSided = false;
   Vec3 oneSidedView{0.3, -0.5, 1.0};
 };
