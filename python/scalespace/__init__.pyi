@@ -31,7 +31,7 @@ def write(path: str, points: Union[Cloud, ArrayLike], normals: Optional[ArrayLik
           attributes: Optional[Mapping[str, ArrayLike]] = ..., *, ascii: bool = ...) -> None: ...
 def estimate_normals(points: ArrayLike, *, k: int = ..., orient: str = ...,
                      viewpoint: Optional[Sequence[float]] = ..., across_weight: float = ...,
-                     visibility: bool = ..., sheet: float = ...,
+                     visibility: bool = ..., sheet: float = ..., max_k: Optional[int] = ...,
                      threads: Optional[int] = ..., progress: Progress = ...) -> Tuple[np.ndarray, np.ndarray]: ...
 def curvature(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               scale: Optional[float] = ..., scale_k: Optional[int] = ..., estimator: str = ...,

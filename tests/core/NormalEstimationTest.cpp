@@ -288,3 +288,42 @@ TEST(NormalEstimation, SheetNormalsOfSmoothSurfacesAreThePcaOnes) {
     worst = std::max(worst, angleDegrees(thin.normals[i], pca.normals[i]));
   EXPECT_GT(worst, 1.0);
 }
+
+// Noise comparable to the sampling: a plane with Gaussian noise 0.8 spacings. Ten neighbours' PCA
+// planes follow the noise; k doubles (NormalEstimationOptions::maxK) until the normals of k and 2k
+// agree, the same for any thread count. A clean plane and maxK = k keep k.
+TEST(NormalEstimation, NoiseComparableToTheSamplingDoublesK) {
+  std::mt19937_64 rng(61);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  std::vector<Vec3> points(40000);
+  for (Vec3& p : points) p = Vec3(u(rng), u(rng), noise(rng));  // spacing 0.005
+  const auto medianError = [&](const NormalEstimationResult& r) {
+    std::vector<double> angles;
+    for (const Vec3& n : r.normals)
+      angles.push_back(std::min(angleDegrees(n, Vec3::UnitZ()), angleDegrees(-n, Vec3::UnitZ())));
+    std::nth_element(angles.begin(), angles.begin() + std::ptrdiff_t(angles.size() / 2),
+                     angles.end());
+    return angles[angles.size() / 2];
+  };
+  NormalEstimationOptions fixed;
+  fixed.maxK = fixed.k;
+  const NormalEstimationResult ten = estimateNormals(points, fixed);
+  NormalEstimationResult adapted, adaptedOneThread;
+  adapted = estimateNormals(points);
+  {
+    const ThreadLimit one(1);
+    adaptedOneThread = estimateNormals(points);
+  }
+  EXPECT_EQ(ten.k, 10u);
+  EXPECT_GE(adapted.k, 20u);
+  EXPECT_LE(adapted.k, NormalEstimationOptions{}.maxK);
+  EXPECT_GT(medianError(ten), 20.0);
+  EXPECT_LT(medianError(adapted), 15.0);
+  EXPECT_EQ(adapted.k, adaptedOneThread.k);
+  EXPECT_EQ(adapted.normals, adaptedOneThread.normals);
+  EXPECT_EQ(estimateNormals(testclouds::plane(40000, 1.0, 62)).k, 10u);
+  NormalEstimationOptions bad;
+  bad.maxNoiseAngleDegrees = 0;
+  EXPECT_THROW(estimateNormals(points, bad), OptionError);
+}

@@ -70,12 +70,16 @@ void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions&
   if (cloud.hasNormals()) return;
   if (!quiet)
     std::fprintf(stderr,
-                 "input has no normals: estimating (%s, %zu neighbours) and orienting (MST%s)\n",
+                 "input has no normals: estimating (%s, %zu neighbours, up to %zu under noise) and "
+                 "orienting (MST%s)\n",
                  estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k,
+                 std::max(estimation.k, estimation.maxK),
                  cloud.viewpoint() ? ", facing the file's viewpoint" : "");
   auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationResult est =
       estimateNormals(cloud.positions(), *index, estimation, makeProgressBar(quiet));
+  if (!quiet && est.k != estimation.k)
+    std::fprintf(stderr, "normals: noisy input, estimated over %zu neighbours\n", est.k);
   NormalOrientationOptions orientation;
   faceFileViewpoint(cloud, orientation);
   orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid,

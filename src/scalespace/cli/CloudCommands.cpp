@@ -177,6 +177,7 @@ void addGenerateCommand(CLI::App& app) {
 // ------------------------------------------------------------------------------------- normals
 struct NormalArgs {
   std::size_t k = 10;
+  std::size_t maxK = NormalEstimationOptions{}.maxK;
   std::vector<std::string> orient{"mst"};
   double acrossWeight = NormalOrientationOptions{}.acrossWeight;
   bool visibility = NormalOrientationOptions{}.visibility;
@@ -185,6 +186,11 @@ struct NormalArgs {
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
   cmd.add_option("--k", a.k, "neighbours for PCA normals and the orientation graph")
+      ->capture_default_str();
+  cmd.add_option("--max-k", a.maxK,
+                 "under noise comparable to the sampling, the PCA's k doubles up to this while the "
+                 "normals of k and 2k neighbours differ by more than 12 degrees (median); <= --k: "
+                 "k as given")
       ->capture_default_str();
   cmd.add_option("--orient", a.orient,
                  "orientation: 'mst' (Hoppe 1992 propagation, seeds towards +z, or each part "
@@ -251,6 +257,7 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
   const auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationOptions eo;
   eo.k = a.k;
+  eo.maxK = a.maxK;
   eo.sheetTolerance = a.sheet;
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
   NormalOrientationResult ori =
@@ -262,7 +269,7 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
     std::fprintf(stderr,
                  "normals: %zu estimated (k = %zu), %zu degenerate, %zu flipped, %zu without a "
                  "reliable orientation (normal_reliable = 0)%s\n",
-                 cloud.size(), a.k, est.invalidCount, ori.flippedCount, ori.unreliableCount,
+                 cloud.size(), est.k, est.invalidCount, ori.flippedCount, ori.unreliableCount,
                  orientation.faceViewpoint ? "; the tree's parts face the file's VIEWPOINT" : "");
 }
 

@@ -106,6 +106,56 @@ Vec3 sheetNormal(const std::vector<Vec3>& points, std::size_t i, std::vector<Nei
   return refit.valid ? refit.normal : best;
 }
 
+/// NormalEstimationOptions::maxK: the smallest k (k, 2k, 4k, ... up to maxK) whose normals
+/// differ from those of twice as many neighbours by at most maxNoiseAngleDegrees, median over
+/// about 20,000 points spread through the cloud (every stride-th in index order; the same for any
+/// thread count).
+std::size_t noiseAdaptedK(const std::vector<Vec3>& points, const SpatialIndex& index,
+                          const NormalEstimationOptions& options) {
+  std::size_t k = options.k;
+  if (options.radius > 0.0 || options.maxK <= k) return k;
+  const std::size_t n = points.size();
+  const std::size_t stride = std::max<std::size_t>(1, n / 20000);
+  std::vector<std::size_t> sample;
+  for (std::size_t i = 0; i < n; i += stride) sample.push_back(i);
+  const double maxCos = std::cos(options.maxNoiseAngleDegrees * M_PI / 180.0);
+  tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
+  const auto normalsAt = [&](std::size_t count, std::vector<Vec3>& normals,
+                             std::vector<std::uint8_t>& valid) {
+    normals.assign(sample.size(), Vec3::Zero());
+    valid.assign(sample.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sample.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        std::vector<Neighbor>& nbrs = scratch.local();
+                        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                          index.knnSearch(points[sample[s]], count, nbrs);
+                          const LocalNormal r = fitPlane(points, nbrs, options.colinearity);
+                          normals[s] = r.normal;
+                          valid[s] = r.valid ? 1 : 0;
+                        }
+                      });
+  };
+  std::vector<Vec3> current, doubled;
+  std::vector<std::uint8_t> currentValid, doubledValid;
+  normalsAt(k, current, currentValid);
+  while (2 * k <= options.maxK && 2 * k <= std::min(n, kMaxNeighborCount)) {
+    normalsAt(2 * k, doubled, doubledValid);
+    std::vector<double> cosines;
+    for (std::size_t s = 0; s < sample.size(); ++s)
+      if (currentValid[s] && doubledValid[s])
+        cosines.push_back(std::abs(current[s].dot(doubled[s])));
+    if (cosines.empty()) break;
+    // The median angle is above the bound when the median cosine is below its cosine.
+    std::nth_element(cosines.begin(), cosines.begin() + std::ptrdiff_t(cosines.size() / 2),
+                     cosines.end());
+    if (cosines[cosines.size() / 2] >= maxCos) break;
+    k *= 2;
+    current.swap(doubled);
+    currentValid.swap(doubledValid);
+  }
+  return k;
+}
+
 }  // namespace
 
 NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const SpatialIndex& index,
@@ -125,8 +175,12 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
     throw OptionError("NormalEstimationOptions::sheetTolerance must be finite and >= 0");
   if (!(options.sheetNoiseFactor >= 0) || !std::isfinite(options.sheetNoiseFactor))
     throw OptionError("NormalEstimationOptions::sheetNoiseFactor must be finite and >= 0");
+  if (!(options.maxNoiseAngleDegrees > 0) || !(options.maxNoiseAngleDegrees < 90))
+    throw OptionError("NormalEstimationOptions::maxNoiseAngleDegrees must be in (0, 90), got " +
+                      std::to_string(options.maxNoiseAngleDegrees));
   const std::size_t n = points.size();
   NormalEstimationResult result;
+  result.k = options.radius > 0.0 ? 0 : noiseAdaptedK(points, index, options);
   result.normals.assign(n, Vec3::UnitZ());
   result.surfaceVariation.assign(n, 1.0 / 3.0);
   result.valid.assign(n, 0);
@@ -141,7 +195,7 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
     if (options.radius > 0.0)
       index.radiusSearch(points[i], options.radius, nbrs);
     else
-      index.knnSearch(points[i], options.k, nbrs);
+      index.knnSearch(points[i], result.k, nbrs);
   };
   std::vector<double> rms(n, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),

@@ -74,10 +74,11 @@ struct NormalOrientationOptions {
   double grazingThreshold = 0.05;  // Viewpoint: |cos| below which the sign is unreliable
   /// MST (not in Hoppe 1992): after the propagation, each piece of the tree (cut where its sign
   /// is a guess, as for the visibility correction) whose normals face away from `viewpoint` (a
-  /// scanner's position; mean cosine below -0.1) is turned over: a single scan's surfaces face
-  /// the scanner, whatever its frame's z (the table scan of python3-pcl, in the sensor's frame:
-  /// with +z seeds 85% of its normals faced away from the sensor, the floor's and the table
-  /// top's pointing down; 6.0% with this). Not where the viewpoint lies within a component's
+  /// scanner's position; mean cosine below -0.1) is turned over, then each point still facing
+  /// away beyond grazing (cosine below -0.1): a single scan's surfaces face the scanner, whatever
+  /// its frame's z (the table scan of python3-pcl, in the sensor's frame: with +z seeds 85% of
+  /// its normals faced away from the sensor, the floor's and the table top's pointing down; 4.1%
+  /// with this, the grazing ones). Not where the viewpoint lies within a component's
   /// bounding box, nor anywhere when it lies farther from the cloud's box than the cloud's
   /// diagonal (a frame's origin, not a scanner). The visibility correction runs after it.
   bool faceViewpoint = false;

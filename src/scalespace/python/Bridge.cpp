@@ -385,7 +385,8 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress, double acrossWeight,
-                                            bool visibility, double sheetTolerance) {
+                                            bool visibility, double sheetTolerance,
+                                            std::size_t maxK) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
   if (k >= cloud.size())
@@ -411,6 +412,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   const auto index = makeSpatialIndex(cloud.positions());
   NormalEstimationOptions eo;
   eo.k = k;
+  eo.maxK = maxK;
   eo.sheetTolerance = sheetTolerance;
   NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
   NormalOrientationResult ori =

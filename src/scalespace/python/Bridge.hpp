@@ -138,7 +138,8 @@ class Call {
   std::unique_ptr<py::error_already_set> pending_;  // raised by the callback or by Ctrl-C
 };
 
-/// Estimates (PCA over k neighbours) and orients normals in place, as `scalespace normals` and
+/// Estimates (PCA over k neighbours, doubled up to maxK under heavy noise) and orients normals in
+/// place, as `scalespace normals` and
 /// the commands that need normals do: orient "mst" or "viewpoint" (then `viewpoint`, absolute
 /// coordinates, is required). Returns the per-point reliability of the orientation. Needs no GIL.
 std::vector<std::uint8_t> estimateAndOrient(
@@ -146,7 +147,8 @@ std::vector<std::uint8_t> estimateAndOrient(
     const std::optional<Vec3>& viewpoint = std::nullopt, const ProgressCallback& progress = {},
     double acrossWeight = NormalOrientationOptions{}.acrossWeight,
     bool visibility = NormalOrientationOptions{}.visibility,
-    double sheetTolerance = NormalEstimationOptions{}.sheetTolerance);
+    double sheetTolerance = NormalEstimationOptions{}.sheetTolerance,
+    std::size_t maxK = NormalEstimationOptions{}.maxK);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);

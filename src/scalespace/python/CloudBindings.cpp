@@ -93,13 +93,14 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
                     const py::handle& viewpoint, double acrossWeight, bool visibility, double sheet,
-                    std::optional<int> threads, py::object progress) {
+                    std::optional<std::size_t> maxK, std::optional<int> threads,
+                    py::object progress) {
   PooledCloud cloud = makeCloud(asPoints(points), py::none());
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   Call call(std::move(progress), threads);
   std::vector<std::uint8_t> reliable = call([&] {
     return estimateAndOrient(cloud, k, orient, view, call.progress(), acrossWeight, visibility,
-                             sheet);
+                             sheet, maxK.value_or(std::max(k, NormalEstimationOptions{}.maxK)));
   });
   py::array_t<bool> reliableArray(py::ssize_t(reliable.size()));
   for (std::size_t i = 0; i < reliable.size(); ++i) reliableArray.mutable_data()[i] = reliable[i];
@@ -279,9 +280,13 @@ void bindClouds(py::module_& m) {
   m.def("estimate_normals", &normalsPy, "points"_a, py::kw_only(), "k"_a = 10, "orient"_a = "mst",
         "viewpoint"_a = py::none(), "across_weight"_a = NormalOrientationOptions{}.acrossWeight,
         "visibility"_a = NormalOrientationOptions{}.visibility,
-        "sheet"_a = NormalEstimationOptions{}.sheetTolerance, "threads"_a = py::none(),
-        "progress"_a = py::none(),
+        "sheet"_a = NormalEstimationOptions{}.sheetTolerance, "max_k"_a = py::none(),
+        "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Estimates (PCA over k neighbours) and orients normals, as `scalespace normals`.
+
+max_k: under noise comparable to the sampling, k doubles up to max_k (default 80) while the
+normals of k and 2k neighbours differ by more than 12 degrees (median over a sample); max_k=k
+keeps k as given.
 
 orient: "mst" (Hoppe 1992 propagation, seeds towards +z; with viewpoint=(x, y, z), each
 connected part instead faces it, as `scalespace` does with a PCD's VIEWPOINT: Cloud.viewpoint) or
