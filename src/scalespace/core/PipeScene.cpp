@@ -122,11 +122,7 @@ bool insideOtherStrand(const Vec3& start, int k, const Vec3& p) {
   return false;
 }
 
-// Whether the ray from a point of strand k along `direction` (unit) meets another strand. Along
-// the point's normal, the best line of sight it has: no scanner sees into the channel between the
-// three strands or the bottoms of the grooves where two touch. Without this the scene held points
-// no scan has (a third of the cable's, facing into a channel 2 cm wide) whose normals no estimate
-// could orient (bench/README.md, bench_cylinders --estimate-normals).
+// Whether the ray from a point of strand k along `direction` (unit) meets another strand.
 bool occludedByOtherStrand(const Vec3& start, int k, const Vec3& p, const Vec3& direction) {
   constexpr double kStep = 0.004, kReach = 0.24;  // beyond the cable's diameter (0.22 m)
   for (double d = kStep; d <= kReach; d += kStep) {
@@ -142,6 +138,26 @@ bool occludedByOtherStrand(const Vec3& start, int k, const Vec3& p, const Vec3& 
     }
   }
   return false;
+}
+
+// Whether the other strands hide a point of strand k (outward `normal`): from `scanner` when
+// given (the line to it is blocked), else from every scanner around the cable (the lines along
+// the normal and along eight directions 50 degrees from it, an incidence a scan still returns,
+// all blocked). Without this the scene held points no scan has (a third of the cable's, facing
+// into the channel 2 cm wide between the strands) whose normals no estimate could orient
+// (bench/README.md, bench_cylinders --estimate-normals).
+bool hiddenByOtherStrands(const Vec3& start, int k, const Vec3& p, const Vec3& normal,
+                          const Vec3* scanner) {
+  if (scanner) return occludedByOtherStrand(start, k, p, (*scanner - p).normalized());
+  if (!occludedByOtherStrand(start, k, p, normal)) return false;
+  const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
+  const double c = std::cos(50 * kPi / 180), s = std::sin(50 * kPi / 180);
+  for (int a = 0; a < 8; ++a) {
+    const double psi = a * kPi / 4;
+    const Vec3 d = c * normal + s * (std::cos(psi) * u + std::sin(psi) * v);
+    if (!occludedByOtherStrand(start, k, p, d)) return false;
+  }
+  return true;
 }
 
 const Vec3 kCableStart{-2.0, -0.9, 0.6};
@@ -228,7 +244,6 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
   std::vector<double> cumulative;
   double total = 0;
   for (const Patch& patch : patches) cumulative.push_back(total += patch.area);
-  const Vec3 view = options.oneSidedView.normalized();
 
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -245,12 +260,14 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
     if (uniform(rng) * patch.maxJacobian > jacobian(patch, u, v)) continue;
     Vec3 p, normal;
     patch.eval(u, v, p, normal);
-    if (options.oneSided && normal.dot(view) <= 0) continue;
+    if (options.oneSided && normal.dot(options.oneSidedScanner - p) <= 0) continue;
     if (k == 0 && p.x() > kBoxLo.x() && p.x() < kBoxHi.x() && p.y() > kBoxLo.y() &&
         p.y() < kBoxHi.y())
       continue;  // floor under the box
-    if (patch.pipe == 5 && (insideOtherStrand(kCableStart, patch.part, p) ||
-                            occludedByOtherStrand(kCableStart, patch.part, p, normal)))
+    if (patch.pipe == 5 &&
+        (insideOtherStrand(kCableStart, patch.part, p) ||
+         hiddenByOtherStrands(kCableStart, patch.part, p, normal,
+                              options.oneSided ? &options.oneSidedScanner : nullptr)))
       continue;
     positions[i] = p;
     normals[i] = normal;
@@ -272,6 +289,7 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
   cloud.setNormals(std::move(normals));
   cloud.addAttribute("gt_pipe", ScalarType::Int32).values = std::move(pipe);
   cloud.addAttribute("gt_part", ScalarType::Int32).values = std::move(part);
+  if (options.oneSided) cloud.setViewpoint(options.oneSidedScanner);
   return cloud;
 }
 

@@ -4,9 +4,9 @@
 // of torus, straight), a tapering pipe (cone), a cable of three strands twisted around a common
 // axis (three thin tubes at a small scale, one thick tube at a large one), and what must not become
 // a cylinder: a floor, a wall and a box standing on the floor. Sampled uniformly by area with exact
-// outward normals. The cable's strands hide each other: no point is kept whose ray along its
-// normal meets another strand (the channel between them, the bottoms of their grooves), which no
-// scanner sees.
+// outward normals. The cable's strands hide each other: a full scan has no point that every line
+// of sight within 50 degrees of its normal leaves blocked by another strand (the channel between
+// them, the bottoms of their grooves), a one-sided scan none whose line to its scanner is.
 //
 // Columns: "gt_pipe" (int32: PipeTruth::id, -1 on the floor, wall and box) and "gt_part" (int32:
 // for the bent pipe 0 / 1 / 2 = first straight / elbow / second straight, for the cable the strand
@@ -26,10 +26,10 @@ struct PipeSceneOptions {
   double noise = 0.0;
   std::uint64_t seed = 1;
   /// Keep only what a scanner above and in front of the rack sees (normals facing
-  /// oneSidedView): every pipe is seen from one side, a half-pipe (what hides a point from this
-  /// scanner is not modelled, only what hides it from every one: the cable's channel).
+  /// oneSidedScanner, which the cloud's viewpoint() holds): every pipe is seen from one side, a
+  /// half-pipe (the other pipes do not hide each other; the cable's strands do).
   bool oneSided = false;
-  Vec3 oneSidedView{0.3, -0.5, 1.0};
+  Vec3 oneSidedScanner{1.3, -2.2, 4.8};
 };
 
 enum class PipeKind { Straight, Bent, Tapering, Cable };
