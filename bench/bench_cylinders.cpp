@@ -14,6 +14,7 @@
 //                   Default: the scene's exact normals)
 //                   [--normal-k K] (with --estimate-normals: K neighbours, fixed; default: 10,
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
+//                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -344,14 +345,16 @@ int main(int argc, char** argv) {
       ours.oneCurvatureSign = true;
     else if (a == "--estimate-normals")
       estimate = true;
+    else if (a == "--min-arc" && i + 1 < argc)
+      ours.tube.minArcDegrees = std::stod(argv[++i]);
     else if (a == "--normal-k" && i + 1 < argc)
       normalK = std::stoul(argv[++i]);
     else {
-      std::fprintf(
-          stderr,
-          "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
-          "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
-          "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] [--normal-k K]\n");
+      std::fprintf(stderr,
+                   "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
+                   "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
+                   "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] [--normal-k "
+                   "K] [--min-arc DEGREES]\n");
       return 2;
     }
   }

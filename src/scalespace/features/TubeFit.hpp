@@ -28,7 +28,11 @@ struct TubeFitOptions {
   /// The points and their own normals must both turn around the axis by at least this: a
   /// half-pipe scan covers 180 degrees, a full pipe 360, while the two faces of a box edge,
   /// rounded by the fit into a tube of radius ~t at every scale, give two normal directions only.
-  double minArcDegrees = 120;
+  /// Counted in 15-degree bins, those two directions fill 120 degrees once noise or normals
+  /// estimated over many neighbours smear them: every tube the pipe rack's box gave with
+  /// estimated normals covered exactly 120 (bench_cylinders --estimate-normals: 13 and 3 false
+  /// cylinders at 120, none at 135; the pipes and the real table scan's legs, 165, unchanged).
+  double minArcDegrees = 135;
   /// A tube much thinner than the scale is not one the fits saw: its whole section lies in one
   /// support. Radius >= minRadiusFactor * t.
   double minRadiusFactor = 0.25;

@@ -215,9 +215,10 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
       });
   m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
-        "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5, "min_arc"_a = 120.0,
-        "max_rms"_a = 0.25, "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
-        "threads"_a = py::none(), "progress"_a = py::none(),
+        "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5,
+        "min_arc"_a = TubeFitOptions{}.minArcDegrees, "max_rms"_a = 0.25,
+        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign, "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
 Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube fitted to each
