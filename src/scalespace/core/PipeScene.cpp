@@ -125,18 +125,8 @@ bool insideOtherStrand(const Vec3& start, int k, const Vec3& p) {
 // Whether the ray from a point of strand k along `direction` (unit) meets another strand.
 bool occludedByOtherStrand(const Vec3& start, int k, const Vec3& p, const Vec3& direction) {
   constexpr double kStep = 0.004, kReach = 0.24;  // beyond the cable's diameter (0.22 m)
-  for (double d = kStep; d <= kReach; d += kStep) {
-    const Vec3 q = p + d * direction;
-    for (int j = 0; j < 3; ++j) {
-      if (j == k) continue;
-      // The strands lean 25 degrees from the axis: the nearest centre lies within 3 cm of q's
-      // abscissa.
-      for (int step = -6; step <= 6; ++step) {
-        const double s = q.x() - start.x() + 0.005 * step;
-        if ((q - strandCentre(start, j, s)).norm() < kStrandRadius) return true;
-      }
-    }
-  }
+  for (double d = kStep; d <= kReach; d += kStep)
+    if (insideOtherStrand(start, k, p + d * direction)) return true;
   return false;
 }
 
