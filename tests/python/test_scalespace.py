@@ -151,6 +151,24 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     assert "Options::" not in str(e.value)
 
 
+def test_noisy_normals_take_more_neighbours_as_the_cli_does(tmp_path):
+    # A plane with noise 0.8 spacings: the normals of 10 neighbours follow the noise; k doubles
+    # (max_k, default 80) until they do not. max_k=k keeps k; the CLI's --max-k is the same.
+    rng = np.random.default_rng(11)
+    points = np.stack([rng.uniform(0, 1, 40000), rng.uniform(0, 1, 40000),
+                       rng.normal(0, 0.004, 40000)], axis=1).astype(np.float32)
+    error = lambda n: np.median(np.degrees(np.arccos(np.clip(np.abs(n[:, 2]), 0, 1))))
+    adapted, _ = ss.estimate_normals(points)
+    fixed, _ = ss.estimate_normals(points, max_k=10)
+    assert error(fixed) > 20 and error(adapted) < 15
+    ss.write(str(tmp_path / "bare.ply"), points)
+    for flags, expected in ((("--max-k", 10), fixed), ((), adapted)):
+        cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", *flags)
+        got = columns(tmp_path / "n.ply")
+        for c, name in enumerate(("nx", "ny", "nz")):
+            np.testing.assert_array_equal(expected[:, c].astype(np.float32), got[name], name)
+
+
 def test_a_pcd_viewpoint_orients_the_normals_as_the_cli_does(tmp_path):
     # A ridge scanned from below (z away from the ground): its parts turn to face the PCD's
     # VIEWPOINT (the +z seeds alone orient it away), and the ridge, seen from the scanner, is a
