@@ -8,7 +8,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -114,10 +113,10 @@ double noiseOffset(const std::vector<float>& spread) {
 /// The tree cut where its sign decision is a guess: a crease (|cos| < creaseThreshold) or an edge
 /// across a thin part (acrossSheet with `minOffset` of the edge's child). `parent` and `treeOrder`
 /// are the tree (parents first); returns the number of pieces.
+template <class MinOffset>
 Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented,
               const std::vector<Index>& parent, const std::vector<Index>& treeOrder,
-              double creaseThreshold, const std::function<double(Index)>& minOffset,
-              std::vector<Index>& piece) {
+              double creaseThreshold, const MinOffset& minOffset, std::vector<Index>& piece) {
   Index pieces = 0;
   for (const Index c : treeOrder) {
     const Index p = parent[c];
@@ -198,10 +197,9 @@ void splitMixedPieces(const std::vector<Index>& parent, const std::vector<Index>
 /// The visibility correction trusts the rays more on a closed surface: there, a point's rays
 /// escape on one side at most. When no more than this share of the points of a component of the
 /// graph that cast rays see out on both sides (3 of 5 rays each), the component is taken as
-/// closed. Measured: libcgal-demo's
-/// CAD parts sampled (bench_features) 0.3-0.5%, noisy blade 2.5%, clean blade 6.9% (rays pass
-/// through its thin rim), kitten, ball, blobby, sphere_20k_normal 0-0.4%; open scans: the real
-/// table scan 38%, hippo1 99%, building 18%, spheres 17%, oni 11%.
+/// closed. Measured: libcgal-demo's CAD parts sampled (bench_features) 0.3-0.5%, noisy blade 2.5%,
+/// clean blade 6.9% (rays pass through its thin rim), kitten, ball, blobby, sphere_20k_normal
+/// 0-0.4%; open scans: the real table scan 38%, hippo1 99%, building 18%, spheres 17%, oni 11%.
 constexpr double kClosedOpenShare = 0.05;
 
 /// The rays of one side of a point: along the normal and four tilted 25 degrees around it.
@@ -228,9 +226,8 @@ constexpr double kEdgeWeight = 2.0;
 /// votes against its side are at least a quarter of its points (a tenth on a closed surface) and
 /// more than twice those for. On the closed components (kClosedOpenShare) the tree is cut again
 /// with the noise taken into account (noiseOffset() of the points' off-plane `spread`,
-/// acrossSheet) and the mixed pieces are split (splitMixedPieces()). Points whose component faced a
-/// viewpoint
-/// (`settled`) cast no votes: a scan's line of sight is better evidence than the rays.
+/// acrossSheet) and the mixed pieces are split (splitMixedPieces()). Points whose component faced
+/// a viewpoint (`settled`) cast no votes: a scan's line of sight is better evidence than the rays.
 void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& oriented,
                          const SpatialIndex& index, const std::vector<std::uint8_t>& inGraph,
                          const std::vector<std::uint8_t>& settled,
@@ -308,9 +305,7 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   const double noise = anyClosed ? noiseOffset(spread) : 0.0;
   const auto noiseAt = [&](std::size_t i) { return isClosed(i) ? noise : 0.0; };
   if (anyClosed) {
-    pieces = cutTree(
-        points, oriented, parent, treeOrder, options.creaseThreshold,
-        [&](Index c) { return noiseAt(c); }, piece);
+    pieces = cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, noiseAt, piece);
     members = countMembers(piece, pieces, treeOrder);
     // Not on flat-faced clean clouds (median off-plane spread under a thousandth of the spacing;
     // curvature or noise lift it above): there the cuts are where the sides meet, and a piece
