@@ -154,7 +154,7 @@ def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               scales: Optional[Sequence[float]] = ..., scale_count: int = ..., tmin: float = ...,
               tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,
               min_arc: float = ..., max_rms: float = ..., one_curvature_sign: bool = ...,
-              threads: Optional[int] = ...,
+              max_gap: int = ..., threads: Optional[int] = ...,
               progress: Progress = ...) -> Cylinders: ...
 
 def parametrize(points: ArrayLike, normals: Optional[ArrayLike] = ..., *, scales: int = ...,

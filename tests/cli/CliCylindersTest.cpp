@@ -74,6 +74,11 @@ TEST_F(Cli, CylindersFindThePipesOfTheRack) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("id,birth_level,birth_scale,death_level,death_scale,persistence", 0), 0u);
+  EXPECT_NE(header.find(",gap_levels"), std::string::npos);
+  for (const auto& c : result["components"])
+    EXPECT_EQ(
+        c["persistence"].get<int>(),
+        c["death_level"].get<int>() - c["birth_level"].get<int>() - c["gap_levels"].get<int>());
 
   // Labels at one scale, and only persistent components: fewer points labelled. The folder is an
   // earlier result, so it is replaced.
@@ -123,6 +128,9 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("c.ply") + " --min-arc 500 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--min-arc"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --max-gap -1 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--max-gap"), std::string::npos) << r.err;
   r = run("cylinders " + path("c.ply") + " --tmin 1 --tmax 0.5 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--tmax"), std::string::npos) << r.err;

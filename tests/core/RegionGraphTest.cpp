@@ -2,6 +2,7 @@
 // (Sec. 2.3.2-2.3.3), on plain index lists.
 #include <gtest/gtest.h>
 
+#include <utility>
 #include <vector>
 
 #include "scalespace/core/Error.hpp"
@@ -58,6 +59,38 @@ TEST(RegionGraph, LabelQueriesOnAMembership) {
   EXPECT_EQ(nearestScaleIndex({0.1, 0.2, 0.4}, 1e-9), 0);
   EXPECT_THROW(nearestScaleIndex({}, 1), OptionError);
   EXPECT_THROW(nearestScaleIndex({0.1}, -1), OptionError);
+}
+
+// A chain may bridge levels where its region was not found (maxGap): it then holds no region
+// there, and only the levels where it was found count in its persistence.
+TEST(RegionGraph, BridgesGapsWhenAsked) {
+  std::vector<RegionLevel> levels(5);
+  for (int j = 0; j < 5; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
+  levels[0].regions = {{0, 1, 2, 3}, {6, 7}};
+  levels[1].regions = {{0, 1, 2, 3, 4}};
+  levels[2].regions = {{5}};              // the first chain is not found here
+  levels[3].regions = {{0, 1, 2, 3, 5}};  // J with level 1's {0..4}: 4/6
+  levels[4].regions = {{6, 7}, {0, 1, 2, 3}};
+  // Without bridges: {0..3} at 0-1, {6,7} at 0, {5} at 2, {0..3,5} at 3-4, {6,7} at 4.
+  EXPECT_EQ(buildRegionGraph(levels, 8).components.size(), 5u);
+  const RegionGraph g = buildRegionGraph(levels, 8, 0.5, nullptr, 2);
+  ASSERT_EQ(g.components.size(), 4u);
+  const GraphComponent& tube = g.components[0];
+  EXPECT_EQ(tube.birthLevel, 0);
+  EXPECT_EQ(tube.deathLevel, 4);
+  EXPECT_EQ(tube.gapLevels, 1);
+  EXPECT_EQ(tube.persistence(), 3);
+  EXPECT_EQ(tube.regionAt, (std::vector<int>{0, 0, -1, 0, 1}));
+  EXPECT_EQ(g.bridge[1][0], (std::pair<int, int>{3, 0}));
+  // {6, 7} comes back after three missing levels: a gap of 3 > 2, so it is two components.
+  EXPECT_EQ(g.components[1].persistence(), 0);
+  EXPECT_EQ(g.componentLabels(2), (std::vector<int>{-1, -1, -1, -1, -1, 2, -1, -1}));
+  EXPECT_EQ(g.components[3].birthLevel, 4);
+  EXPECT_EQ(buildRegionGraph(levels, 8, 0.5, nullptr, 3).components.size(), 3u);
+  // The caller's test refuses a bridge (the tubes of both ends differ): no bridge is made.
+  const BridgeTest never = [](int, int, int, int) { return false; };
+  EXPECT_EQ(buildRegionGraph(levels, 8, 0.5, nullptr, 3, never).components.size(), 5u);
+  EXPECT_THROW(buildRegionGraph(levels, 8, 0.5, nullptr, -1), OptionError);
 }
 
 // Regions of different kinds are never linked, whatever their Jaccard index: the chain splits.

@@ -53,7 +53,7 @@ void writeComponentsCsv(const CylinderDetection& detection, const Vec3& origin,
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "id,birth_level,birth_scale,death_level,death_scale,persistence,representative_scale,"
            "point_count,straight,radius,radius_start,radius_end,rms,length,arc_degrees,dx,dy,dz,"
-           "cx,cy,cz\n";
+           "cx,cy,cz,gap_levels\n";
     out.precision(9);
     for (const CylinderComponent& c : detection.components) {
       const TubeFit& t = c.tube;
@@ -65,9 +65,10 @@ void writeComponentsCsv(const CylinderDetection& detection, const Vec3& origin,
           << t.radii.back() << ',' << t.rms << ',' << t.length << ',' << t.arcDegrees;
       if (t.straight)
         out << ',' << t.direction.x() << ',' << t.direction.y() << ',' << t.direction.z() << ','
-            << centre.x() << ',' << centre.y() << ',' << centre.z() << '\n';
+            << centre.x() << ',' << centre.y() << ',' << centre.z();
       else
-        out << ",,,,,,\n";  // a bent tube has no straight axis
+        out << ",,,,,,";  // a bent tube has no straight axis
+      out << ',' << c.gapLevels << '\n';
     }
   });
 }
@@ -83,6 +84,7 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
                            {"birth_scale", c.birthScale},
                            {"death_level", c.deathLevel},
                            {"death_scale", c.deathScale},
+                           {"gap_levels", c.gapLevels},
                            {"persistence", c.persistence},
                            {"representative_level", c.representativeLevel},
                            {"point_count", t.pointCount},
@@ -148,6 +150,10 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
+      ->capture_default_str();
+  cmd->add_option("--max-gap", args->cylinders.maxGapLevels,
+                  "a component bridges up to this many scales where its tube was not found (0: "
+                  "consecutive scales only, as the thesis)")
       ->capture_default_str();
   cmd->add_flag("--one-curvature-sign", args->cylinders.oneCurvatureSign,
                 "a region only grows over points curving the way its seed does, which stops it at "
@@ -238,6 +244,7 @@ void addCylindersCommand(CLI::App& app) {
           {"max_mean_variation", o.filter.maxMeanVariation},
           {"min_arc_degrees", o.tube.minArcDegrees},
           {"max_relative_rms", o.tube.maxRelativeRms},
+          {"max_gap_levels", o.maxGapLevels},
           {"curved_seeds_first", o.lines.curvedSeedsFirst},
           {"threads", args->threads}}},
         {"levels", levels},

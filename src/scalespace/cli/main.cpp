@@ -68,6 +68,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"CylinderOptions::epsilon", "--epsilon"},
     {"CylinderOptions::minAnisotropy", "--min-anisotropy"},
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
+    {"CylinderOptions::maxGapLevels", "--max-gap"},
     {"TubeFitOptions::maxRelativeRms", "--max-rms"},
     {"FlatteningOptions::scaleCount", "--scales"},
     {"FlatteningOptions::K", "--k"},

@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <unordered_map>
@@ -103,11 +104,39 @@ std::vector<int> RegionGraph::componentLabels(int level) const {
   return labels;
 }
 
+namespace {
+// For each region r of level `from` with wanted[r], the region of level `to` (of the same kind)
+// with Jaccard index > minJaccard, or -1. Regions of a level are disjoint, so J > 0.5 holds for
+// at most one: the answer does not depend on the order of the search.
+std::vector<int> linkLevels(const RegionGraph& graph, std::size_t from, std::size_t to,
+                            double minJaccard, const std::vector<std::vector<std::uint8_t>>* kinds,
+                            const std::vector<char>& wanted, const std::vector<char>& open) {
+  const std::vector<int> toLabels = regionLabels(graph.levels[to], graph.pointCount);
+  const auto& here = graph.levels[from].regions;
+  const auto& there = graph.levels[to].regions;
+  std::vector<int> link(here.size(), -1);
+  tbb::parallel_for(std::size_t(0), here.size(), [&](std::size_t r) {
+    if (!wanted[r]) return;
+    std::unordered_map<int, std::size_t> overlap;
+    for (Index i : here[r])
+      if (toLabels[i] >= 0) ++overlap[toLabels[i]];
+    for (const auto& [s, common] : overlap) {
+      if (!open[std::size_t(s)]) continue;
+      if (kinds && (*kinds)[from][r] != (*kinds)[to][std::size_t(s)]) continue;
+      const std::size_t unionSize = here[r].size() + there[std::size_t(s)].size() - common;
+      if (double(common) > minJaccard * double(unionSize)) link[r] = s;  // Eq. 2.1
+    }
+  });
+  return link;
+}
+}  // namespace
+
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
-                             double minJaccard,
-                             const std::vector<std::vector<std::uint8_t>>* kinds) {
+                             double minJaccard, const std::vector<std::vector<std::uint8_t>>* kinds,
+                             int maxGap, const BridgeTest& bridgeAllowed) {
   if (!(minJaccard >= 0.5 && minJaccard < 1))
     throw OptionError("the Jaccard threshold must be in [0.5, 1): below 0.5 links are ambiguous");
+  if (maxGap < 0) throw OptionError("region graph: the largest bridged gap must be >= 0 levels");
   if (kinds) {
     bool sized = kinds->size() == levels.size();
     for (std::size_t j = 0; sized && j < levels.size(); ++j)
@@ -119,34 +148,48 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
   graph.levels = std::move(levels);
   const std::size_t m = graph.levels.size();
   graph.successor.resize(m);
+  graph.bridge.resize(m);
   graph.componentOf.resize(m);
   std::vector<std::vector<int>> predecessor(m);
   for (std::size_t j = 0; j < m; ++j) {
-    graph.successor[j].assign(graph.levels[j].regions.size(), -1);
-    graph.componentOf[j].assign(graph.levels[j].regions.size(), -1);
-    predecessor[j].assign(graph.levels[j].regions.size(), -1);
+    const std::size_t count = graph.levels[j].regions.size();
+    graph.successor[j].assign(count, -1);
+    graph.bridge[j].assign(count, {-1, -1});
+    graph.componentOf[j].assign(count, -1);
+    predecessor[j].assign(count, -1);
   }
   // Edges between consecutive levels: the candidates of region r at level j are the regions of
   // level j+1 holding its points; J > 0.5 holds for at most one of them (and, symmetrically, for
   // at most one region of level j per region of level j+1).
   for (std::size_t j = 0; j + 1 < m; ++j) {
-    const std::vector<int> nextLabels = regionLabels(graph.levels[j + 1], pointCount);
-    const auto& here = graph.levels[j].regions;
-    const auto& next = graph.levels[j + 1].regions;
-    tbb::parallel_for(std::size_t(0), here.size(), [&](std::size_t r) {
-      std::unordered_map<int, std::size_t> overlap;
-      for (Index i : here[r])
-        if (nextLabels[i] >= 0) ++overlap[nextLabels[i]];
-      for (const auto& [s, common] : overlap) {
-        if (kinds && (*kinds)[j][r] != (*kinds)[j + 1][std::size_t(s)]) continue;
-        const std::size_t unionSize = here[r].size() + next[std::size_t(s)].size() - common;
-        if (double(common) > minJaccard * double(unionSize)) graph.successor[j][r] = s;  // Eq. 2.1
-      }
-    });
-    for (std::size_t r = 0; r < here.size(); ++r)
+    graph.successor[j] = linkLevels(graph, j, j + 1, minJaccard, kinds,
+                                    std::vector<char>(graph.levels[j].regions.size(), 1),
+                                    std::vector<char>(graph.levels[j + 1].regions.size(), 1));
+    for (std::size_t r = 0; r < graph.successor[j].size(); ++r)
       if (graph.successor[j][r] >= 0)
         predecessor[j + 1][std::size_t(graph.successor[j][r])] = int(r);
   }
+  // Bridges: chain ends to chain starts 1..maxGap levels further, shorter gaps first. Two ends of
+  // one level cannot both pass J > 0.5 with one start; an end of an earlier level that would,
+  // finds the start taken (one bridge per start, the first in this order).
+  for (int gap = 1; gap <= maxGap; ++gap)
+    for (std::size_t j = 0; j + std::size_t(gap) + 1 < m; ++j) {
+      const std::size_t k = j + std::size_t(gap) + 1;
+      std::vector<char> ends(graph.levels[j].regions.size()),
+          starts(graph.levels[k].regions.size());
+      for (std::size_t r = 0; r < ends.size(); ++r)
+        ends[r] = graph.successor[j][r] < 0 && graph.bridge[j][r].first < 0;
+      for (std::size_t s = 0; s < starts.size(); ++s) starts[s] = predecessor[k][s] < 0;
+      if (std::find(ends.begin(), ends.end(), 1) == ends.end()) continue;
+      const std::vector<int> link = linkLevels(graph, j, k, minJaccard, kinds, ends, starts);
+      for (std::size_t r = 0; r < link.size(); ++r) {
+        const int s = link[r];
+        if (s < 0 || predecessor[k][std::size_t(s)] >= 0) continue;
+        if (bridgeAllowed && !bridgeAllowed(int(j), int(r), int(k), s)) continue;
+        graph.bridge[j][r] = {int(k), s};
+        predecessor[k][std::size_t(s)] = int(r);
+      }
+    }
   // Chains start at the nodes without predecessor; levels and region indices increase, so the
   // component order (birth level, then region index) is deterministic.
   for (std::size_t j = 0; j < m; ++j)
@@ -161,9 +204,19 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
         c.regionAt.push_back(region);
         graph.componentOf[level][std::size_t(region)] = id;
         const int s = graph.successor[level][std::size_t(region)];
-        if (s < 0) break;
-        region = s;
-        ++level;
+        if (s >= 0) {
+          region = s;
+          ++level;
+          continue;
+        }
+        const auto [bridgeLevel, bridgeRegion] = graph.bridge[level][std::size_t(region)];
+        if (bridgeRegion < 0) break;
+        for (std::size_t g = level + 1; g < std::size_t(bridgeLevel); ++g) {
+          c.regionAt.push_back(-1);
+          ++c.gapLevels;
+        }
+        level = std::size_t(bridgeLevel);
+        region = bridgeRegion;
       }
       c.deathLevel = int(level);
       c.birthScale = graph.levels[j].t;

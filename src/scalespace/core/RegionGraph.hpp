@@ -3,9 +3,14 @@
 // scale (plain point-index lists, so any primitive's regions fit: the planes' filtered regions),
 // an edge joins regions of consecutive scales with Jaccard index > 0.5 (Eq. 2.1). Regions of one
 // scale are disjoint, so a node has at most one such successor and one such predecessor: the
-// components are chains, each with a birth and a death level.
+// components are chains, each with a birth and a death level. Optionally (not in the thesis) a
+// chain may bridge a gap: a region with no successor links, by the same rule, to a region of a
+// later level with no predecessor, when the levels between found nothing there (a pipe whose two
+// walls one scale's region growing joins into one rough region, then separates again).
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include "scalespace/core/Types.hpp"
@@ -24,15 +29,20 @@ struct GraphComponent {
   int deathLevel = 0;
   double birthScale = 0.0;
   double deathScale = 0.0;
-  std::vector<int> regionAt;  // region index at level birthLevel + k
-  /// pers(C) = l_d - l_b in levels (Sec. 2.3.3; docs/THESIS_NOTES.md: the one definition we keep).
-  int persistence() const { return deathLevel - birthLevel; }
+  std::vector<int> regionAt;  // region index at level birthLevel + k; -1 in a bridged gap
+  int gapLevels = 0;          // levels inside [birthLevel, deathLevel] where it has no region
+  /// pers(C) = l_d - l_b in levels (Sec. 2.3.3; docs/THESIS_NOTES.md: the one definition we keep),
+  /// less the levels of its bridged gaps: only the levels where it was found count.
+  int persistence() const { return deathLevel - birthLevel - gapLevels; }
 };
 
 struct RegionGraph {
   std::vector<RegionLevel> levels;
   /// successor[j][r]: the region at level j+1 linked to region r of level j, or -1.
   std::vector<std::vector<int>> successor;
+  /// bridge[j][r]: (level, region) beyond a gap linked to region r of level j (its successor is
+  /// -1), or (-1, -1).
+  std::vector<std::vector<std::pair<int, int>>> bridge;
   /// componentOf[j][r]: the component holding region r of level j.
   std::vector<std::vector<int>> componentOf;
   /// Ordered by birth level, then by region index at birth.
@@ -79,9 +89,15 @@ double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b);
 
 /// Links consecutive levels (J > minJaccard, 0.5 in Sec. 2.3.2) and extracts the chains. With
 /// `kinds` (kinds[j][r] per region), only regions of the same kind are linked: a chain never
-/// mixes them (planes/RegionPlanarity.hpp: planar and non-planar regions).
+/// mixes them (planes/RegionPlanarity.hpp: planar and non-planar regions). With maxGap > 0, a
+/// chain's last region also links to the first region of a chain starting up to maxGap + 1
+/// levels later (J > minJaccard; shorter gaps first, then lower levels and region indices), if
+/// `bridgeAllowed(level, region, laterLevel, laterRegion)` (when given) agrees: the primitives
+/// fitted to both must be one (the same tube radius), since nothing between them vouches for it.
+using BridgeTest = std::function<bool(int, int, int, int)>;
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
                              double minJaccard = 0.5,
-                             const std::vector<std::vector<std::uint8_t>>* kinds = nullptr);
+                             const std::vector<std::vector<std::uint8_t>>* kinds = nullptr,
+                             int maxGap = 0, const BridgeTest& bridgeAllowed = {});
 
 }  // namespace scalespace

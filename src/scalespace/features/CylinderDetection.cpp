@@ -167,6 +167,7 @@ void validateCylinderOptions(const CylinderOptions& options) {
           "CylinderOptions::graphNeighbors must be in [1, 100]");
   require(options.minJaccard >= 0.5 && options.minJaccard < 1,
           "CylinderOptions::minJaccard must be in [0.5, 1)");
+  require(options.maxGapLevels >= 0, "CylinderOptions::maxGapLevels must be >= 0");
   validateLineFilterOptions(options.filter);
   validateTubeFitOptions(options.tube);
   require(std::isfinite(options.coverage.rmsFactor) && options.coverage.rmsFactor >= 0,
@@ -255,7 +256,16 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     if (progress && !progress(double(s + 1) / count, stage)) throw Cancelled();
   }
 
-  result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard);
+  // Across a gap the two tubes must agree in radius (10%): a region that swallowed both walls of
+  // a thick pipe at one scale (radius between them) shares most of its points with the outer
+  // wall's tube of a later scale.
+  const auto sameTube = [&](int j, int r, int k, int s) {
+    const double a = result.levels[std::size_t(j)].tubes[std::size_t(r)].radius;
+    const double b = result.levels[std::size_t(k)].tubes[std::size_t(s)].radius;
+    return std::abs(a - b) <= 0.1 * std::max(a, b);
+  };
+  result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard, nullptr,
+                                  options.maxGapLevels, sameTube);
   for (std::size_t c = 0; c < result.graph.components.size(); ++c) {
     const GraphComponent& g = result.graph.components[c];
     CylinderComponent component;
@@ -264,6 +274,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     component.deathLevel = g.deathLevel;
     component.birthScale = g.birthScale;
     component.deathScale = g.deathScale;
+    component.gapLevels = g.gapLevels;
     component.persistence = g.persistence();
     // The representative tube: of the levels holding at least 80% of the component's largest
     // set, the one whose tube fits best (lowest RMS over radius; the lower level on ties). The
@@ -277,13 +288,13 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     const auto tubeAt = [&](std::size_t k) -> const TubeFit& {
       return result.levels[std::size_t(g.birthLevel) + k].tubes[std::size_t(g.regionAt[k])];
     };
-    std::size_t largest = 0;
+    std::size_t largest = 0;  // a chain starts and ends with a region; gaps (-1) lie between
     for (std::size_t k = 1; k < g.regionAt.size(); ++k)
-      if (sizeAt(k) > sizeAt(largest)) largest = k;
+      if (g.regionAt[k] >= 0 && sizeAt(k) > sizeAt(largest)) largest = k;
     std::size_t chosen = largest;
     double bestFit = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < g.regionAt.size(); ++k) {
-      if (10 * sizeAt(k) < 8 * sizeAt(largest)) continue;
+      if (g.regionAt[k] < 0 || 10 * sizeAt(k) < 8 * sizeAt(largest)) continue;
       const TubeFit& tube = tubeAt(k);
       const double fit = tube.rms / tube.radius;
       if (fit < bestFit) bestFit = fit, chosen = k;

@@ -66,6 +66,11 @@ struct CylinderOptions {
   TubeFitOptions tube;
   TubeCoverageOptions coverage;
   double minJaccard = 0.5;  // Sec. 2.3.2
+  /// A component bridges up to this many levels where its tube was not found (core/RegionGraph):
+  /// the two walls of a thick pipe (libcgal-demo's pipe.off) join, over the rim, into one rough
+  /// region at two middle scales and part again above them; without the bridge each wall was two
+  /// components, the same tube reported twice. 0: the thesis' consecutive links only.
+  int maxGapLevels = 2;
 };
 
 /// OptionError naming the field unless the options can run.
@@ -86,7 +91,8 @@ struct CylinderComponent {
   int id = 0;
   int birthLevel = 0, deathLevel = 0;
   double birthScale = 0, deathScale = 0;
-  int persistence = 0;
+  int gapLevels = 0;    // levels between birth and death where it was not found (maxGapLevels)
+  int persistence = 0;  // death - birth - gapLevels
   /// Of the levels where the component holds at least 80% of its largest set, the one whose tube
   /// fits best (lowest rms / radius; the lowest on ties): its tube is reported.
   int representativeLevel = 0;

@@ -13,6 +13,7 @@ const std::vector<Index>& componentPointsAt(const RegionGraph& graph, int id, in
   const GraphComponent& c = graph.components.at(std::size_t(id));
   if (level < c.birthLevel || level > c.deathLevel) return none;
   const int region = c.regionAt[std::size_t(level - c.birthLevel)];
+  if (region < 0) return none;  // a bridged gap
   return graph.levels[std::size_t(level)].regions[std::size_t(region)];
 }
 

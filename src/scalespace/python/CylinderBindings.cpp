@@ -70,6 +70,7 @@ class Cylinders {
       d["birth_scale"] = c.birthScale;
       d["death_level"] = c.deathLevel;
       d["death_scale"] = c.deathScale;
+      d["gap_levels"] = c.gapLevels;
       d["persistence"] = c.persistence;
       d["representative_level"] = c.representativeLevel;
       d["representative_scale"] = detection_.levels[std::size_t(c.representativeLevel)].scale;
@@ -119,8 +120,10 @@ class Cylinders {
     checkLevel(level);
     const GraphComponent& c = detection_.graph.components[std::size_t(component)];
     std::vector<std::uint32_t> out;
-    if (level >= c.birthLevel && level <= c.deathLevel) {
-      const int region = c.regionAt[std::size_t(level - c.birthLevel)];
+    const int region = level >= c.birthLevel && level <= c.deathLevel
+                           ? c.regionAt[std::size_t(level - c.birthLevel)]
+                           : -1;
+    if (region >= 0) {  // -1: not at this level, or in a bridged gap
       const auto& indices =
           detection_.graph.levels[std::size_t(level)].regions[std::size_t(region)];
       out.assign(indices.begin(), indices.end());
@@ -144,8 +147,8 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
                                        const std::optional<std::vector<double>>& scales,
                                        int scaleCount, double tmin, double tmax, double epsilon,
                                        double minAnisotropy, double minArc, double maxRms,
-                                       bool oneCurvatureSign, std::optional<int> threads,
-                                       py::object progress) {
+                                       bool oneCurvatureSign, int maxGap,
+                                       std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -157,6 +160,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.tube.minArcDegrees = minArc;
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
+  options.maxGapLevels = maxGap;
   validateCylinderOptions(options);
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud = makeCloud(asPoints(points), normals);
@@ -187,7 +191,9 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
       .def_property_readonly(
           "components", &Cylinders::components,
           "per component a dict: id, birth_level, birth_scale, death_level, death_scale, "
-          "persistence, representative_level and _scale (where it holds the most points: its "
+          "gap_levels (levels between them where it was not found), persistence (death_level - "
+          "birth_level - gap_levels), representative_level and _scale (where it holds the most "
+          "points: its "
           "tube is reported), point_count, straight, radius, rms, length, arc_degrees, direction "
           "(3,) and centre (3,) of the straight axis (None for a bent tube), axis (K, 3), radii "
           "(K,: the radius at each axis vertex)")
@@ -206,7 +212,7 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
            "ties) with persistence >= min_persistence holding it at any level, else -1.")
       .def("points", &Cylinders::points, "component"_a, "level"_a,
            "(P,) uint32: the points of the component at this level (its tube's points there; "
-           "empty at a level outside its life).")
+           "empty at a level outside its life or in one of its gaps).")
       .def("__len__", &Cylinders::componentCount)
       .def("__repr__", [](const Cylinders& c) {
         return "<scalespace.Cylinders " + std::to_string(c.componentCount()) + " components, " +
@@ -217,7 +223,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
         "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5,
         "min_arc"_a = TubeFitOptions{}.minArcDegrees, "max_rms"_a = 0.25,
-        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign, "threads"_a = py::none(),
+        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
+        "max_gap"_a = CylinderOptions{}.maxGapLevels, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
@@ -229,7 +236,8 @@ tolerance of Eq. 3.10; min_anisotropy: the least sigma of a region's points; min
 the points' normals must turn around the axis; max_rms: a tube's RMS distance to its surface
 over its radius. one_curvature_sign: a region only grows over points curving the way its seed
 does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
-normals; off: Eq. 3.10 alone). Without
+normals; off: Eq. 3.10 alone). max_gap: a component bridges up to this many levels where its
+tube was not found (0: consecutive levels only, as the thesis). Without
 normals they are estimated (PCA, 10 neighbours) and oriented (MST), as
 the CLI does. Returns a Cylinders.)doc");
 }
