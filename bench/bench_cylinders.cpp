@@ -347,6 +347,8 @@ int main(int argc, char** argv) {
       estimate = true;
     else if (a == "--min-arc" && i + 1 < argc)
       ours.tube.minArcDegrees = std::stod(argv[++i]);
+    else if (a == "--max-gap" && i + 1 < argc)
+      ours.maxGapLevels = std::stoi(argv[++i]);
     else if (a == "--normal-k" && i + 1 < argc)
       normalK = std::stoul(argv[++i]);
     else {
@@ -354,7 +356,7 @@ int main(int argc, char** argv) {
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
                    "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
                    "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] [--normal-k "
-                   "K] [--min-arc DEGREES]\n");
+                   "K] [--min-arc DEGREES] [--max-gap LEVELS]\n");
       return 2;
     }
   }

@@ -135,13 +135,25 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("features " + c + " --salient 2 -o " + path("out.ply"), "--salient");
   refused("features " + c + " --scales 0 -o " + path("out.ply"), "--scales");
   refused("features " + c + " --min-scales 9 -o " + path("out.ply"), "--min-scales");
-  refused("features " + c + " -o " + path("out.off"), "OFF and OBJ");
+  refused("features " + c + " -o " + path("out.off"), "OFF, OBJ and STL are meshes");
   refused("features " + c + " --mesh-samples 0 -o " + path("out.ply"), "--mesh-samples");
   refused("features " + c + " --sheet-normals -1 -o " + path("out.ply"), "--sheet-normals");
   std::ofstream(path("bad.off")) << "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n";
   refused("features " + path("bad.off") + " -o " + path("out.ply"), "vertex 2", 1);
-  std::ofstream(path("flat.off")) << "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n";
-  refused("features " + path("flat.off") + " -o " + path("out.ply"), "no faces", 1);
+  std::ofstream(path("bad.stl")) << "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n";
+  refused("features " + path("bad.stl") + " -o " + path("out.ply"), "inside a facet", 1);
+  // An OFF of vertices only (as CGAL's point sets) is a point cloud: its points are labelled.
+  ASSERT_EQ(run("generate sphere -n 500 -q -o " + path("flat.ply")).code, 0);
+  const PointCloud sphere = readCloud(path("flat.ply"));
+  std::ofstream off(path("points.off"));
+  off << "OFF\n" << sphere.size() << " 0 0\n";
+  for (std::size_t i = 0; i < sphere.size(); ++i)
+    off << sphere.absolutePosition(i).transpose() << "\n";
+  off.close();
+  const auto r = run("features " + path("points.off") + " -q -o " + path("points.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readCloud(path("points.ply")).size(), sphere.size());
+  EXPECT_EQ(readJson(path("points.json"))["labelled"], "points");
 }
 
 TEST_F(Cli, LinesSayWhenTheDefaultScalesCollapse) {

@@ -289,10 +289,22 @@ TEST_F(Cli, MeshesCanBeSampledByArea) {
   Result r = run("normals " + path("quad.off") + " --sample 500 -q -o " + path("q.ply"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(readCloud(path("q.ply")).size(), 500u);
-  ASSERT_EQ(run("generate sphere -n 100 -q -o " + path("s.ply")).code, 0);
-  r = run("normals " + path("s.ply") + " --sample 500 -o " + path("x.ply"));
+  ASSERT_EQ(run("generate sphere -n 100 -q -o " + path("s.xyz")).code, 0);
+  r = run("normals " + path("s.xyz") + " --sample 500 -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--sample applies to meshes"), std::string::npos) << r.err;
+  // A PLY is a mesh when it has faces; one without is refused with the reason.
+  writeText(path("quad.ply"),
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  r = run("normals " + path("quad.ply") + " --sample 500 -q -o " + path("qp.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readCloud(path("qp.ply")).size(), 500u);
+  ASSERT_EQ(run("generate sphere -n 100 -q -o " + path("s.ply")).code, 0);
+  r = run("normals " + path("s.ply") + " --sample 500 -q -o " + path("x.ply"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("no faces to sample"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, WrongExtensionsAndValuesAreRefused) {

@@ -42,7 +42,7 @@ TEST(MalformedCorpus, EveryFileIsRejectedWithAFileErrorNamingIt) {
 
 TEST(MalformedCorpus, MeshSamplingRejectsTheMeshFilesToo) {
   const std::filesystem::path root = std::filesystem::path(SCALESPACE_TEST_DATA) / "malformed";
-  for (const char* folder : {"off", "obj"}) {
+  for (const char* folder : {"off", "obj", "stl"}) {
     for (const auto& entry : std::filesystem::directory_iterator(root / folder)) {
       const std::string path = entry.path().string();
       SCOPED_TRACE(path);

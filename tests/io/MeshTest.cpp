@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
 
 #include "IoTestSupport.hpp"
 #include "scalespace/core/Error.hpp"
@@ -199,6 +203,119 @@ TEST(Mesh, ReadCloudDispatchesMeshFiles) {
   EXPECT_EQ(readCloud(dir.file("m.OFF")).size(), 6u);
   test::writeText(dir.file("m.obj"), "v 1 2 3\n");
   EXPECT_EQ(readCloud(dir.file("m.obj")).absolutePosition(0), Vec3(1, 2, 3));
+}
+
+// The unit cube as STL: 12 triangles, each with its own 3 corners (36), welded into 8 vertices.
+std::string cubeStlAscii() {
+  std::string text = "solid cube\n";
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  auto corner = [](int v) {
+    return std::to_string(v & 1) + " " + std::to_string((v >> 1) & 1) + " " +
+           std::to_string((v >> 2) & 1);
+  };
+  for (const auto& q : faces)
+    for (const auto& t :
+         {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+      text += "  facet normal 0 0 0\n    outer loop\n";
+      for (const int v : t) text += "      vertex " + corner(v) + "\n";
+      text += "    endloop\n  endfacet\n";
+    }
+  return text + "endsolid cube\n";
+}
+
+/// The same triangles as binary STL (with a header that starts with "solid", as some exporters
+/// write it).
+std::string toBinaryStl(const TriangleMesh& mesh) {
+  std::string data = "solid but binary";
+  data.resize(80, ' ');
+  const auto count = std::uint32_t(mesh.triangles.size());
+  data.append(reinterpret_cast<const char*>(&count), 4);
+  for (const auto& t : mesh.triangles) {
+    const float normal[3] = {0, 0, 0};
+    data.append(reinterpret_cast<const char*>(normal), 12);
+    for (const Index v : t)
+      for (int c = 0; c < 3; ++c) {
+        const auto x = float(mesh.vertices[v][c]);
+        data.append(reinterpret_cast<const char*>(&x), 4);
+      }
+    data.append(2, '\0');
+  }
+  return data;
+}
+
+TEST(Stl, AsciiAndBinaryWeldTheirCorners) {
+  const TriangleMesh ascii = parseStl(cubeStlAscii(), "cube.stl");
+  EXPECT_EQ(ascii.vertices.size(), 8u);
+  ASSERT_EQ(ascii.triangles.size(), 12u);
+  // Welded: every edge of the closed cube is shared by exactly two triangles, in opposite order.
+  std::map<std::pair<Index, Index>, int> edges;
+  for (const auto& t : ascii.triangles)
+    for (int k = 0; k < 3; ++k) ++edges[{t[std::size_t(k)], t[std::size_t((k + 1) % 3)]}];
+  EXPECT_EQ(edges.size(), 36u);
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(edges.count({edge.second, edge.first}), 1u);
+  }
+  const TriangleMesh binary = parseStl(toBinaryStl(ascii), "cube.stl");
+  EXPECT_EQ(binary.vertices, ascii.vertices);
+  EXPECT_EQ(binary.triangles, ascii.triangles);
+  EXPECT_TRUE(binary.vertexBytes);
+  EXPECT_EQ(binary.vertexWhere(0), "byte 96");  // 80 + 4 + 12: the first corner
+  // As a cloud: the 8 vertices, or samples on the faces with the faces' normals.
+  EXPECT_EQ(readStl(cubeStlAscii(), "cube.stl").size(), 8u);
+  ReadOptions options;
+  options.meshSamples = 600;
+  const PointCloud samples = readStl(toBinaryStl(ascii), "cube.stl", options);
+  ASSERT_EQ(samples.size(), 600u);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Vec3 p = samples.absolutePosition(i);
+    EXPECT_NEAR((p - Vec3::Constant(0.5)).cwiseAbs().maxCoeff(), 0.5, 1e-6);
+  }
+}
+
+TEST(Stl, MalformedFilesNameTheirPlace) {
+  auto expectError = [](const std::string& data, const std::string& needle) {
+    try {
+      parseStl(data, "s.stl");
+      ADD_FAILURE() << data;
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  std::string text = cubeStlAscii();
+  expectError(text.substr(0, text.size() / 2), "s.stl: line");
+  std::string fourth = text;
+  fourth.insert(fourth.find("    endloop"), "      vertex 1 1 1\n");
+  expectError(fourth, "line 7: a facet has more than 3 vertices");
+  std::string word = text;
+  word.replace(word.find("outer loop"), 10, "outer hoop");
+  expectError(word, "line 3: unexpected");
+  std::string binary = toBinaryStl(parseStl(text, "s.stl"));
+  expectError(binary.substr(0, binary.size() - 1),
+              "a binary STL declaring 12 triangles has 684 bytes");
+  expectError("", "too short");
+}
+
+TEST(Mesh, FacesAreFoundInEveryFormatThatHasThem) {
+  test::ScratchDir dir;
+  test::writeText(dir.file("cube.stl"), cubeStlAscii());
+  test::writeText(dir.file("points.off"), "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n");
+  test::writeText(dir.file("quad.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                  "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  test::writeText(dir.file("points.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                  "property float z\nend_header\n0 0 0\n");
+  EXPECT_EQ(readFacesIfAny(dir.file("cube.stl"))->triangles.size(), 12u);
+  EXPECT_EQ(readFacesIfAny(dir.file("quad.ply"))->triangles.size(), 2u);
+  EXPECT_FALSE(readFacesIfAny(dir.file("points.off")));  // CGAL's point sets are such files
+  EXPECT_FALSE(readFacesIfAny(dir.file("points.ply")));
+  EXPECT_THROW(readTriangleMesh(dir.file("points.ply")), FileError);
+  EXPECT_TRUE(isMeshPath(dir.file("cube.STL")));
+  EXPECT_EQ(readCloud(dir.file("cube.stl")).size(), 8u);
+  EXPECT_THROW(writeCloud(readCloud(dir.file("cube.stl")), dir.file("out.stl")), OptionError);
 }
 
 }  // namespace

@@ -87,6 +87,41 @@ TEST(Ply, HeaderVariantsFacesListsCommentsAliasesAndCrlf) {
   EXPECT_EQ(cloud.attributes()[0].values, (std::vector<double>{7, 255, 0}));
   EXPECT_EQ(cloud.attributes()[1].name, "nx");
   EXPECT_EQ(cloud.attributes()[1].values[2], 0.25);
+  // Asked for, the faces (declared before the vertices here) come back as triangle fans.
+  std::vector<std::array<Index, 3>> triangles;
+  EXPECT_EQ(readPly(text, "variants.ply", {}, nullptr, nullptr, &triangles).size(), 3u);
+  EXPECT_EQ(triangles, (std::vector<std::array<Index, 3>>{{0, 1, 2}, {0, 1, 2}, {0, 2, 0}}));
+}
+
+TEST(Ply, FacesAreCheckedAgainstTheVertices) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+      "float z\nelement face 1\nproperty list uchar uint vertex_index\nend_header\n0 0 0\n1 0 "
+      "0\n0 1 0\n";
+  std::vector<std::array<Index, 3>> triangles;
+  readPly(head + "3 2 1 0\n", "f.ply", {}, nullptr, nullptr, &triangles);
+  EXPECT_EQ(triangles, (std::vector<std::array<Index, 3>>{{2, 1, 0}}));
+  auto expectError = [&](const std::string& text, const std::string& needle) {
+    try {
+      readPly(text, "f.ply", {}, nullptr, nullptr, &triangles);
+      ADD_FAILURE() << text;
+    } catch (const FileError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expectError(head + "3 0 1 3\n", "f.ply: line 13: face 1: vertex index 3 is not in [0, 3)");
+  expectError(head + "2 0 1\n", "face 1 has 2 vertices");
+  ReadOptions drop;
+  drop.dropNonFinite = true;
+  EXPECT_THROW(readPly(head + "3 0 1 2\n", "f.ply", drop, nullptr, nullptr, &triangles),
+               OptionError);
+  // Without a face element, no triangles; without the list, an error naming what is missing.
+  readPly(head.substr(0, head.find("element face")) + "end_header\n0 0 0\n1 0 0\n0 1 0\n", "f.ply",
+          {}, nullptr, nullptr, &triangles);
+  EXPECT_TRUE(triangles.empty());
+  std::string noList = head;
+  noList.replace(noList.find("list uchar uint vertex_index"), 28, "uchar flags");
+  expectError(noList + "3\n", "no list property 'vertex_indices'");
 }
 
 TEST(Ply, HandWrittenBigEndianWithFacesAfterVertices) {
@@ -110,6 +145,12 @@ TEST(Ply, HandWrittenBigEndianWithFacesAfterVertices) {
   EXPECT_EQ(cloud.findAttribute("s")->type, ScalarType::Int16);
   // One byte less: the face list is truncated.
   EXPECT_THROW(readPly(data.substr(0, data.size() - 1), "big.ply"), FileError);
+  std::vector<std::array<Index, 3>> triangles;
+  readPly(data, "big.ply", {}, nullptr, nullptr, &triangles);
+  EXPECT_EQ(triangles, (std::vector<std::array<Index, 3>>{{0, 1, 1}}));
+  EXPECT_THROW(
+      readPly(data.substr(0, data.size() - 1), "big.ply", {}, nullptr, nullptr, &triangles),
+      FileError);
 }
 
 TEST(Ply, NonFiniteCoordinatesAreRejectedOrDropped) {

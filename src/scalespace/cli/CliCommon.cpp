@@ -28,15 +28,15 @@ constexpr std::size_t kMaxMeshSamples = 100'000'000;
 void addInputOptions(CLI::App& command, InputOptions& input) {
   command
       .add_option("input", input.path,
-                  "input point cloud (.ply .xyz .txt .csv .pts .pwn .off .obj .las .pcd)")
+                  "input point cloud (.ply .xyz .txt .csv .pts .pwn .off .obj .stl .las .pcd)")
       ->required()
       ->check(CLI::ExistingFile);
   command.add_flag("--drop-invalid", input.dropInvalid,
                    "skip points with NaN/Inf coordinates instead of stopping with an error");
   command
       .add_option("--sample", input.meshSamples,
-                  "OFF/OBJ meshes: N points sampled uniformly by area, with interpolated normals "
-                  "(default: the mesh vertices)")
+                  "meshes (OFF, OBJ, STL, PLY with faces): N points sampled uniformly by area, "
+                  "with interpolated normals (default: the mesh vertices)")
       ->check(CLI::Range(std::size_t(1), kMaxMeshSamples));
 }
 
@@ -46,14 +46,19 @@ PointCloud loadCloud(const InputOptions& input, bool quiet) {
   options.meshSamples = input.meshSamples;
   if (input.meshSamples > 0) {
     const CloudFormat format = formatFromPath(input.path);
-    if (format != CloudFormat::Off && format != CloudFormat::Obj)
-      throw OptionError("--sample applies to meshes (.off .obj); " + input.path + " is a " +
-                        formatName(format) + " point cloud");
+    if (!canHoldFaces(format))
+      throw OptionError("--sample applies to meshes (.off .obj .stl, .ply with faces); " +
+                        input.path + " is a " + formatName(format) + " point cloud");
   }
   ReadReport report;
   PointCloud cloud = readCloud(input.path, options, &report);
   if (cloud.empty())
     throw FileError(input.path, "", "the file holds no points", "nothing to analyse");
+  if (!quiet && input.meshSamples == 0 && isMeshPath(input.path))
+    std::fprintf(stderr,
+                 "%s: a mesh, read as its %zu vertices (--sample N draws N points on its faces "
+                 "instead)\n",
+                 input.path.c_str(), cloud.size());
   if (!quiet && report.droppedNonFinite > 0)
     std::fprintf(stderr, "%s: skipped %zu points with NaN/Inf coordinates\n", input.path.c_str(),
                  report.droppedNonFinite);
@@ -149,9 +154,10 @@ void checkOutput(const std::string& output, OutputKind kind,
       } catch (const Error&) {
         throw OptionError("output " + output + ": not a point cloud extension; " + writable);
       }
-      if (format == CloudFormat::Off || format == CloudFormat::Obj)
+      if (isMeshFormat(format))
         throw OptionError("output " + output +
-                          ": OFF and OBJ are meshes and cannot hold a point cloud; " + writable);
+                          ": OFF, OBJ and STL are meshes and cannot hold a point cloud; " +
+                          writable);
       if (kind == OutputKind::Cloud && ext == ".pwn")
         throw OptionError("output " + output +
                           ": a .pwn holds positions and normals only, and this command's result "

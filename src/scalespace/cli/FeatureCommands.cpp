@@ -219,7 +219,7 @@ void addFeaturesCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "features",
       "feature curves by multi-scale voting of salient curvature lines (Sec. 3.4.1); a mesh "
-      "input (.off .obj) labels its vertices");
+      "input (.off .obj .stl, .ply with faces) labels its vertices");
   cmd->add_option("input", args->input.path, "input point cloud or mesh")->required();
   cmd->add_flag("--drop-invalid", args->input.dropInvalid,
                 "skip points with NaN/Inf coordinates instead of failing");
@@ -299,13 +299,15 @@ void addFeaturesCommand(CLI::App& app) {
     }
 
     // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
-    // edges; a cloud labels its own points on its k-NN graph.
-    const bool mesh = isMeshPath(args->input.path);
+    // edges; a cloud labels its own points on its k-NN graph. A mesh file without faces (an OFF
+    // of vertices only, as CGAL's point sets) is a cloud.
+    std::optional<TriangleMesh> faces = readFacesIfAny(args->input.path);
+    const bool mesh = faces.has_value();
     PointCloud cloud, targets;
     FeatureCurveResult result;
     const auto progress = makeProgressBar(args->quiet);
     if (mesh) {
-      const TriangleMesh triangles = readTriangleMesh(args->input.path);
+      const TriangleMesh triangles = std::move(*faces);
       MeshFeatureCurves onMesh =
           detectMeshFeatureCurves(triangles, options, args->samplesPerVertex, progress);
       if (onMesh.coarse)

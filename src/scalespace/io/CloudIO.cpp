@@ -1,11 +1,13 @@
 #include "scalespace/io/CloudIO.hpp"
 
 #include <filesystem>
+#include <optional>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudBuilder.hpp"
 #include "scalespace/io/LasFormat.hpp"
+#include "scalespace/io/MeshCloud.hpp"
 #include "scalespace/io/MeshFormat.hpp"
 #include "scalespace/io/PcdFormat.hpp"
 #include "scalespace/io/PlyFormat.hpp"
@@ -17,7 +19,19 @@ namespace scalespace {
 
 namespace {
 
-const char* const kSupported = ".ply .xyz .txt .csv .pts .pwn .off .obj .las .pcd";
+const char* const kSupported = ".ply .xyz .txt .csv .pts .pwn .off .obj .stl .las .pcd";
+
+/// A PLY file as a mesh: its vertices as stored (a non-finite one is an error: faces index them)
+/// with its normals when it has them, and its faces.
+TriangleMesh meshFromPly(std::string_view data, const std::string& path) {
+  TriangleMesh mesh;
+  const PointCloud cloud = readPly(data, path, {}, nullptr, nullptr, &mesh.triangles);
+  mesh.vertices.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) mesh.vertices[i] = cloud.absolutePosition(i);
+  mesh.normals = cloud.normals();
+  mesh.vertexLines.assign(cloud.size(), 0);  // unused: readPly has checked every vertex
+  return mesh;
+}
 
 }  // namespace
 
@@ -30,6 +44,7 @@ CloudFormat formatFromPath(const std::string& path) {
     return CloudFormat::Xyz;
   if (extension == ".off") return CloudFormat::Off;
   if (extension == ".obj") return CloudFormat::Obj;
+  if (extension == ".stl") return CloudFormat::Stl;
   if (extension == ".las") return CloudFormat::Las;
   if (extension == ".pcd") return CloudFormat::Pcd;
   if (extension == ".laz")
@@ -51,6 +66,8 @@ const char* formatName(CloudFormat format) {
       return "off";
     case CloudFormat::Obj:
       return "obj";
+    case CloudFormat::Stl:
+      return "stl";
     case CloudFormat::Las:
       return "las";
     case CloudFormat::Pcd:
@@ -64,7 +81,11 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
   const std::string data = io_detail::readWholeFile(path);
   switch (format) {
     case CloudFormat::Ply:
-      return readPly(data, path, options, report);
+      // Sampling a PLY mesh needs its faces (meshToCloud then says when it has none).
+      if (options.meshSamples == 0) return readPly(data, path, options, report);
+      return io_detail::meshToCloud(meshFromPly(data, path), path, options, report, "ply");
+    case CloudFormat::Stl:
+      return readStl(data, path, options, report);
     case CloudFormat::Xyz:
       return readXyz(data, path, options, report);
     case CloudFormat::Off:
@@ -79,35 +100,50 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
   throw OptionError(path + ": unknown format");
 }
 
+bool isMeshFormat(CloudFormat format) {
+  return format == CloudFormat::Off || format == CloudFormat::Obj || format == CloudFormat::Stl;
+}
+
+bool canHoldFaces(CloudFormat format) { return isMeshFormat(format) || format == CloudFormat::Ply; }
+
 bool isMeshPath(const std::string& path) {
   try {
-    const CloudFormat format = formatFromPath(path);
-    return format == CloudFormat::Off || format == CloudFormat::Obj;
+    return isMeshFormat(formatFromPath(path));
   } catch (const Error&) {
     return false;
   }
 }
 
-TriangleMesh readTriangleMesh(const std::string& path) {
-  if (!isMeshPath(path))
-    throw FileError(path, "", "is not a mesh file", "give an .off or .obj file");
+std::optional<TriangleMesh> readFacesIfAny(const std::string& path) {
+  const CloudFormat format = formatFromPath(path);
+  if (!canHoldFaces(format)) return std::nullopt;
   const std::string data = io_detail::readWholeFile(path);
-  TriangleMesh mesh =
-      formatFromPath(path) == CloudFormat::Off ? parseOff(data, path) : parseObj(data, path);
+  TriangleMesh mesh = format == CloudFormat::Off   ? parseOff(data, path)
+                      : format == CloudFormat::Obj ? parseObj(data, path)
+                      : format == CloudFormat::Stl ? parseStl(data, path)
+                                                   : meshFromPly(data, path);
+  if (mesh.triangles.empty()) return std::nullopt;
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
     if (!io_detail::isUsablePosition(mesh.vertices[v]))
-      throw FileError(path, io_detail::lineWhere(mesh.vertexLines[v]),
+      throw FileError(path, mesh.vertexWhere(v),
                       "vertex " + std::to_string(v + 1) +
                           " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                       "fix or remove that vertex");
-  if (mesh.triangles.empty())
-    throw FileError(path, "", "the mesh has no faces", "give a mesh with triangles or polygons");
   return mesh;
+}
+
+TriangleMesh readTriangleMesh(const std::string& path) {
+  if (!canHoldFaces(formatFromPath(path)))
+    throw FileError(path, "", "is not a mesh file", "give an .off, .obj, .stl or .ply mesh");
+  std::optional<TriangleMesh> mesh = readFacesIfAny(path);
+  if (!mesh)
+    throw FileError(path, "", "the mesh has no faces", "give a mesh with triangles or polygons");
+  return std::move(*mesh);
 }
 
 void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOptions& options) {
   const CloudFormat format = formatFromPath(path);
-  if (format == CloudFormat::Off || format == CloudFormat::Obj)
+  if (isMeshFormat(format))
     throw OptionError(path + ": cannot write ." + formatName(format) +
                       " (a point cloud has no faces); writable extensions: .ply .xyz .txt .csv "
                       ".pts .pwn .las .pcd");
@@ -136,6 +172,7 @@ void writeCloud(const PointCloud& cloud, const std::string& path, const WriteOpt
         break;
       case CloudFormat::Off:
       case CloudFormat::Obj:
+      case CloudFormat::Stl:
         break;
     }
   });

@@ -15,7 +15,7 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
     builder.reserve(mesh.vertices.size());
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
       builder.addPoint(mesh.vertices[v], normals ? mesh.normals[v] : Vec3::Zero(), nullptr,
-                       [&] { return lineWhere(mesh.vertexLines[v]); });
+                       [&] { return mesh.vertexWhere(v); });
     return builder.finish(report, formatDescription);
   }
 
@@ -25,7 +25,7 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     if (isUsablePosition(mesh.vertices[v])) continue;
     if (!options.dropNonFinite)
-      throw FileError(file, lineWhere(mesh.vertexLines[v]),
+      throw FileError(file, mesh.vertexWhere(v),
                       "vertex " + std::to_string(v + 1) +
                           " has a NaN, infinite or absurdly large (beyond 1e100) coordinate",
                       "skip its faces with ReadOptions::dropNonFinite");

@@ -15,6 +15,13 @@
 // each vertex is given the same vn by every face that references it (and every vertex is
 // referenced), or, when faces reference no vn at all, there are exactly as many vn as v (matched by
 // index). Otherwise they are ignored (and recomputed from the faces when sampling).
+// STL: binary (an 80-byte header, a triangle count, 50 bytes per triangle; taken as binary when
+// the size matches the count exactly, even if the header starts with "solid") or ASCII ("solid",
+// then facet / outer loop / three vertex lines / endloop / endfacet). STL stores each triangle
+// with its own copies of its corners: corners with identical coordinates are welded into one
+// vertex (so that vertex normals and features see the faces as connected); the facet normals are
+// ignored (recomputed from the faces, as most exporters write them unreliably).
+// PLY meshes: the `face` element's `vertex_indices` (or `vertex_index`) list, read by readPly.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -30,16 +37,21 @@ struct TriangleMesh {
   std::vector<Vec3> vertices;
   std::vector<Vec3> normals;  // per vertex, or empty
   std::vector<std::array<Index, 3>> triangles;
-  std::vector<std::size_t> vertexLines;  // line of each vertex in its file, for error messages
+  std::vector<std::size_t> vertexLines;  // line (or byte) of each vertex, for error messages
+  bool vertexBytes = false;              // vertexLines hold byte offsets (binary files)
+  std::string vertexWhere(std::size_t v) const;
 };
 
 /// Parses a mesh file held in memory (no sampling, no finiteness checks).
 TriangleMesh parseOff(std::string_view data, const std::string& file);
 TriangleMesh parseObj(std::string_view data, const std::string& file);
+TriangleMesh parseStl(std::string_view data, const std::string& file);
 
 PointCloud readOff(std::string_view data, const std::string& file, const ReadOptions& options = {},
                    ReadReport* report = nullptr);
 PointCloud readObj(std::string_view data, const std::string& file, const ReadOptions& options = {},
+                   ReadReport* report = nullptr);
+PointCloud readStl(std::string_view data, const std::string& file, const ReadOptions& options = {},
                    ReadReport* report = nullptr);
 
 /// Area-weighted vertex normals (sum of the incident faces' cross products, normalised); a vertex

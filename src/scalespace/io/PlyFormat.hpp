@@ -3,13 +3,13 @@
 //
 // Reading: the `vertex` element gives the points: x y z -> positions, nx ny nz -> normals, every
 // other scalar property -> an attribute column of that PLY type (char/uchar/.../double and the
-// int8/.../float64 aliases). List properties and other elements (faces, ...) are parsed and
-// skipped; so is the `edge` element (scalar vertex1, vertex2: polylines, io/Polylines.hpp) unless
-// the caller asks for it. Comments and obj_info are ignored.
-// Writing: x y z as float32 when that is exact, else float64; nx ny nz float32; then every
-// attribute column with its ScalarType, in column order; then, when given, the edges as
-// `element edge` with `int vertex1, int vertex2` (the layout CloudCompare, MeshLab and Blender
-// use).
+// int8/.../float64 aliases). List properties and other elements are parsed and skipped; so are
+// the `face` element (unless the caller asks for the faces: a mesh) and the `edge` element (scalar
+// vertex1, vertex2: polylines, io/Polylines.hpp) unless the caller asks for it. Comments and
+// obj_info are ignored. Writing: x y z as float32 when that is exact, else float64; nx ny nz
+// float32; then every attribute column with its ScalarType, in column order; then, when given, the
+// edges as `element edge` with `int vertex1, int vertex2` (the layout CloudCompare, MeshLab and
+// Blender use).
 #include <array>
 #include <ostream>
 #include <string>
@@ -31,8 +31,12 @@ using PlyEdge = std::array<Index, 2>;
 /// each index checked against the vertex count (FileError naming the edge's line or byte); an edge
 /// element without scalar vertex1 and vertex2 properties is a FileError. Reading edges with
 /// ReadOptions::dropNonFinite is an OptionError: skipping a vertex would renumber the others.
+/// With `triangles`, also hands back the `face` element's polygons (its `vertex_indices` or
+/// `vertex_index` list) as triangle fans, each index checked against the vertex count; none when
+/// the file has no face element. The same dropNonFinite rule as for edges.
 PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options = {},
-                   ReadReport* report = nullptr, std::vector<PlyEdge>* edges = nullptr);
+                   ReadReport* report = nullptr, std::vector<PlyEdge>* edges = nullptr,
+                   std::vector<std::array<Index, 3>>* triangles = nullptr);
 
 /// Writes the cloud as the vertex element and, when `edges` is given, an edge element after it
 /// (indices below cloud.size(), which must fit an int: Error otherwise).

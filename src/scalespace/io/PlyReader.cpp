@@ -188,8 +188,14 @@ VertexLayout planVertex(const PlyElement& vertex, const std::string& file, Cloud
   return layout;
 }
 
+/// What a sink does with list properties: nothing (they are skipped) unless it says otherwise.
+struct SkipsLists {
+  static constexpr bool kKeepsLists = false;
+  void setList(std::size_t, const std::vector<double>&) {}
+};
+
 /// Stores property `i`'s value into the point being assembled; `finish` adds the point.
-struct VertexAssembler {
+struct VertexAssembler : SkipsLists {
   const VertexLayout& layout;
   CloudBuilder& builder;
   Vec3 position = Vec3::Zero();
@@ -232,7 +238,7 @@ EdgeLayout planEdge(const PlyElement& edge, const std::string& file) {
 
 /// Collects the `edge` element's vertex index pairs, each checked against the vertex count as it
 /// is read, so that the error names the place of the bad edge.
-struct EdgeAssembler {
+struct EdgeAssembler : SkipsLists {
   const EdgeLayout& layout;
   std::size_t vertexCount;
   const std::string& file;
@@ -257,8 +263,54 @@ struct EdgeAssembler {
   }
 };
 
+/// The `face` element's vertex index list: `vertex_indices` (the usual name) or `vertex_index`.
+int planFace(const PlyElement& face, const std::string& file) {
+  for (std::size_t i = 0; i < face.properties.size(); ++i)
+    if (face.properties[i].isList &&
+        (face.properties[i].name == "vertex_indices" || face.properties[i].name == "vertex_index"))
+      return int(i);
+  throw FileError(file, lineWhere(face.line),
+                  "the face element has no list property 'vertex_indices'",
+                  "a face is declared as 'property list uchar int vertex_indices'");
+}
+
+/// Collects the faces as triangles (polygons as fans, as OFF and OBJ), each index checked against
+/// the vertex count as it is read; a face of fewer than 3 vertices is an error, as in OFF.
+struct FaceAssembler {
+  static constexpr bool kKeepsLists = true;
+  int listIndex;
+  std::size_t vertexCount;
+  const std::string& file;
+  std::vector<std::array<Index, 3>>& triangles;
+  std::vector<double> polygon;
+  std::size_t faces = 0;
+
+  void set(std::size_t, double) {}
+  void setList(std::size_t i, const std::vector<double>& values) {
+    if (int(i) == listIndex) polygon = values;
+  }
+  template <class Where>
+  void finish(Where&& where) {
+    ++faces;
+    if (polygon.size() < 3)
+      throw FileError(
+          file, where(),
+          "face " + std::to_string(faces) + " has " + std::to_string(polygon.size()) + " vertices",
+          "a face needs at least 3");
+    for (const double v : polygon)
+      if (!(v >= 0 && v < double(vertexCount) && v == std::floor(v)))
+        throw FileError(file, where(),
+                        "face " + std::to_string(faces) + ": vertex index " + formatNumber(v) +
+                            " is not in [0, " + std::to_string(vertexCount) + ")",
+                        "vertex indices start at 0 and stay below the vertex count");
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
+      triangles.push_back({Index(polygon[0]), Index(polygon[k]), Index(polygon[k + 1])});
+    polygon.clear();
+  }
+};
+
 /// For elements nobody reads: ascii values are still parsed (and so checked).
-struct IgnoredItems {
+struct IgnoredItems : SkipsLists {
   void set(std::size_t, double) {}
   template <class Where>
   void finish(Where&&) {}
@@ -274,15 +326,26 @@ void skipBinaryList(ByteReader& in, const PlyProperty& p, bool big, const std::s
   in.skip(bytes, "list items");
 }
 
-/// Decodes every item of `element` into `sink` (lists are skipped: no reader keeps one).
+/// Decodes every item of `element` into `sink` (lists are skipped unless the sink keeps them).
 template <class Sink>
 void readBinaryItems(ByteReader& in, const PlyElement& element, bool big, const std::string& file,
                      Sink& sink) {
+  std::vector<double> list;
   for (std::size_t n = 0; n < element.count; ++n) {
     const std::size_t start = in.offset();
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
       const PlyProperty& p = element.properties[i];
-      if (p.isList)
+      if (p.isList && Sink::kKeepsLists) {
+        const double count = in.readScalar(p.countType, big, "a list count");
+        if (count < 0 || count * double(scalarTypeSize(p.type)) > double(in.remaining()))
+          throw FileError(file, byteWhere(in.offset()),
+                          "list '" + p.name + "' declares " + formatNumber(count) +
+                              " items but the file has fewer bytes left",
+                          "the file is truncated or corrupt");
+        list.resize(std::size_t(count));
+        for (double& v : list) v = in.readScalar(p.type, big, "a list item");
+        sink.setList(i, list);
+      } else if (p.isList)
         skipBinaryList(in, p, big, file);
       else
         sink.set(i, in.readScalar(p.type, big, "a property value"));
@@ -291,7 +354,8 @@ void readBinaryItems(ByteReader& in, const PlyElement& element, bool big, const 
   }
 }
 
-/// The elements a reader wants: the vertices always, the edges when `edges` is given.
+/// The elements a reader wants: the vertices always, the edges when `edges` is given, the faces
+/// when `triangles` is.
 struct ElementPlan {
   std::size_t vertexIndex = 0;
   const VertexLayout* vertex = nullptr;
@@ -299,6 +363,9 @@ struct ElementPlan {
   const EdgeLayout* edge = nullptr;
   std::size_t vertexCount = 0;
   std::vector<PlyEdge>* edges = nullptr;
+  std::size_t faceIndex = std::size_t(-1);  // none
+  int faceList = -1;
+  std::vector<std::array<Index, 3>>* triangles = nullptr;
 };
 
 void readBinary(const PlyHeader& header, std::string_view data, const std::string& file,
@@ -330,8 +397,12 @@ void readBinary(const PlyHeader& header, std::string_view data, const std::strin
       readBinaryItems(in, element, big, file, vertex);
     } else if (e == plan.edgeIndex) {
       plan.edges->reserve(element.count);
-      EdgeAssembler edge{*plan.edge, plan.vertexCount, file, *plan.edges};
+      EdgeAssembler edge{{}, *plan.edge, plan.vertexCount, file, *plan.edges};
       readBinaryItems(in, element, big, file, edge);
+    } else if (e == plan.faceIndex) {
+      plan.triangles->reserve(element.count);
+      FaceAssembler face{plan.faceList, plan.vertexCount, file, *plan.triangles, {}, 0};
+      readBinaryItems(in, element, big, file, face);
     } else if (fixed) {
       in.skip(needed, element.name.c_str());
     } else {
@@ -351,6 +422,7 @@ template <class Sink>
 void readAsciiItems(LineScanner& lines, std::size_t lineBase, const PlyElement& element,
                     const std::string& file, Sink& sink) {
   std::vector<std::string_view> tokens;
+  std::vector<double> list;
   std::string_view line;
   for (std::size_t n = 0; n < element.count; ++n) {
     do {
@@ -383,7 +455,9 @@ void readAsciiItems(LineScanner& lines, std::size_t lineBase, const PlyElement& 
           throw FileError(file, lineWhere(lineNumber),
                           "list '" + p.name + "' declares " + formatNumber(count) +
                               " items but the line has fewer values");
-        for (std::size_t k = 0; k < std::size_t(count); ++k) nextNumber(p.type, p.name);
+        list.resize(std::size_t(count));
+        for (double& v : list) v = nextNumber(p.type, p.name);
+        if (Sink::kKeepsLists) sink.setList(i, list);
       } else {
         sink.set(i, nextNumber(p.type, p.name));
       }
@@ -417,8 +491,12 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
       readAsciiItems(lines, lineBase, element, file, vertex);
     } else if (e == plan.edgeIndex) {
       plan.edges->reserve(element.count);
-      EdgeAssembler edge{*plan.edge, plan.vertexCount, file, *plan.edges};
+      EdgeAssembler edge{{}, *plan.edge, plan.vertexCount, file, *plan.edges};
       readAsciiItems(lines, lineBase, element, file, edge);
+    } else if (e == plan.faceIndex) {
+      plan.triangles->reserve(element.count);
+      FaceAssembler face{plan.faceList, plan.vertexCount, file, *plan.triangles, {}, 0};
+      readAsciiItems(lines, lineBase, element, file, face);
     } else {
       IgnoredItems ignored;
       readAsciiItems(lines, lineBase, element, file, ignored);
@@ -429,24 +507,28 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
 }  // namespace
 
 PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options,
-                   ReadReport* report, std::vector<PlyEdge>* edges) {
+                   ReadReport* report, std::vector<PlyEdge>* edges,
+                   std::vector<std::array<Index, 3>>* triangles) {
   const PlyHeader header = parseHeader(data, file);
   ElementPlan plan;
   plan.vertexIndex = header.elements.size();
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     if (header.elements[e].name == "vertex") plan.vertexIndex = e;
     if (header.elements[e].name == "edge" && edges) plan.edgeIndex = e;
+    if (header.elements[e].name == "face" && triangles) plan.faceIndex = e;
   }
   if (plan.vertexIndex == header.elements.size())
     throw FileError(file, lineWhere(header.dataLine), "the header declares no 'vertex' element",
                     "a point cloud PLY needs 'element vertex <count>' with x, y, z properties");
-  if (edges) {
-    // Edges index the vertices as stored: dropping a vertex would shift every later index.
+  if (edges || triangles) {
+    // Edges and faces index the vertices as stored: dropping a vertex would shift every later
+    // index.
     if (options.dropNonFinite)
-      throw OptionError(
-          "ReadOptions::dropNonFinite cannot be used when reading edges (it would renumber "
-          "the vertices they join)");
-    edges->clear();
+      throw OptionError(std::string("ReadOptions::dropNonFinite cannot be used when reading ") +
+                        (edges ? "edges" : "faces") +
+                        " (it would renumber the vertices they join)");
+    if (edges) edges->clear();
+    if (triangles) triangles->clear();
   }
   CloudBuilder builder(file, options);
   const VertexLayout vertex = planVertex(header.elements[plan.vertexIndex], file, builder);
@@ -460,6 +542,14 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
     plan.vertexCount = header.elements[plan.vertexIndex].count;
   } else {
     plan.edgeIndex = std::size_t(-1);  // no edge stored
+  }
+  plan.vertexCount = header.elements[plan.vertexIndex].count;
+  if (plan.faceIndex < header.elements.size() &&
+      !header.elements[plan.faceIndex].properties.empty()) {
+    plan.faceList = planFace(header.elements[plan.faceIndex], file);
+    plan.triangles = triangles;
+  } else {
+    plan.faceIndex = std::size_t(-1);  // no face stored
   }
   if (header.encoding == PlyEncoding::Ascii)
     readAscii(header, data, file, builder, plan);

@@ -29,9 +29,9 @@ py::dict readCloudPy(const std::string& path, bool dropInvalid, std::size_t samp
   options.seed = seed;
   if (sample > 0) {
     const CloudFormat format = formatFromPath(path);
-    if (format != CloudFormat::Off && format != CloudFormat::Obj)
-      throw OptionError("sample applies to meshes (.off .obj); " + path + " is a " +
-                        formatName(format) + " point cloud");
+    if (!canHoldFaces(format))
+      throw OptionError("sample applies to meshes (.off .obj .stl, .ply with faces); " + path +
+                        " is a " + formatName(format) + " point cloud");
   }
   ReadReport report;
   PointCloud cloud;

@@ -165,7 +165,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
     cloud = makeCloud(asPoints(points), normals);
   } else {
     // A mesh is sampled by area (interpolated normals) and its vertices are labelled on its
-    // edges, as `scalespace features` does with an OFF/OBJ input.
+    // edges, as `scalespace features` does with a mesh input.
     if (!normals.is_none())
       throw OptionError("normals go with a cloud; a mesh's come from its faces");
     mesh = meshFrom(asPoints(points), triangles);
@@ -287,8 +287,8 @@ CLI does).)doc");
                               toArray(std::move(flat), {py::ssize_t(mesh.triangles.size()), 3}));
       },
       "path"_a,
-      "The vertices (V, 3) float64 and triangles (T, 3) uint32 of an OFF or OBJ mesh (polygons "
-      "as fans).");
+      "The vertices (V, 3) float64 and triangles (T, 3) uint32 of an OFF, OBJ, STL (its "
+      "repeated corners welded) or PLY mesh (polygons as fans).");
 }
 
 }  // namespace scalespace::python

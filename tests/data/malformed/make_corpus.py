@@ -95,6 +95,27 @@ write("obj", "face_two_corners.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n")
 write("obj", "bad_normal_ref.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n")
 write("obj", "nan_vertex.obj", "v 0 0 0\nv inf 0 0\n")
 
+# --- STL ---
+STL_FACET = "facet normal 0 0 1\nouter loop\n{v}endloop\nendfacet\n"
+
+
+def stl_ascii(*facets, end="endsolid s\n"):
+    body = "".join(STL_FACET.format(v="".join("vertex %s\n" % c for c in f)) for f in facets)
+    return "solid s\n" + body + end
+
+
+TRI = ("0 0 0", "1 0 0", "0 1 0")
+write("stl", "empty.stl", b"")
+write("stl", "truncated_binary.stl", b"\0" * 80 + struct.pack("<I", 2) + b"\0" * 50)
+write("stl", "binary_garbage.stl", bytes((i * 13 + 5) % 256 for i in range(300)))
+write("stl", "four_vertices.stl", stl_ascii(TRI + ("1 1 0",)))
+write("stl", "two_vertices.stl", stl_ascii(TRI[:2]))
+write("stl", "bad_number.stl", stl_ascii(("0 0 0", "1 x 0", "0 1 0")))
+write("stl", "short_vertex.stl", stl_ascii(("0 0 0", "1 0", "0 1 0")))
+write("stl", "no_endsolid.stl", stl_ascii(TRI, end=""))
+write("stl", "unknown_keyword.stl", stl_ascii(TRI).replace("outer loop", "outer hoop"))
+write("stl", "nan_vertex.stl", stl_ascii(("0 0 0", "nan 0 0", "0 1 0")))
+
 # --- LAS ---
 def las(minor=2, fmt=0, reclen=20, count=1, offset=None, header_size=None, scale=(0.01, 0.01, 0.01),
         records=None, count64=None):
