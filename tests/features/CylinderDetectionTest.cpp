@@ -229,6 +229,37 @@ TEST(Cylinders, ANoisyBoxWithEstimatedNormalsIsNoCylinder) {
   for (const CylinderComponent& c : d.components) EXPECT_EQ(c.persistence, 0);
 }
 
+// A clean octahedron, normals estimated: around the axis through two opposite vertices its four
+// faces, joined at edges the fits round, pass every other tube test at one scale (libcgal-demo's
+// octahedron.off: a tube of radius 1.3 over half its points); its normals take four directions only
+// (TubeFitOptions::minNormalDirections).
+TEST(Cylinders, APrismsFewFaceDirectionsAreNoTube) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> p;
+  for (int k = 0; k < 50000; ++k) {  // a random face, a uniform point on it
+    const Vec3 sign(u(rng) < 0.5 ? -1 : 1, u(rng) < 0.5 ? -1 : 1, u(rng) < 0.5 ? -1 : 1);
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    p.push_back(2 * Vec3(a, b, 1 - a - b).cwiseProduct(sign));
+  }
+  PointCloud octahedron;  // normals estimated, as a user's scan gets them: smeared at the edges
+  octahedron.setAbsolutePositions(p);
+  NormalEstimationResult estimated = estimateNormals(octahedron.positions());
+  orientNormals(octahedron.positions(), estimated.normals, {}, estimated.valid);
+  octahedron.setNormals(std::move(estimated.normals));
+  CylinderOptions options;
+  options.tube.minNormalDirections = 0;
+  const std::size_t without = detectCylinders(octahedron, options).components.size();
+  EXPECT_GE(without, 1u);  // the other tests alone let it through
+  const CylinderDetection d = detectCylinders(octahedron, {});
+  EXPECT_TRUE(d.components.empty()) << d.components.size() << " components on an octahedron";
+  std::size_t faceted = 0;
+  for (const CylinderLevel& level : d.levels)
+    faceted += level.rejections[std::size_t(TubeRejection::Faceted)];
+  EXPECT_EQ(faceted, without);  // each tube the test turned down
+}
+
 // Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and
 // the surface is their union's, a concave groove where they meet), with exact normals; which
 // cylinder each point lies on in `lobe`.

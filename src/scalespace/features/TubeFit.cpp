@@ -253,6 +253,7 @@ struct AxisEvaluation {
   std::vector<Vec3> axis;
   std::vector<double> radii;
   double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
+  double normalDirections = 0;
 };
 
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
@@ -333,6 +334,27 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     return arcs[arcs.size() / 2];
   };
   e.normalArc = arc([&](std::size_t k, std::size_t) { return normals[points[k]]; });
+  // The effective number of 2-degree directions the normals take around the axis (the exponential
+  // of their histogram's entropy): a tube's turn continuously, a prism's sit on its few faces.
+  {
+    constexpr int kFine = 180;
+    std::array<std::uint32_t, kFine> fine{};
+    std::uint32_t counted = 0;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const std::size_t s = proj[k].segment;
+      const Vec3& d = normals[points[k]];
+      const Vec3 radial = d - d.dot(tangent[s]) * tangent[s];
+      if (radial.norm() < 0.5 * d.norm()) continue;
+      const double angle =
+          std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
+      ++fine[std::size_t(std::min(kFine - 1, int((angle + kPi) / (2 * kPi) * kFine)))];
+      ++counted;
+    }
+    double entropy = 0;
+    for (const std::uint32_t c : fine)
+      if (c > 0) entropy -= double(c) / counted * std::log(double(c) / counted);
+    e.normalDirections = std::exp(entropy);
+  }
   e.positionArc = arc([&](std::size_t k, std::size_t s) {
     const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
     return Vec3(positions[points[k]] - foot);
@@ -405,6 +427,8 @@ const char* tubeRejectionName(TubeRejection rejection) {
       return "thin";
     case TubeRejection::Rough:
       return "rough";
+    case TubeRejection::Faceted:
+      return "faceted";
     case TubeRejection::Merged:
       return "merged";
   }
@@ -423,6 +447,8 @@ void validateTubeFitOptions(const TubeFitOptions& options) {
         "TubeFitOptions::minRadiusFactor must be finite and >= 0");
   check(std::isfinite(options.maxRelativeRms) && options.maxRelativeRms > 0,
         "TubeFitOptions::maxRelativeRms must be finite and > 0");
+  check(std::isfinite(options.minNormalDirections) && options.minNormalDirections >= 0,
+        "TubeFitOptions::minNormalDirections must be finite and >= 0");
   check(std::isfinite(options.straightRmsRatio) && options.straightRmsRatio >= 1,
         "TubeFitOptions::straightRmsRatio must be finite and >= 1");
 }
@@ -492,6 +518,7 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   fit.rms = chosen.rms;
   fit.radius = fit.straight ? fit.straightRadius : chosen.meanDistance;
   fit.arcDegrees = std::min(chosen.normalArc, chosen.positionArc);
+  fit.normalDirections = chosen.normalDirections;
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 
@@ -503,6 +530,9 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
     fit.rejection = TubeRejection::Thin;
   else if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t)))
     fit.rejection = TubeRejection::Rough;
+  else if (fit.normalDirections <
+           std::min(options.minNormalDirections, 0.5 * double(points.size())))
+    fit.rejection = TubeRejection::Faceted;
   else
     fit.rejection = TubeRejection::None;
   return fit;

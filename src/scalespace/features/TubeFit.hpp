@@ -40,6 +40,14 @@ struct TubeFitOptions {
   /// than the scale (the strands of a cable seen as one tube) is smoothed by the fits, so it is
   /// not held against the tube.
   double maxRelativeRms = 0.25;
+  /// The input normals must take at least this many distinct directions around the axis (the
+  /// exponential of the entropy of their azimuths in 2-degree bins; at most half the point count
+  /// is asked of a small region). A tube's normals turn continuously (30 and more on every tube
+  /// of the pipe rack, the table scan and libcgal-demo's meshes); a prism's sit on its faces:
+  /// libcgal-demo's octahedron (16.0) and star (12.6), clean, were tubes of radius 1.32 and 0.087
+  /// at one scale. A tessellated cylinder of 40 facets (pipe.off) gives 36-73. Noise spreads a
+  /// prism's normals and hides its faces.
+  double minNormalDirections = 24;
   /// The axis is straight unless the curved axis fits the points better: straight when the RMS
   /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
   /// the radius of it).
@@ -48,7 +56,16 @@ struct TubeFitOptions {
 
 /// Why a region is no tube (None: it is one; Merged: it joined a touching tube,
 /// features/CylinderDetection). Merged is the last.
-enum class TubeRejection : std::uint8_t { None, TooSmall, Flat, NarrowArc, Thin, Rough, Merged };
+enum class TubeRejection : std::uint8_t {
+  None,
+  TooSmall,
+  Flat,
+  NarrowArc,
+  Thin,
+  Rough,
+  Faceted,
+  Merged
+};
 const char* tubeRejectionName(TubeRejection rejection);
 
 struct TubeFit {
@@ -63,7 +80,8 @@ struct TubeFit {
   Vec3 centre = Vec3::Zero();
   double straightRadius = 0;  // radius of the straight fit
   double arcDegrees = 0;  // the arc around the axis covered by both the points and their normals
-  double length = 0;      // of the axis polyline
+  double normalDirections = 0;  // TubeFitOptions::minNormalDirections' measure
+  double length = 0;            // of the axis polyline
   std::size_t pointCount = 0;
 };
 

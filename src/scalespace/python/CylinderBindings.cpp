@@ -186,7 +186,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
       .def_property_readonly(
           "levels", &Cylinders::levels,
           "per level a dict: scale, lines, regular_lines, regions, tubes, rejected (regions "
-          "turned down by each test of the tube fit: too_small, flat, narrow_arc, thin, rough), "
+          "turned down by each test of the tube fit: too_small, flat, narrow_arc, thin, rough, "
+          "faceted, merged), "
           "seconds")
       .def_property_readonly(
           "components", &Cylinders::components,
