@@ -100,6 +100,9 @@ TEST_F(Cli, FeaturesLabelPointsAndMeshVertices) {
   };
   checkCube(readCloud(path("m.ply")), Vec3::Zero());
   EXPECT_EQ(readJson(path("m.json"))["labelled"], "mesh vertices");
+  // Per edge: the cube's 12, each one curve's part (edge_id in the cloud, "edges" in the JSON).
+  EXPECT_EQ(readJson(path("m.json"))["edges"].size(), 12u);
+  ASSERT_NE(readCloud(path("m.ply")).findAttribute("edge_id"), nullptr);
   EXPECT_GT(readPolylines(path("m_lines.ply")).lineCount(), 0u);
 
   // The same cube far from the origin (georeferenced coordinates: the samples are stored relative

@@ -7,8 +7,10 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
+#include <utility>
 
 #include "features/CubeMesh.hpp"
 #include "scalespace/core/Error.hpp"
@@ -110,6 +112,27 @@ EdgeLabels labelsAlong(const std::vector<Vec3>& points, const FeatureCurveResult
   return out;
 }
 
+/// The edge id most of the labelled points near the middle of `edge` carry (away from its
+/// corners), and the share of them carrying it.
+std::pair<int, double> edgeIdAlong(const std::vector<Vec3>& points, const FeatureCurveResult& r,
+                                   const Edge& edge, double band) {
+  std::map<int, std::size_t> count;
+  std::size_t total = 0;
+  const Vec3 d = edge.b - edge.a;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double along = (points[i] - edge.a).dot(d) / d.squaredNorm();
+    if (along < 0.2 || along > 0.8 || segmentDistance(points[i], edge.a, edge.b) > band ||
+        r.edgeId[i] < 0)
+      continue;
+    ++count[r.edgeId[i]];
+    ++total;
+  }
+  std::pair<int, double> best{-1, 0.0};
+  for (const auto& [id, c] : count)
+    if (double(c) / double(total) > best.second) best = {id, double(c) / double(total)};
+  return best;
+}
+
 }  // namespace
 
 TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
@@ -143,6 +166,23 @@ TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
   EXPECT_EQ(largest.convexity, 1);
   EXPECT_NEAR(largest.length, 12.0, 3.0);
   EXPECT_EQ(largest.scaleMask, 0x1Fu) << "every scale voted";
+  // Split at the corners: 12 edges, each cube edge one of them, of length ~1.
+  EXPECT_EQ(r.edges.size(), 12u);
+  std::set<int> ids;
+  for (const Edge& edge : cubeEdges()) {
+    const auto [id, share] = edgeIdAlong(cloud.positions(), r, edge, 0.5 * e);
+    EXPECT_GT(share, 0.99) << edge.a.transpose() << " -> " << edge.b.transpose();
+    ids.insert(id);
+    if (id >= 0) EXPECT_NEAR(r.edges[std::size_t(id)].length, 1.0, 0.25);
+  }
+  EXPECT_EQ(ids.size(), 12u);
+  for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(r.edgeId[i] >= 0, r.curveId[i] >= 0);
+  // edgeReach 0: one edge per curve.
+  FeatureCurveOptions whole;
+  whole.edgeReach = 0;
+  const FeatureCurveResult unsplit = detectFeatureCurves(cloud, whole);
+  EXPECT_EQ(unsplit.edgeId, unsplit.curveId);
+  EXPECT_EQ(unsplit.edges.size(), unsplit.curves.size());
 }
 
 // The voting detail is returned only when asked for, changes no label, and agrees with the curves'
@@ -261,6 +301,15 @@ TEST(FeatureCurves, ABoxOnTheGroundAddsItsFootprintAsAConcaveCurve) {
     EXPECT_EQ(convexCurves.count(c), 0u);
     EXPECT_NEAR(r.curves[std::size_t(c)].length, 4.0, 1.0);
   }
+  // Per edge: the 8 convex edges and the 4 of the footprint, each its own.
+  std::set<int> ids;
+  for (const Edge& edge : cubeEdges()) {
+    const auto [id, share] = edgeIdAlong(cloud.positions(), r, edge, 0.5 * e);
+    EXPECT_GT(share, 0.99);
+    ids.insert(id);
+  }
+  EXPECT_EQ(ids.size(), 12u);
+  EXPECT_EQ(ids.count(-1), 0u);
 }
 
 // Sensor noise of 0.13 e (1e-3 of the diagonal on bench_features' models) gives flat faces a
@@ -346,6 +395,7 @@ TEST(FeatureCurves, SameResultForAnyThreadCount) {
   const FeatureCurveResult one = run(1), many = run(4);
   EXPECT_EQ(one.votes, many.votes);
   EXPECT_EQ(one.curveId, many.curveId);
+  EXPECT_EQ(one.edgeId, many.edgeId);
 }
 
 TEST(FeatureCurves, MeshVerticesAreLabelledOnTheMeshEdges) {

@@ -295,10 +295,16 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
                                       written.attributes[name], name)
     features = ss.features(cloud.points, cloud.normals)
     labelled = ss.read(str(tmp_path / "f.ply")).attributes
-    for name in ("feature_votes", "curve_id", "convexity"):
+    for name in ("feature_votes", "curve_id", "convexity", "edge_id"):
         np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
                                       labelled[name], name)
     assert len(features["curves"]) == features["curve_id"].max() + 1
+    # Each curve split at its corners: every labelled point in one edge of its own curve.
+    assert len(features["edges"]) == features["edge_id"].max() + 1 >= len(features["curves"])
+    np.testing.assert_array_equal(features["edge_id"] >= 0, features["curve_id"] >= 0)
+    for k, edge in enumerate(features["edges"]):
+        assert np.all(features["edge_id"][edge["points"]] == k)
+        assert np.all(features["curve_id"][edge["points"]] == edge["curve"])
     cli("features", data / "house.ply", "-o", tmp_path / "g.ply", "--salient-per-scale")
     thesis_k = ss.features(cloud.points, cloud.normals, salient_per_scale=True)
     written = ss.read(str(tmp_path / "g.ply")).attributes["feature_votes"]
@@ -482,9 +488,14 @@ def test_features_on_a_mesh_equal_the_cli(tmp_path):
     with pytest.warns(RuntimeWarning, match="the mesh is coarse"):  # the CLI's warning, too
         features = ss.features(vertices, triangles=triangles)
     labelled = ss.read(str(tmp_path / "f.ply")).attributes
-    for name in ("feature_votes", "curve_id", "convexity"):
+    for name in ("feature_votes", "curve_id", "convexity", "edge_id"):
         np.testing.assert_array_equal(features[name].astype(labelled[name].dtype),
                                       labelled[name], name)
+    # The edges the JSON lists are those of the dict, each within one curve.
+    edges = json.loads((tmp_path / "f.json").read_text())["edges"]
+    assert len(edges) == len(features["edges"]) >= len(features["curves"])
+    for written, edge in zip(edges, features["edges"]):
+        assert written["curve"] == edge["curve"] and written["points"] == len(edge["points"])
     with pytest.raises(ValueError, match="triangles: row 0 names vertex 864"):
         ss.features(vertices, triangles=np.full((1, 3), 864))
 

@@ -264,6 +264,10 @@ void addFeaturesCommand(CLI::App& app) {
                   "keep a curve's points near the centreline fitted to the salient vertices within "
                   "this x e (0 = the thesis' band: every point the votes reach)")
       ->capture_default_str();
+  cmd->add_option("--edge-reach", args->features.edgeReach,
+                  "edge_id splits each curve at its corners: points whose curve neighbours within "
+                  "this x e do not lie along a line are corners (0: one edge per curve)")
+      ->capture_default_str();
   cmd->add_option("--band-half-width", args->features.bandHalfWidth,
                   "the points kept lie within this x e of the centreline")
       ->capture_default_str();
@@ -333,9 +337,11 @@ void addFeaturesCommand(CLI::App& app) {
     votes.values = result.votes;
     AttributeColumn& ids = out.addAttribute("curve_id", ScalarType::Int32);
     AttributeColumn& convexity = out.addAttribute("convexity", ScalarType::Int8);
+    AttributeColumn& edgeIds = out.addAttribute("edge_id", ScalarType::Int32);
     for (std::size_t i = 0; i < out.size(); ++i) {
       ids.values[i] = result.curveId[i];
       convexity.values[i] = result.convexity[i];
+      edgeIds.values[i] = result.edgeId[i];
     }
     writeCloud(out, args->output, WriteOptions{args->ascii});
     if (!args->linesOutput.empty()) {
@@ -366,6 +372,12 @@ void addFeaturesCommand(CLI::App& app) {
                         {"convexity", curve.convexity > 0 ? "convex" : "concave"},
                         {"scales", voted}});
     }
+    nlohmann::json edges = nlohmann::json::array();
+    for (std::size_t k = 0; k < result.edges.size(); ++k)
+      edges.push_back({{"id", k},
+                       {"curve", result.edges[k].curve},
+                       {"points", result.edges[k].points.size()},
+                       {"length", result.edges[k].length}});
     const double total = std::chrono::duration<double>(Clock::now() - start).count();
     const nlohmann::json json = {{"command", "features"},
                                  {"version", SCALESPACE_VERSION},
@@ -394,10 +406,12 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"centreline_reach", options.centrelineReach},
                                    {"band_half_width", options.bandHalfWidth},
                                    {"centreline_linearity", options.centrelineLinearity},
+                                   {"edge_reach", options.edgeReach},
                                    {"curved_seeds_first", options.lines.curvedSeedsFirst},
                                    {"threads", args->threads}}},
                                  {"scales", scales},
                                  {"curves", curves},
+                                 {"edges", edges},
                                  {"seconds", total}};
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);

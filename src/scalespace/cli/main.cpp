@@ -58,6 +58,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::salientThreshold", "--salient"},
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
+    {"FeatureCurveOptions::edgeReach", "--edge-reach"},
     {"FeatureCurveOptions::joinGap", "--join-gap"},
     {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
     {"FeatureCurveOptions::minVotingScales", "--min-scales"},

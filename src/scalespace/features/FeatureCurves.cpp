@@ -15,6 +15,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/features/CurveEdges.hpp"
 #include "scalespace/scales/PointNoise.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
@@ -220,6 +221,10 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::salientThreshold must be in [0, 1]");
   require(std::isfinite(o.minSalientCurvature) && o.minSalientCurvature >= 0,
           "FeatureCurveOptions::minSalientCurvature must be finite and >= 0");
+  require(std::isfinite(o.edgeReach) && o.edgeReach >= 0,
+          "FeatureCurveOptions::edgeReach must be finite and >= 0 (0 = off)");
+  require(o.edgeSpread >= 0 && o.edgeSpread <= 1,
+          "FeatureCurveOptions::edgeSpread must be in [0, 1]");
   require(std::isfinite(o.joinGap) && o.joinGap >= 0,
           "FeatureCurveOptions::joinGap must be finite and >= 0");
   require(std::isfinite(o.noiseSalientFactor) && o.noiseSalientFactor >= 0,
@@ -462,6 +467,28 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     curve.convexity = result.convexity[curve.points.front()];
     for (const Index p : curve.points) curve.scaleMask |= voters[p];
     curve.length = bandLength(targets, curve.points, 2 * e);
+  });
+  // (not in the thesis) Each curve split into edges at its corners.
+  if (options.edgeReach > 0) {
+    CurveEdges split = splitCurvesAtCorners(
+        targets, targetGraph, result.curveId,
+        {options.edgeReach * e, options.edgeSpread, std::max(1.0, options.joinGap) * e});
+    result.edgeId = std::move(split.edgeId);
+    result.edges.resize(split.points.size());
+    for (std::size_t k = 0; k < split.points.size(); ++k) {
+      result.edges[k].points = std::move(split.points[k]);
+      result.edges[k].curve = split.curveOf[k];
+    }
+  } else {
+    result.edgeId = result.curveId;
+    result.edges.resize(result.curves.size());
+    for (std::size_t c = 0; c < result.curves.size(); ++c) {
+      result.edges[c].points = result.curves[c].points;
+      result.edges[c].curve = int(c);
+    }
+  }
+  tbb::parallel_for(std::size_t(0), result.edges.size(), [&](std::size_t k) {
+    result.edges[k].length = bandLength(targets, result.edges[k].points, 2 * e);
   });
   if (options.keepVotingDetail) {
     result.voterScales = std::move(voters);

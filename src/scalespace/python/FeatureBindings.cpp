@@ -211,6 +211,16 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
     curves.append(c);
   }
   d["curves"] = curves;
+  d["edge_id"] = toArray(std::move(result.edgeId));
+  py::list edges;
+  for (FeatureEdge& edge : result.edges) {
+    py::dict e;
+    e["points"] = toArray(std::move(edge.points));
+    e["curve"] = edge.curve;
+    e["length"] = edge.length;
+    edges.append(e);
+  }
+  d["edges"] = edges;
   py::list perScale;
   for (const FeatureCurveScale& s : result.scales) {
     py::dict e;
@@ -258,7 +268,8 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
 
 Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
 (e), max_vote, noise_rms (sigma read from the points), salient_curvature_floor (max(min_curvature,
-noise_curvature * sigma / e): the |k1| t a salient vertex needs), curves (per curve: points, length, convexity, the scales that voted), scales (per
+noise_curvature * sigma / e): the |k1| t a salient vertex needs), curves (per curve: points, length, convexity, the scales that voted), edge_id (N,: -1 none)
+and edges (per edge: points, curve, length; each curve split at its corners), scales (per
 scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
 traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
 scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
