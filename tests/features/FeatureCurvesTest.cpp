@@ -173,7 +173,9 @@ TEST(FeatureCurves, TheTwelveEdgesOfACubeAreConvex) {
     const auto [id, share] = edgeIdAlong(cloud.positions(), r, edge, 0.5 * e);
     EXPECT_GT(share, 0.99) << edge.a.transpose() << " -> " << edge.b.transpose();
     ids.insert(id);
-    if (id >= 0) EXPECT_NEAR(r.edges[std::size_t(id)].length, 1.0, 0.25);
+    if (id >= 0) {
+      EXPECT_NEAR(r.edges[std::size_t(id)].length, 1.0, 0.25);
+    }
   }
   EXPECT_EQ(ids.size(), 12u);
   for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(r.edgeId[i] >= 0, r.curveId[i] >= 0);
