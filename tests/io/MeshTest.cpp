@@ -112,6 +112,21 @@ TEST(Off, SampledNormalsInterpolateVertexNormals) {
   }
 }
 
+// Without normals in the file, a CAD mesh's averaged vertex normals lean across its edges (54.7
+// degrees at a cube's corners): the samples take their face's normal instead (the file's own
+// normals, above, are interpolated as given).
+TEST(Off, SampledNormalsOfACadMeshAreItsFaceNormals) {
+  const std::string cube =
+      "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+      "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  ReadOptions options;
+  options.meshSamples = 600;
+  const PointCloud cloud = readOff(cube, "cube.off", options);
+  ASSERT_EQ(cloud.size(), 600u);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    ASSERT_NEAR(cloud.normals()[i].cwiseAbs().maxCoeff(), 1.0, 1e-12) << cloud.normals()[i];
+}
+
 TEST(Mesh, AreaWeightedVertexNormals) {
   // Two faces sharing the edge (0, 1): the shared vertices' normal weights the bigger face more.
   TriangleMesh mesh;

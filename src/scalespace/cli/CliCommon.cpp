@@ -36,7 +36,8 @@ void addInputOptions(CLI::App& command, InputOptions& input) {
   command
       .add_option("--sample", input.meshSamples,
                   "meshes (OFF, OBJ, STL, PLY with faces): N points sampled uniformly by area, "
-                  "with interpolated normals (default: the mesh vertices)")
+                  "with interpolated normals (face normals at creases of 30 degrees or more when "
+                  "the file has none) (default: the mesh vertices)")
       ->check(CLI::Range(std::size_t(1), kMaxMeshSamples));
 }
 

@@ -525,7 +525,7 @@ MeshFeatureCurves detectMeshFeatureCurves(const TriangleMesh& mesh, FeatureCurve
           "detectMeshFeatureCurves: samplesPerVertex must be in [1, 10000]");
   require(!mesh.triangles.empty(), "detectMeshFeatureCurves: the mesh has no triangles");
   // Interpolated normals (Sec. 3.4.1) except on triangles at a sharp edge (THESIS_NOTES).
-  constexpr double kCreaseAngleDegrees = 30;
+  constexpr double kCreaseAngleDegrees = kMeshCreaseAngleDegrees;
   MeshFeatureCurves out;
   out.samples = sampleMesh(mesh, samplesPerVertex * mesh.vertices.size(), 1, kCreaseAngleDegrees);
   if (options.spacing == 0) {

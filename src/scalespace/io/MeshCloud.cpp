@@ -45,7 +45,11 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
         "read its vertices instead (no mesh sampling)");
   PointCloud cloud;
   try {
-    cloud = sampleMesh(mesh, options.meshSamples, options.seed);
+    // The file's own vertex normals are interpolated as given; ours (area-weighted) only where
+    // they do not lean across a crease.
+    const bool own = mesh.normals.size() == mesh.vertices.size() && !mesh.vertices.empty();
+    cloud =
+        sampleMesh(mesh, options.meshSamples, options.seed, own ? 180.0 : kMeshCreaseAngleDegrees);
   } catch (const OptionError& e) {
     throw FileError(file, "", e.what(), "check that the faces are not all degenerate");
   }

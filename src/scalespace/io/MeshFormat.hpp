@@ -5,7 +5,9 @@
 // normals when it has usable ones). With N > 0 the cloud is N points drawn uniformly by area on
 // the triangles, each with the normalised barycentric interpolation of the vertex normals of its
 // triangle (Sec. 3.4.1); vertex normals are the file's, or the area-weighted average of the
-// incident face normals when the file has none. Polygons are triangulated as fans.
+// incident face normals when the file has none (then a triangle whose vertex normal leans more
+// than kMeshCreaseAngleDegrees from its own gives its samples the face normal: a CAD mesh's
+// edges). Polygons are triangulated as fans.
 //
 // OFF: "OFF" / "NOFF" (x y z nx ny nz per vertex) / "COFF" / "CNOFF" headers, counts on the header
 // line or the next one; one vertex or face per line, extra values (colours) ignored.
@@ -67,5 +69,12 @@ std::vector<Vec3> areaWeightedVertexNormals(const TriangleMesh& mesh);
 /// samples the face normal: on a CAD mesh the interpolation would tilt every normal near an edge.
 PointCloud sampleMesh(const TriangleMesh& mesh, std::size_t count, std::uint64_t seed,
                       double creaseAngleDegrees = 180);
+
+/// The crease angle of mesh sampling where the normals are ours (the file has none): readers with
+/// ReadOptions::meshSamples and the feature curves' protocol. On a CAD mesh a vertex's averaged
+/// normal leans half-way between the faces of its edges (54.7 degrees at a cube's corner), and
+/// interpolated over a face it tilts every sample: `planes cube.off --sample 20000` found 84
+/// components in 31 s against 17 in 1.6 s on the same points with estimated normals.
+constexpr double kMeshCreaseAngleDegrees = 30;
 
 }  // namespace scalespace
