@@ -291,20 +291,24 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     a -= a.dot(tangent[s]) * tangent[s];
     across[s] = a.squaredNorm() > 1e-12 ? a.normalized() : anyPerpendicular(tangent[s]);
   }
+  // A direction's azimuth around the axis at segment s, in the frame carried along it; NaN when
+  // it runs along the axis (an end cap, not the side).
+  auto azimuth = [&](std::size_t s, const Vec3& d) {
+    const Vec3 radial = d - d.dot(tangent[s]) * tangent[s];
+    if (radial.norm() < 0.5 * d.norm()) return std::numeric_limits<double>::quiet_NaN();
+    return std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
+  };
   // Arcs are counted per axis segment, each in its own frame, and the median over the segments
   // holding enough points is kept: along a polyline that wanders (the axis of a box's rounded
   // footprint turning at its corners) one frame would smear two face normals over many angles.
-  auto arc = [&](auto&& directionOf) {
+  auto arc = [&](auto&& angleOf) {
     std::vector<std::array<std::uint32_t, kBins>> bins(m - 1);
     for (auto& b : bins) b.fill(0);
     for (std::size_t k = 0; k < points.size(); ++k) {
-      const std::size_t s = proj[k].segment;
-      const Vec3 d = directionOf(k, s);
-      const Vec3 radial = d - d.dot(tangent[s]) * tangent[s];
-      if (radial.norm() < 0.5 * d.norm()) continue;  // along the axis: an end cap, not the side
-      const double angle =
-          std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
-      ++bins[s][std::size_t(std::min(kBins - 1, int((angle + kPi) / (2 * kPi) * kBins)))];
+      const double angle = angleOf(k);
+      if (std::isnan(angle)) continue;
+      ++bins[proj[k].segment]
+            [std::size_t(std::min(kBins - 1, int((angle + kPi) / (2 * kPi) * kBins)))];
     }
     std::vector<double> arcs;
     std::array<std::uint32_t, kBins> all{};
@@ -333,20 +337,18 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     std::nth_element(arcs.begin(), arcs.begin() + std::ptrdiff_t(arcs.size() / 2), arcs.end());
     return arcs[arcs.size() / 2];
   };
-  e.normalArc = arc([&](std::size_t k, std::size_t) { return normals[points[k]]; });
+  std::vector<double> normalAngle(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k)
+    normalAngle[k] = azimuth(proj[k].segment, normals[points[k]]);
+  e.normalArc = arc([&](std::size_t k) { return normalAngle[k]; });
   // The effective number of 2-degree directions the normals take around the axis (the exponential
   // of their histogram's entropy): a tube's turn continuously, a prism's sit on its few faces.
   {
     constexpr int kFine = 180;
     std::array<std::uint32_t, kFine> fine{};
     std::uint32_t counted = 0;
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const std::size_t s = proj[k].segment;
-      const Vec3& d = normals[points[k]];
-      const Vec3 radial = d - d.dot(tangent[s]) * tangent[s];
-      if (radial.norm() < 0.5 * d.norm()) continue;
-      const double angle =
-          std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
+    for (const double angle : normalAngle) {
+      if (std::isnan(angle)) continue;
       ++fine[std::size_t(std::min(kFine - 1, int((angle + kPi) / (2 * kPi) * kFine)))];
       ++counted;
     }
@@ -355,9 +357,10 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
       if (c > 0) entropy -= double(c) / counted * std::log(double(c) / counted);
     e.normalDirections = std::exp(entropy);
   }
-  e.positionArc = arc([&](std::size_t k, std::size_t s) {
+  e.positionArc = arc([&](std::size_t k) {
+    const std::size_t s = proj[k].segment;
     const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
-    return Vec3(positions[points[k]] - foot);
+    return azimuth(s, Vec3(positions[points[k]] - foot));
   });
 }
 
