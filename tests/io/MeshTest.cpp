@@ -210,6 +210,20 @@ TEST(Mesh, NonFiniteVerticesAreDroppedWithTheirFaces) {
   EXPECT_EQ(cloud.size(), 30u);
   EXPECT_EQ(report.droppedNonFinite, 1u);
   for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(cloud.absolutePosition(i).z(), 0.0);
+
+  // The same mesh as a PLY: the vertex goes with its face, the other face's indices are kept.
+  test::ScratchDir dir;
+  test::writeText(dir.file("d.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
+                  "y\nproperty float z\nelement face 2\nproperty list uchar int "
+                  "vertex_indices\nend_header\n0 0 inf\n0 0 0\n1 0 0\n0 1 0\n3 1 2 3\n3 0 1 2\n");
+  ReadReport plyReport;
+  const PointCloud fromPly = readCloud(dir.file("d.ply"), options, &plyReport);
+  EXPECT_EQ(fromPly.size(), 30u);
+  EXPECT_EQ(plyReport.droppedNonFinite, 1u);
+  for (std::size_t i = 0; i < fromPly.size(); ++i) EXPECT_EQ(fromPly.absolutePosition(i).z(), 0.0);
+  options.dropNonFinite = false;
+  EXPECT_THROW(readCloud(dir.file("d.ply"), options), FileError);
 }
 
 TEST(Mesh, ReadCloudDispatchesMeshFiles) {

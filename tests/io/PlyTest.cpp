@@ -111,10 +111,17 @@ TEST(Ply, FacesAreCheckedAgainstTheVertices) {
   };
   expectError(head + "3 0 1 3\n", "f.ply: line 13: face 1: vertex index 3 is not in [0, 3)");
   expectError(head + "2 0 1\n", "face 1 has 2 vertices");
+  // A dropped vertex takes its faces along; the others are renumbered.
   ReadOptions drop;
   drop.dropNonFinite = true;
-  EXPECT_THROW(readPly(head + "3 0 1 2\n", "f.ply", drop, nullptr, nullptr, &triangles),
-               OptionError);
+  std::string withNan = head;
+  withNan.replace(withNan.find("vertex 3"), 8, "vertex 4");
+  withNan.replace(withNan.find("face 1"), 6, "face 2");
+  EXPECT_EQ(
+      readPly(withNan + "nan 0 0\n3 1 2 3\n3 2 1 0\n", "f.ply", drop, nullptr, nullptr, &triangles)
+          .size(),
+      3u);
+  EXPECT_EQ(triangles, (std::vector<std::array<Index, 3>>{{2, 1, 0}}));
   // Without a face element, no triangles; without the list, an error naming what is missing.
   readPly(head.substr(0, head.find("element face")) + "end_header\n0 0 0\n1 0 0\n0 1 0\n", "f.ply",
           {}, nullptr, nullptr, &triangles);

@@ -224,11 +224,21 @@ TEST(Polylines, MalformedEdgesAreFileErrorsNamingThePlace) {
   } catch (const FileError& error) {
     EXPECT_EQ(error.file(), dir.file("cut.ply"));
   }
-  // Dropping vertices would renumber the edges.
+  // Dropping a vertex drops the edges that use it and renumbers the others.
   ReadOptions drop;
   drop.dropNonFinite = true;
   std::vector<PlyEdge> read;
-  EXPECT_THROW(readPly(out.str(), "x.ply", drop, nullptr, &read), OptionError);
+  const std::string fourPoints = std::string("ply\nformat ascii 1.0\nelement vertex 4\n") +
+                                 "property float x\nproperty float y\nproperty float z\n" +
+                                 edgeHeader + "end_header\n0 0 0\nnan 0 0\n2 0 0\n3 0 0\n" +
+                                 "0 1\n2 3\n";
+  ReadReport report;
+  const PointCloud kept = readPly(fourPoints, "x.ply", drop, &report, &read);
+  EXPECT_EQ(kept.size(), 3u);
+  EXPECT_EQ(report.droppedNonFinite, 1u);
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_EQ(read[0], (PlyEdge{1, 2}));
+  EXPECT_DOUBLE_EQ(kept.absolutePosition(read[0][0]).x(), 2.0);
 }
 
 TEST(Polylines, MissingFilesAndOtherExtensionsAreRefused) {

@@ -41,6 +41,7 @@ class CloudBuilder {
   bool addPoint(const Vec3& position, const Vec3& normal, const double* values, Where&& where) {
     if (!isUsablePosition(position)) {
       if (dropNonFinite_) {
+        droppedOrdinals_.push_back(positions_.size() + dropped_);
         ++dropped_;
         return false;
       }
@@ -52,6 +53,10 @@ class CloudBuilder {
     return true;
   }
 
+  /// The 0-based file order of each point skipped so far (readers that also hand back indices into
+  /// the points, such as PLY faces, renumber with it).
+  const std::vector<std::size_t>& droppedOrdinals() const { return droppedOrdinals_; }
+
   /// Moves everything into a PointCloud (recentred positions) and fills `report` if given.
   PointCloud finish(ReadReport* report, const std::string& formatDescription);
 
@@ -61,6 +66,7 @@ class CloudBuilder {
   bool dropNonFinite_;
   bool withNormals_ = false;
   std::size_t dropped_ = 0;
+  std::vector<std::size_t> droppedOrdinals_;
   std::vector<Vec3> positions_;
   std::vector<Vec3> normals_;
   std::vector<AttributeColumn> columns_;

@@ -21,11 +21,17 @@ namespace {
 
 const char* const kSupported = ".ply .xyz .txt .csv .pts .pwn .off .obj .stl .las .pcd";
 
-/// A PLY file as a mesh: its vertices as stored (a non-finite one is an error: faces index them)
-/// with its normals when it has them, and its faces.
-TriangleMesh meshFromPly(std::string_view data, const std::string& path) {
+/// A PLY file as a mesh: its vertices with their normals when it has them, and its faces. A
+/// non-finite vertex is an error or, with options.dropNonFinite, is skipped with its faces
+/// (counted in `dropped`).
+TriangleMesh meshFromPly(std::string_view data, const std::string& path,
+                         const ReadOptions& options = {}, std::size_t* dropped = nullptr) {
   TriangleMesh mesh;
-  const PointCloud cloud = readPly(data, path, {}, nullptr, nullptr, &mesh.triangles);
+  ReadOptions vertexOptions;
+  vertexOptions.dropNonFinite = options.dropNonFinite;
+  ReadReport report;
+  const PointCloud cloud = readPly(data, path, vertexOptions, &report, nullptr, &mesh.triangles);
+  if (dropped) *dropped = report.droppedNonFinite;
   mesh.vertices.resize(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) mesh.vertices[i] = cloud.absolutePosition(i);
   mesh.normals = cloud.normals();
@@ -83,7 +89,13 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
     case CloudFormat::Ply:
       // Sampling a PLY mesh needs its faces (meshToCloud then says when it has none).
       if (options.meshSamples == 0) return readPly(data, path, options, report);
-      return io_detail::meshToCloud(meshFromPly(data, path), path, options, report, "ply");
+      {
+        std::size_t dropped = 0;
+        PointCloud cloud = io_detail::meshToCloud(meshFromPly(data, path, options, &dropped), path,
+                                                  options, report, "ply");
+        if (report) report->droppedNonFinite = dropped;
+        return cloud;
+      }
     case CloudFormat::Stl:
       return readStl(data, path, options, report);
     case CloudFormat::Xyz:
@@ -118,6 +130,7 @@ std::optional<TriangleMesh> readFacesIfAny(const std::string& path) {
   const CloudFormat format = formatFromPath(path);
   if (!canHoldFaces(format)) return std::nullopt;
   const std::string data = io_detail::readWholeFile(path);
+  if (format == CloudFormat::Ply && !plyDeclaresFaces(data, path)) return std::nullopt;
   TriangleMesh mesh = format == CloudFormat::Off   ? parseOff(data, path)
                       : format == CloudFormat::Obj ? parseObj(data, path)
                       : format == CloudFormat::Stl ? parseStl(data, path)

@@ -29,14 +29,18 @@ using PlyEdge = std::array<Index, 2>;
 /// Parses a whole PLY file held in `data`; `file` names it in error messages. With `edges`, also
 /// hands back the `edge` element's items in file order (none when the file has no such element),
 /// each index checked against the vertex count (FileError naming the edge's line or byte); an edge
-/// element without scalar vertex1 and vertex2 properties is a FileError. Reading edges with
-/// ReadOptions::dropNonFinite is an OptionError: skipping a vertex would renumber the others.
+/// element without scalar vertex1 and vertex2 properties is a FileError.
 /// With `triangles`, also hands back the `face` element's polygons (its `vertex_indices` or
 /// `vertex_index` list) as triangle fans, each index checked against the vertex count; none when
-/// the file has no face element. The same dropNonFinite rule as for edges.
+/// the file has no face element. With ReadOptions::dropNonFinite, a skipped vertex takes the edges
+/// and triangles that use it along, and the other indices are renumbered to the points kept.
 PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options = {},
                    ReadReport* report = nullptr, std::vector<PlyEdge>* edges = nullptr,
                    std::vector<std::array<Index, 3>>* triangles = nullptr);
+
+/// Whether the header declares a non-empty `face` element (only the header is parsed: a point
+/// cloud's body is not read twice by callers that look for faces first).
+bool plyDeclaresFaces(std::string_view data, const std::string& file);
 
 /// Writes the cloud as the vertex element and, when `edges` is given, an edge element after it
 /// (indices below cloud.size(), which must fit an int: Error otherwise).

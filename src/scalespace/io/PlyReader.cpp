@@ -504,6 +504,36 @@ void readAscii(const PlyHeader& header, std::string_view data, const std::string
   }
 }
 
+constexpr Index kDroppedVertex = Index(-1);
+
+/// Each file vertex's index among the kept ones, kDroppedVertex for a skipped one.
+std::vector<Index> renumberAfterDrops(std::size_t vertexCount,
+                                      const std::vector<std::size_t>& dropped) {
+  std::vector<Index> renumbered(vertexCount, 0);
+  for (std::size_t d : dropped) renumbered[d] = kDroppedVertex;
+  Index next = 0;
+  for (Index& r : renumbered)
+    if (r != kDroppedVertex) r = next++;
+  return renumbered;
+}
+
+/// Drops the items (edges, triangles) that use a skipped vertex and renumbers the others.
+template <std::size_t N>
+void dropAndRenumber(std::vector<std::array<Index, N>>& items,
+                     const std::vector<Index>& renumbered) {
+  std::size_t kept = 0;
+  for (const std::array<Index, N>& item : items) {
+    std::array<Index, N> mapped;
+    bool usable = true;
+    for (std::size_t k = 0; k < N; ++k) {
+      mapped[k] = renumbered[std::size_t(item[k])];
+      usable = usable && mapped[k] != kDroppedVertex;
+    }
+    if (usable) items[kept++] = mapped;
+  }
+  items.resize(kept);
+}
+
 }  // namespace
 
 PointCloud readPly(std::string_view data, const std::string& file, const ReadOptions& options,
@@ -520,16 +550,8 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
   if (plan.vertexIndex == header.elements.size())
     throw FileError(file, lineWhere(header.dataLine), "the header declares no 'vertex' element",
                     "a point cloud PLY needs 'element vertex <count>' with x, y, z properties");
-  if (edges || triangles) {
-    // Edges and faces index the vertices as stored: dropping a vertex would shift every later
-    // index.
-    if (options.dropNonFinite)
-      throw OptionError(std::string("ReadOptions::dropNonFinite cannot be used when reading ") +
-                        (edges ? "edges" : "faces") +
-                        " (it would renumber the vertices they join)");
-    if (edges) edges->clear();
-    if (triangles) triangles->clear();
-  }
+  if (edges) edges->clear();
+  if (triangles) triangles->clear();
   CloudBuilder builder(file, options);
   const VertexLayout vertex = planVertex(header.elements[plan.vertexIndex], file, builder);
   plan.vertex = &vertex;
@@ -555,7 +577,19 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
     readAscii(header, data, file, builder, plan);
   else
     readBinary(header, data, file, builder, plan);
+  if (!builder.droppedOrdinals().empty()) {
+    const std::vector<Index> renumbered =
+        renumberAfterDrops(plan.vertexCount, builder.droppedOrdinals());
+    if (edges) dropAndRenumber(*edges, renumbered);
+    if (triangles) dropAndRenumber(*triangles, renumbered);
+  }
   return builder.finish(report, std::string("ply (") + encodingName(header.encoding) + ")");
+}
+
+bool plyDeclaresFaces(std::string_view data, const std::string& file) {
+  for (const PlyElement& element : parseHeader(data, file).elements)
+    if (element.name == "face" && element.count > 0 && !element.properties.empty()) return true;
+  return false;
 }
 
 }  // namespace scalespace
