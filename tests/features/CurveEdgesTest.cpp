@@ -83,3 +83,36 @@ TEST(CurveEdges, AGentleArcAndAGapDoNotSplit) {
   EXPECT_THROW(splitCurvesAtCorners(points, buildKnnGraph(points, 10), {0}, options()),
                OptionError);
 }
+
+TEST(CurveEdges, AStraightEdgeBrokenByWideSpotsIsJoinedAgainButNotRoundACorner) {
+  // An L whose long arm's band widens into a disc every 15 spacings (a scan's noisy band): the
+  // linearity test fails at each disc and cuts the arm; the pieces lie along one line.
+  std::vector<Vec3> points = bandAlong({Vec3(1, 0, 0), Vec3(0, 0, 0), Vec3(0, 0.5, 0)});
+  for (int spot = 1; spot <= 5; ++spot)
+    for (int u = -3; u <= 3; ++u)
+      for (int v = -3; v <= 3; ++v)
+        if (u * u + v * v <= 9)
+          points.push_back(Vec3(0.15 * spot + 0.8 * kSpacing * u, 0.8 * kSpacing * v, 0));
+  const std::vector<int> curve(points.size(), 0);
+  const KnnGraph graph = buildKnnGraph(points, 10);
+  CurveEdgeOptions apart = options();
+  apart.mergeAngleDegrees = 0;
+  const CurveEdges pieces = splitCurvesAtCorners(points, graph, curve, apart);
+  EXPECT_GE(pieces.points.size(), 4u);  // the discs cut the long arm
+  const CurveEdges edges = splitCurvesAtCorners(points, graph, curve, options());
+  ASSERT_EQ(edges.points.size(), 2u);
+  std::set<int> armX, armY;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].x() > 0.1) armX.insert(edges.edgeId[i]);
+    if (points[i].y() > 0.1) armY.insert(edges.edgeId[i]);
+  }
+  EXPECT_EQ(armX.size(), 1u);
+  EXPECT_EQ(armY.size(), 1u);
+  EXPECT_NE(*armX.begin(), *armY.begin());
+  CurveEdgeOptions bad = options();
+  bad.mergeThickening = 0.5;
+  EXPECT_THROW(splitCurvesAtCorners(points, graph, curve, bad), OptionError);
+  bad = options();
+  bad.mergeAngleDegrees = 120;
+  EXPECT_THROW(splitCurvesAtCorners(points, graph, curve, bad), OptionError);
+}

@@ -39,6 +39,116 @@ std::vector<std::vector<Index>> curveLinks(const KnnGraph& graph, const std::vec
   return links;
 }
 
+/// Sums that give a point set's line fit, and that of a union of sets, in O(1).
+struct LineSums {
+  double count = 0;
+  Vec3 sum = Vec3::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  void add(const Vec3& p) { count += 1, sum += p, outer += p * p.transpose(); }
+  void add(const LineSums& o) { count += o.count, sum += o.sum, outer += o.outer; }
+  struct Line {
+    Vec3 direction;
+    double rms;      // of the points' distances to the line
+    bool elongated;  // the second eigenvalue at most half the first: the direction means something
+    bool blob;       // not elongated, and its RMS extent along the direction within `radius`
+  };
+  /// The line through the points (false below 3 points).
+  bool fit(double radius, Line& line) const {
+    if (count < 3) return false;
+    const Vec3 mean = sum / count;
+    const Eigen::Matrix3d covariance = outer / count - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+    const Vec3 lambda = eigen.eigenvalues().cwiseMax(0.0);
+    line.direction = eigen.eigenvectors().col(2);
+    line.rms = std::sqrt(lambda(0) + lambda(1));
+    line.elongated = lambda(1) <= 0.5 * lambda(2);
+    line.blob = !line.elongated && lambda(2) <= radius * radius;
+    return true;
+  }
+};
+
+/// Joins adjacent edges (edgeOf, ids below edgeCount) of one curve along one line, most parallel
+/// pairs first, each edge joined at most once per round, until no pair qualifies; edgeOf then
+/// holds one id per joined set. Sequential: the same for any thread count.
+void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& curveId,
+                         const std::vector<Index>& labelled, const SpatialIndex& index,
+                         const CurveEdgeOptions& options, std::vector<int>& edgeOf,
+                         std::size_t edgeCount) {
+  if (!(options.mergeAngleDegrees > 0) || edgeCount < 2) return;
+  const std::size_t m = at.size();
+  // Adjacent edges: points of one curve within the link distance of each other.
+  std::vector<std::pair<int, int>> adjacent;
+  std::vector<Neighbor> found;
+  for (std::size_t a = 0; a < m; ++a) {
+    index.radiusSearch(at[a], options.linkDistance, found);
+    for (const Neighbor& nb : found) {
+      const int x = edgeOf[a], y = edgeOf[nb.index];
+      if (x < y && curveId[labelled[a]] == curveId[labelled[nb.index]]) adjacent.push_back({x, y});
+    }
+  }
+  std::sort(adjacent.begin(), adjacent.end());
+  adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
+  if (adjacent.empty()) return;
+  // Relative to the centroid of all points: the sums of squares stay well conditioned.
+  Vec3 origin = Vec3::Zero();
+  for (const Vec3& p : at) origin += p / double(m);
+  std::vector<LineSums> sums(edgeCount);
+  for (std::size_t a = 0; a < m; ++a) sums[std::size_t(edgeOf[a])].add(at[a] - origin);
+  DisjointSets sets(edgeCount);
+  const double parallel = std::cos(options.mergeAngleDegrees * 3.14159265358979323846 / 180);
+  for (;;) {
+    struct Candidate {
+      double cosine;
+      int x, y;
+    };
+    std::vector<Candidate> candidates;
+    for (const auto& [ex, ey] : adjacent) {
+      const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
+      if (x == y) continue;
+      LineSums both = sums[std::size_t(x)];
+      both.add(sums[std::size_t(y)]);
+      LineSums::Line lx, ly, lu;
+      const double r = options.radius;
+      if (!sums[std::size_t(x)].fit(r, lx) || !sums[std::size_t(y)].fit(r, ly) || !both.fit(r, lu))
+        continue;
+      // A small blob (a patch of the band chained by its local directions) has no direction of
+      // its own to compare: the union's thickness decides alone.
+      if (!(lx.elongated || lx.blob) || !(ly.elongated || ly.blob) || (lx.blob && ly.blob))
+        continue;
+      // Each piece and their union lie along a line: within half the radius of it (a curved
+      // edge's pieces are left as they are).
+      if (std::max({lx.rms, ly.rms, lu.rms}) > 0.5 * r) continue;
+      const double cosine =
+          lx.elongated && ly.elongated ? std::abs(lx.direction.dot(ly.direction)) : parallel;
+      if (lu.elongated && cosine >= parallel &&
+          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms))
+        candidates.push_back({cosine, std::min(x, y), std::max(x, y)});
+    }
+    if (candidates.empty()) break;
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& p, const Candidate& q) {
+      return p.cosine != q.cosine ? p.cosine > q.cosine
+                                  : std::make_pair(p.x, p.y) < std::make_pair(q.x, q.y);
+    });
+    candidates.erase(std::unique(candidates.begin(), candidates.end(),
+                                 [](const Candidate& p, const Candidate& q) {
+                                   return p.x == q.x && p.y == q.y;
+                                 }),
+                     candidates.end());
+    std::vector<std::uint8_t> joined(edgeCount, 0);
+    for (const Candidate& c : candidates) {
+      if (joined[std::size_t(c.x)] || joined[std::size_t(c.y)]) continue;
+      joined[std::size_t(c.x)] = joined[std::size_t(c.y)] = 1;
+      sets.unite(Index(c.x), Index(c.y));
+      const int root = int(sets.find(Index(c.x)));
+      LineSums merged = sums[std::size_t(c.x)];
+      merged.add(sums[std::size_t(c.y)]);
+      sums[std::size_t(root)] = merged;
+    }
+  }
+  for (std::size_t a = 0; a < m; ++a) edgeOf[a] = int(sets.find(Index(edgeOf[a])));
+}
+
 }  // namespace
 
 CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGraph& graph,
@@ -49,6 +159,10 @@ CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGra
     throw OptionError("CurveEdgeOptions::linkDistance must be finite and > 0");
   if (!(options.maxSpread >= 0 && options.maxSpread <= 1))
     throw OptionError("CurveEdgeOptions::maxSpread must be in [0, 1]");
+  if (!(options.mergeAngleDegrees >= 0 && options.mergeAngleDegrees <= 90))
+    throw OptionError("CurveEdgeOptions::mergeAngleDegrees must be in [0, 90]");
+  if (!(options.mergeThickening >= 1) || !std::isfinite(options.mergeThickening))
+    throw OptionError("CurveEdgeOptions::mergeThickening must be finite and >= 1");
   if (curveId.size() != positions.size() || graph.size() != positions.size())
     throw OptionError("splitCurvesAtCorners: one curve id and one graph vertex per point needed");
   const std::size_t n = positions.size();
@@ -198,6 +312,23 @@ CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGra
       for (const Index c : links[b])
         if (edgeOf[c] < 0) edgeOf[c] = e, stack.push_back(c);
     }
+  }
+
+  // 4. Pieces of one straight edge rejoined: on a scan the band is wider and its directions
+  // noisier than on a CAD model, so the linearity test cuts a long edge into runs between
+  // non-linear patches (a table's front edge in 10 pieces). Adjacent edges of a curve whose lines
+  // agree and whose union is about as thin as each are one edge; a corner's arms are not (their
+  // union is as wide as they are long).
+  mergeCollinearEdges(at, curveId, labelled, *index, options, edgeOf, edges.size());
+  std::size_t edgeCount = 0;
+  {
+    std::vector<int> dense(std::max<std::size_t>(edges.size(), 1), -1);
+    for (std::size_t a = 0; a < m; ++a) {
+      int& d = dense[std::size_t(edgeOf[a])];
+      if (d < 0) d = int(edgeCount++);
+      edgeOf[a] = d;
+    }
+    edges.assign(edgeCount, {});
   }
 
   // Renumbered by curve, then lowest point.

@@ -12,7 +12,8 @@
 // points whose lines agree; pieces shorter than radius / 2 are taken as corner points; each corner
 // point then joins the edge it is nearest to through the graph (breadth first, ties to the lower
 // edge id), or, cut off by a gap, the edge of its curve's nearest edge point. A curve without any
-// edge point stays one edge.
+// edge point stays one edge. Last, adjacent edges along one line are joined again (on a scan a
+// noisy band breaks the linearity test here and there along a straight edge).
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"
@@ -23,9 +24,14 @@ namespace scalespace {
 struct CurveEdgeOptions {
   double radius = 0;        // the neighbourhood of the linearity test (required, > 0)
   double maxSpread = 0.15;  // FeatureCurveOptions::edgeSpread
-  /// Linear points this close whose lines agree within 30 degrees are on one edge, across gaps
+  /// Linear points this close whose lines agree within 20 degrees are on one edge, across gaps
   /// in the curve (required, > 0).
   double linkDistance = 0;
+  /// Adjacent edges of a curve (points within linkDistance) whose lines agree within this angle
+  /// and whose union's RMS distance to its line is at most mergeThickening times the larger of
+  /// theirs are one edge (0: never joined).
+  double mergeAngleDegrees = 20;
+  double mergeThickening = 1.5;
 };
 
 struct CurveEdges {
