@@ -56,7 +56,10 @@
 // the diagonal (distances between noise-free positions); per curve: each ground-truth curve is
 // matched with the detected curve that holds most of its points; cDice and cH/diag are the means
 // over ground-truth curves (cH over the matched ones), cRec the fraction of ground-truth curves
-// whose match covers >= 50 % of their points. Seconds: the method on a cloud with normals (the
+// whose match covers >= 50 % of their points; per edge the same against the mesh's edges (runs of a
+// curve's sharp edges through the vertices where exactly two of one sign meet, turning by less
+// than 30 degrees) and the detected edges (ours' FeatureCurveResult::edgeId; a peer's edges are
+// its curves): edges, eDice, eRec. Seconds: the method on a cloud with normals (the
 // peers' 10-NN graph included; settings of one peer that share a computation each report it).
 // The whole run (11 models, both noise levels) took about 17 min on 2 shared cores, 13 of them in
 // CGAL's VCM (about 11 s per setting and cloud of 100k points: its offset step, which r does not
@@ -108,6 +111,10 @@ constexpr double kNoise = 1e-3;           // sigma over the bounding-box diagona
 constexpr double kCurveCovered = 0.5;     // cRec: the match covers >= 50 % of the curve
 constexpr double kVcmThreshold = 0.16;    // CGAL's example value
 constexpr double kAngleTolerance = 1e-6;  // degrees: creases built at exactly --angle count
+// Ground-truth edges: a curve's run turning by more than kEdgeTurnDegrees over kEdgeReach spacings
+// on each side of a vertex ends there; runs shorter than kEdgeReach spacings are corners, not
+// scored.
+constexpr double kEdgeTurnDegrees = 30, kEdgeReach = 2;
 constexpr std::uint64_t kSampleSeed = 1, kNoiseSeed = 2;
 
 const char* const kCadModels[] = {"fandisk", "blade", "anchor",       "rotor",
@@ -265,11 +272,14 @@ struct SharpEdge {
   Index a = 0, b = 0;
   int sign = 0;  // +1 convex, -1 concave
   int curve = -1;
+  int edge = -1;  // the straight or smoothly turning run of the curve it is on
 };
 
 struct MeshEdges {
   std::vector<SharpEdge> sharp;
   int curves = 0;
+  int edges = 0;
+  std::vector<double> edgeLength;  // per edge
   std::size_t convex = 0, concave = 0;
   std::size_t border = 0, nonManifold = 0,
               inconsistent = 0;  // edges with 1, > 2 faces; bad winding
@@ -303,7 +313,7 @@ Index opposite(const Triangle& t, Index a, Index b) {
 }
 
 // Sharp edges (normals turning by >= angleDegrees) with their sign, grouped into curves.
-MeshEdges findSharpEdges(const TriangleMesh& mesh, double angleDegrees) {
+MeshEdges findSharpEdges(const TriangleMesh& mesh, double angleDegrees, double spacing) {
   std::unordered_map<std::uint64_t, std::vector<Index>> faces;  // edge (lo, hi) -> faces
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
     for (int k = 0; k < 3; ++k) {
@@ -345,6 +355,52 @@ MeshEdges findSharpEdges(const TriangleMesh& mesh, double angleDegrees) {
         e.curve = it->second;
       }
   }
+  // Edges: a curve's sharp edges chained through the vertices where exactly two sharp edges meet,
+  // of the same sign, where the chain's chords over kEdgeReach spacings on each side turn by less
+  // than kEdgeTurnDegrees (a finely tessellated arc is one edge; a fillet of a few spacings, as
+  // the samples see it, is a corner; a box's corner, where three meet, ends three).
+  std::vector<std::vector<Index>> atVertex(mesh.vertices.size());
+  for (std::size_t k = 0; k < out.sharp.size(); ++k) {
+    atVertex[out.sharp[k].a].push_back(Index(k));
+    atVertex[out.sharp[k].b].push_back(Index(k));
+  }
+  const auto other = [&](Index edge, Index v) {
+    return out.sharp[edge].a == v ? out.sharp[edge].b : out.sharp[edge].a;
+  };
+  // The vertex reached from v along `edge`, on along the chain until kEdgeReach e away or its end.
+  const auto reach = [&](Index v, Index edge) {
+    const Vec3 start = mesh.vertices[v];
+    Index at = other(edge, v);
+    for (std::size_t steps = 0; steps < out.sharp.size(); ++steps) {
+      if ((mesh.vertices[at] - start).norm() >= kEdgeReach * spacing || atVertex[at].size() != 2)
+        break;
+      edge = atVertex[at][0] == edge ? atVertex[at][1] : atVertex[at][0];
+      const Index next = other(edge, at);
+      if (next == v) break;  // a closed loop
+      at = next;
+    }
+    return mesh.vertices[at];
+  };
+  DisjointSets runs(out.sharp.size());
+  const double turnLimit = std::cos(kEdgeTurnDegrees * kPi / 180);
+  for (std::size_t v = 0; v < atVertex.size(); ++v) {
+    if (atVertex[v].size() != 2) continue;
+    const Index e1 = atVertex[v][0], e2 = atVertex[v][1];
+    if (out.sharp[e1].sign != out.sharp[e2].sign) continue;
+    const Vec3 in = mesh.vertices[v] - reach(Index(v), e1);
+    const Vec3 onward = reach(Index(v), e2) - mesh.vertices[v];
+    if (in.norm() > 0 && onward.norm() > 0 && in.normalized().dot(onward.normalized()) > turnLimit)
+      runs.unite(e1, e2);
+  }
+  std::map<Index, int> edgeOfRoot;
+  for (std::size_t k = 0; k < out.sharp.size(); ++k) {
+    const auto [it, added] = edgeOfRoot.emplace(runs.find(Index(k)), out.edges);
+    out.edges += added;
+    out.sharp[k].edge = it->second;
+  }
+  out.edgeLength.assign(std::size_t(out.edges), 0.0);
+  for (const SharpEdge& e : out.sharp)
+    out.edgeLength[std::size_t(e.edge)] += (mesh.vertices[e.a] - mesh.vertices[e.b]).norm();
   return out;
 }
 
@@ -354,12 +410,12 @@ double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
   return (p - (a + t * ab)).norm();
 }
 
-// Per point, the curve of its nearest sharp edge when that edge lies within `radius`, else -1.
-// Each edge queries balls along itself (pieces <= 2 radius long) rather than one ball around it:
-// a long edge would otherwise visit most of the cloud.
+// Per point, the curve (or, with `byEdge`, the edge) of its nearest sharp edge when that edge lies
+// within `radius`, else -1. Each edge queries balls along itself (pieces <= 2 radius long) rather
+// than one ball around it: a long edge would otherwise visit most of the cloud.
 std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const SpatialIndex& index,
                                       const TriangleMesh& mesh, const Vec3& origin,
-                                      const MeshEdges& edges, double radius) {
+                                      const MeshEdges& edges, double radius, bool byEdge = false) {
   std::vector<int> curve(positions.size(), -1);
   std::vector<double> best(positions.size(), radius);
   std::vector<Neighbor> found;
@@ -372,7 +428,7 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
       index.radiusSearch(centre, 0.5 * length / pieces + radius, found);
       for (const Neighbor& n : found) {
         const double d = segmentDistance(positions[n.index], a, b);
-        if (d <= best[n.index]) best[n.index] = d, curve[n.index] = e.curve;
+        if (d <= best[n.index]) best[n.index] = d, curve[n.index] = byEdge ? e.edge : e.curve;
       }
     }
   }
@@ -423,6 +479,7 @@ struct Model {
   PointCloud clean;               // with estimated normals
   std::vector<Vec3> meshNormals;  // of the samples, interpolated from the mesh
   std::vector<int> gt;            // per point: ground-truth curve or -1
+  std::vector<int> gtEdge;        // per point: ground-truth edge or -1 (where gt is not)
   std::vector<int> gt2,
       gt3;           // the same within 2 e and 3 e (--per-curve: where false positives lie)
   int gtCurves = 0;  // curves with at least one point
@@ -454,10 +511,12 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
   m.diagonal = m.clean.boundingBoxDiagonal();
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
-  m.edges = findSharpEdges(m.mesh, angle);
+  m.edges = findSharpEdges(m.mesh, angle, m.spacing);
   const auto index = makeSpatialIndex(m.clean.positions());
   m.gt = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                               m.spacing);
+  m.gtEdge = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
+                                  m.spacing, true);
   if (printPerCurve) {
     m.gt2 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                                  2 * m.spacing);
@@ -522,6 +581,8 @@ struct Scores {
   double labelled = 0, precision = 0, recall = 0, mcc = 0, dice = 0, hausdorff = NAN;
   std::size_t curves = 0;
   double curveDice = 0, curveHausdorff = NAN, curveRecall = 0, seconds = 0;
+  std::size_t edges = 0;  // detected edges (a peer's are its curves)
+  double edgeDice = 0, edgeRecall = 0;
 };
 
 // Why ours misses a curve: per scale, the share of its points with a salient vertex of that scale
@@ -780,18 +841,57 @@ void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<
       ratio[std::min(n - 1, n * 9 / 10)]);
 }
 
+// Each ground-truth group (curve or edge) against the detected group holding most of its points:
+// match[g] (-1 for none) and the points they share.
+struct Matches {
+  std::map<std::pair<int, int>, std::size_t> overlap;  // (truth, detected) -> shared points
+  std::vector<int> match;
+  std::vector<std::size_t> common;
+};
+
+Matches bestMatches(const std::vector<int>& truth, int truthCount,
+                    const std::vector<int>& detected) {
+  Matches out;
+  for (std::size_t i = 0; i < truth.size(); ++i)
+    if (truth[i] >= 0 && detected[i] >= 0) ++out.overlap[{truth[i], detected[i]}];
+  out.match.assign(std::size_t(truthCount), -1);
+  out.common.assign(std::size_t(truthCount), 0);
+  for (const auto& [pair, k] : out.overlap)
+    if (k > out.common[std::size_t(pair.first)])
+      out.common[std::size_t(pair.first)] = k, out.match[std::size_t(pair.first)] = pair.second;
+  return out;
+}
+
+// Per edge: the same matching between the mesh's edges and the detected edges (Dice and the
+// share covered >= kCurveCovered).
+void scoreEdges(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
+  const std::vector<std::vector<Index>> truth = groups(m.gtEdge, m.edges.edges),
+                                        found = groups(detected, detectedCount);
+  const Matches matches = bestMatches(m.gtEdge, m.edges.edges, detected);
+  double diceSum = 0;
+  std::size_t counted = 0, covered = 0;
+  for (std::size_t g = 0; g < truth.size(); ++g) {
+    if (truth[g].empty() || m.edges.edgeLength[g] < kEdgeReach * m.spacing) continue;
+    ++counted;
+    if (matches.match[g] < 0) continue;
+    diceSum +=
+        dice(matches.common[g], truth[g].size(), found[std::size_t(matches.match[g])].size());
+    covered += double(matches.common[g]) >= kCurveCovered * double(truth[g].size());
+  }
+  s.edges = std::size_t(detectedCount);
+  if (counted == 0) return;
+  s.edgeDice = diceSum / double(counted);
+  s.edgeRecall = double(covered) / double(counted);
+}
+
 // Per curve: each ground-truth curve against the detected curve holding most of its points.
 void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedCount, Scores& s) {
   const std::vector<std::vector<Index>> truth = groups(m.gt, m.edges.curves),
                                         found = groups(detected, detectedCount);
-  std::map<std::pair<int, int>, std::size_t> overlap;
-  for (std::size_t i = 0; i < m.gt.size(); ++i)
-    if (m.gt[i] >= 0 && detected[i] >= 0) ++overlap[{m.gt[i], detected[i]}];
-  std::vector<int> match(truth.size(), -1);
-  std::vector<std::size_t> common(truth.size(), 0);
-  for (const auto& [pair, k] : overlap)
-    if (k > common[std::size_t(pair.first)])
-      common[std::size_t(pair.first)] = k, match[std::size_t(pair.first)] = pair.second;
+  const Matches matches = bestMatches(m.gt, m.edges.curves, detected);
+  const auto& overlap = matches.overlap;
+  const std::vector<int>& match = matches.match;
+  const std::vector<std::size_t>& common = matches.common;
   std::map<int, std::unique_ptr<SpatialIndex>> foundIndex;  // a large component matches many
   double diceSum = 0, hausdorffSum = 0;
   std::size_t counted = 0, matched = 0, covered = 0;
@@ -831,8 +931,10 @@ void scoreCurves(const Model& m, const std::vector<int>& detected, int detectedC
   if (matched) s.curveHausdorff = hausdorffSum / double(matched) / m.diagonal;
 }
 
-// `detected`: per point, its detected curve or -1 (labelled = detected >= 0).
-Scores score(const Model& m, const std::vector<int>& detected, int detectedCount) {
+// `detected`: per point, its detected curve or -1 (labelled = detected >= 0); `edges`: per point,
+// its detected edge (labelled where detected is).
+Scores score(const Model& m, const std::vector<int>& detected, int detectedCount,
+             const std::vector<int>& edges, int edgeCount) {
   double tp = 0, fp = 0, fn = 0, tn = 0;
   std::vector<Index> truthSet, labelledSet;
   for (std::size_t i = 0; i < m.gt.size(); ++i) {
@@ -858,6 +960,7 @@ Scores score(const Model& m, const std::vector<int>& detected, int detectedCount
   s.dice = dice(std::size_t(tp), truthSet.size(), labelledSet.size());
   s.hausdorff = hausdorff(truthSet, labelledSet, m.clean.positions()) / m.diagonal;
   scoreCurves(m, detected, detectedCount, s);
+  scoreEdges(m, edges, edgeCount, s);
   return s;
 }
 
@@ -867,6 +970,8 @@ Scores score(const Model& m, const std::vector<int>& detected, int detectedCount
 struct Detection {
   std::vector<int> curve;
   int count = 0;
+  std::vector<int> edge;  // ours' edges; empty: a peer's, whose edges are its curves
+  int edgeCount = 0;
 };
 
 // Ours with the library's defaults unless --salient / --vote-threshold / --min-curvature /
@@ -877,6 +982,8 @@ Detection runOurs(const PointCloud& cloud) {
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
+  d.edge = result.edgeId;
+  d.edgeCount = int(result.edges.size());
   if (printPerCurve) {
     lastOurs = std::make_unique<FeatureCurveResult>(std::move(result));
     lastCloud = &cloud;
@@ -932,9 +1039,9 @@ struct Row {
 
 void printHeader(double noise) {
   std::printf("\n# noise %g of the diagonal\n", noise);
-  std::printf("%-14s %-11s %6s %6s %6s %6s %6s %8s %6s %6s %8s %5s %8s\n", "model", "method",
-              "lab%", "P", "R", "MCC", "Dice", "H/diag", "curves", "cDice", "cH/diag", "cRec",
-              "seconds");
+  std::printf("%-14s %-11s %6s %6s %6s %6s %6s %8s %6s %6s %8s %5s %8s %6s %6s %5s\n", "model",
+              "method", "lab%", "P", "R", "MCC", "Dice", "H/diag", "curves", "cDice", "cH/diag",
+              "cRec", "seconds", "edges", "eDice", "eRec");
 }
 
 // A Hausdorff distance over the diagonal, "-" when one of the sets is empty.
@@ -945,19 +1052,21 @@ std::string distanceText(double d) {
 }
 
 void printScores(const char* model, const char* method, const Scores& s) {
-  std::printf("%-14s %-11s %6.2f %6.3f %6.3f %6.3f %6.3f %8s %6zu %6.3f %8s %5.2f %8.2f\n", model,
-              method, 100 * s.labelled, s.precision, s.recall, s.mcc, s.dice,
-              distanceText(s.hausdorff).c_str(), s.curves, s.curveDice,
-              distanceText(s.curveHausdorff).c_str(), s.curveRecall, s.seconds);
+  std::printf(
+      "%-14s %-11s %6.2f %6.3f %6.3f %6.3f %6.3f %8s %6zu %6.3f %8s %5.2f %8.2f %6zu %6.3f %5.2f\n",
+      model, method, 100 * s.labelled, s.precision, s.recall, s.mcc, s.dice,
+      distanceText(s.hausdorff).c_str(), s.curves, s.curveDice,
+      distanceText(s.curveHausdorff).c_str(), s.curveRecall, s.seconds, s.edges, s.edgeDice,
+      s.edgeRecall);
   std::fflush(stdout);
 }
 
 void printModel(const Model& m, std::size_t gtPoints) {
   std::printf(
       "# %s: %zu vertices, %zu triangles; sharp edges %zu (convex %zu, concave %zu) in %d curves, "
-      "%d with points; %.2f %% of the points are feature points; e %.4g, diagonal %.4g",
+      "%d with points, %d edges; %.2f %% of the points are feature points; e %.4g, diagonal %.4g",
       m.name.c_str(), m.mesh.vertices.size(), m.mesh.triangles.size(), m.edges.sharp.size(),
-      m.edges.convex, m.edges.concave, m.edges.curves, m.gtCurves,
+      m.edges.convex, m.edges.concave, m.edges.curves, m.gtCurves, m.edges.edges,
       100.0 * double(gtPoints) / double(m.gt.size()), m.spacing, m.diagonal);
   if (m.edges.border) std::printf("; %zu border edges", m.edges.border);
   if (m.edges.nonManifold) std::printf("; %zu non-manifold edges", m.edges.nonManifold);
@@ -975,7 +1084,7 @@ void printMeans(const std::vector<Row>& rows) {
       methods.push_back(r.method);
   for (const std::string& method : methods) {
     Scores mean;
-    double n = 0, nH = 0, nCH = 0, curves = 0;
+    double n = 0, nH = 0, nCH = 0, curves = 0, edges = 0;
     mean.hausdorff = mean.curveHausdorff = 0;
     for (const Row& r : rows) {
       if (r.method != method) continue;
@@ -984,15 +1093,18 @@ void printMeans(const std::vector<Row>& rows) {
       mean.labelled += s.labelled, mean.precision += s.precision, mean.recall += s.recall;
       mean.mcc += s.mcc, mean.dice += s.dice, curves += double(s.curves);
       mean.curveDice += s.curveDice, mean.curveRecall += s.curveRecall, mean.seconds += s.seconds;
+      mean.edgeDice += s.edgeDice, mean.edgeRecall += s.edgeRecall, edges += double(s.edges);
       if (!std::isnan(s.hausdorff)) mean.hausdorff += s.hausdorff, nH += 1;
       if (!std::isnan(s.curveHausdorff)) mean.curveHausdorff += s.curveHausdorff, nCH += 1;
     }
-    for (double* v : {&mean.labelled, &mean.precision, &mean.recall, &mean.mcc, &mean.dice,
-                      &mean.curveDice, &mean.curveRecall, &mean.seconds})
+    for (double* v :
+         {&mean.labelled, &mean.precision, &mean.recall, &mean.mcc, &mean.dice, &mean.curveDice,
+          &mean.curveRecall, &mean.seconds, &mean.edgeDice, &mean.edgeRecall})
       *v /= n;
     mean.hausdorff = nH ? mean.hausdorff / nH : NAN;
     mean.curveHausdorff = nCH ? mean.curveHausdorff / nCH : NAN;
     mean.curves = std::size_t(std::lround(curves / n));
+    mean.edges = std::size_t(std::lround(edges / n));
     printScores("mean", method.c_str(), mean);
   }
 }
@@ -1028,7 +1140,8 @@ bool makeMesh(const std::string& name, const std::string& dir, std::size_t point
 // Every method on one cloud (clean or noisy) of a model.
 void runMethods(const Model& m, const PointCloud& cloud, bool peers, std::vector<Row>& rows) {
   const auto add = [&](const std::string& method, const Detection& d, double seconds) {
-    Row row{method, score(m, d.curve, d.count)};
+    Row row{method, d.edge.empty() ? score(m, d.curve, d.count, d.curve, d.count)
+                                   : score(m, d.curve, d.count, d.edge, d.edgeCount)};
     row.scores.seconds = seconds;
     printScores(m.name.c_str(), method.c_str(), row.scores);
     rows.push_back(row);
