@@ -116,3 +116,23 @@ TEST(CurveEdges, AStraightEdgeBrokenByWideSpotsIsJoinedAgainButNotRoundACorner) 
   bad.mergeAngleDegrees = 120;
   EXPECT_THROW(splitCurvesAtCorners(points, graph, curve, bad), OptionError);
 }
+
+TEST(CurveEdges, AStraightLineIsNotJoinedAcrossAJunction) {
+  // A T: where the stem meets the bar, the bar is two edges, as on a mesh (its vertex there joins
+  // three sharp edges), though its two halves lie along one line.
+  std::vector<Vec3> points = bandAlong({Vec3(-0.6, 0, 0), Vec3(0.6, 0, 0)});
+  for (const Vec3& p : bandAlong({Vec3(0, 0.5, 0), Vec3(0, 0.015, 0)})) points.push_back(p);
+  const CurveEdges edges = splitCurvesAtCorners(points, buildKnnGraph(points, 10),
+                                                std::vector<int>(points.size(), 0), options());
+  ASSERT_EQ(edges.points.size(), 3u);
+  std::set<int> left, right, stem;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].x() < -0.1) left.insert(edges.edgeId[i]);
+    if (points[i].x() > 0.1) right.insert(edges.edgeId[i]);
+    if (points[i].y() > 0.1) stem.insert(edges.edgeId[i]);
+  }
+  ASSERT_EQ(left.size(), 1u);
+  ASSERT_EQ(right.size(), 1u);
+  ASSERT_EQ(stem.size(), 1u);
+  EXPECT_EQ((std::set<int>{*left.begin(), *right.begin(), *stem.begin()}).size(), 3u);
+}

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <string>
 #include <utility>
@@ -52,6 +53,7 @@ struct LineSums {
     double rms;      // of the points' distances to the line
     bool elongated;  // the second eigenvalue at most half the first: the direction means something
     bool blob;       // not elongated, and its RMS extent along the direction within `radius`
+    double extent;   // RMS extent along the direction
   };
   /// The line through the points (false below 3 points).
   bool fit(double radius, Line& line) const {
@@ -64,6 +66,7 @@ struct LineSums {
     line.rms = std::sqrt(lambda(0) + lambda(1));
     line.elongated = lambda(1) <= 0.5 * lambda(2);
     line.blob = !line.elongated && lambda(2) <= radius * radius;
+    line.extent = std::sqrt(lambda(2));
     return true;
   }
 };
@@ -103,6 +106,29 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
       int x, y;
     };
     std::vector<Candidate> candidates;
+    std::vector<std::vector<int>> around(edgeCount);  // per joined set, the sets it touches
+    for (const auto& [ex, ey] : adjacent) {
+      const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
+      if (x != y) around[std::size_t(x)].push_back(y), around[std::size_t(y)].push_back(x);
+    }
+    for (auto& a : around) {
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+    }
+    // A third edge (elongated, at least `radius` long) touching both: a junction where it meets
+    // the line; the two pieces are edges of their own there, as on the mesh.
+    const auto junction = [&](int x, int y) {
+      const std::vector<int>&ax = around[std::size_t(x)], &ay = around[std::size_t(y)];
+      std::vector<int> both;
+      std::set_intersection(ax.begin(), ax.end(), ay.begin(), ay.end(), std::back_inserter(both));
+      for (const int z : both) {
+        LineSums::Line lz;
+        if (sums[std::size_t(z)].fit(options.radius, lz) && lz.elongated &&
+            lz.extent >= 0.5 * options.radius)
+          return true;
+      }
+      return false;
+    };
     for (const auto& [ex, ey] : adjacent) {
       const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
       if (x == y) continue;
@@ -122,7 +148,7 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
       const double cosine =
           lx.elongated && ly.elongated ? std::abs(lx.direction.dot(ly.direction)) : parallel;
       if (lu.elongated && cosine >= parallel &&
-          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms))
+          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) && !junction(x, y))
         candidates.push_back({cosine, std::min(x, y), std::max(x, y)});
     }
     if (candidates.empty()) break;

@@ -13,7 +13,8 @@
 // point then joins the edge it is nearest to through the graph (breadth first, ties to the lower
 // edge id), or, cut off by a gap, the edge of its curve's nearest edge point. A curve without any
 // edge point stays one edge. Last, adjacent edges along one line are joined again (on a scan a
-// noisy band breaks the linearity test here and there along a straight edge).
+// noisy band breaks the linearity test here and there along a straight edge), unless a third edge
+// meets them there (a junction).
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"
