@@ -205,6 +205,17 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
     if (print)
       std::printf("    %-9s IoU %.3f %s%s%s\n", t.name.c_str(), j, found ? "found" : "MISSED",
                   k < m.sets.size() ? (" (" + m.sets[k].where + ")").c_str() : "", errors.c_str());
+    if (print && !found && k < m.sets.size()) {  // the best set: too small, or spilling over
+      const std::vector<Index>& target = gt[std::size_t(t.id)];
+      std::size_t common = 0, elsewhere = 0;
+      for (const Index i : m.sets[k].points) {
+        const bool mine = int(pipe[i]) == t.id;
+        common += mine;
+        elsewhere += !mine;
+      }
+      std::printf("      %zu of its %zu points in a set of %zu (%s): %zu elsewhere\n", common,
+                  target.size(), m.sets[k].points.size(), m.sets[k].where.c_str(), elsewhere);
+    }
   }
   for (int k = 0; k < 3; ++k) {
     // What a scan sees of a strand: one piece all round, or, seen from one side, the runs along
