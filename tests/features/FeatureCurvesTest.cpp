@@ -457,6 +457,7 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   refused([](auto& o) { o.centrelineReach = -1; }, "FeatureCurveOptions::centrelineReach");
   refused([](auto& o) { o.bandHalfWidth = 0; }, "FeatureCurveOptions::bandHalfWidth");
   refused([](auto& o) { o.centrelineLinearity = 2; }, "FeatureCurveOptions::centrelineLinearity");
+  refused([](auto& o) { o.edgeRejoinAngle = 95; }, "FeatureCurveOptions::edgeRejoinAngle");
   // One scale cannot give the default 3 voting scales: the message names both fields and values.
   refused([](auto& o) { o.scaleCount = 1; },
           "FeatureCurveOptions::minVotingScales must be in [1, FeatureCurveOptions::scaleCount = "

@@ -268,6 +268,10 @@ void addFeaturesCommand(CLI::App& app) {
                   "edge_id splits each curve at its corners: points whose curve neighbours within "
                   "this x e do not lie along a line are corners (0: one edge per curve)")
       ->capture_default_str();
+  cmd->add_option("--edge-rejoin-angle", args->features.edgeRejoinAngle,
+                  "adjacent edges of a curve along one line (within this angle, degrees) are "
+                  "joined again where no third edge meets them (0: never)")
+      ->capture_default_str();
   cmd->add_option("--band-half-width", args->features.bandHalfWidth,
                   "the points kept lie within this x e of the centreline")
       ->capture_default_str();
@@ -407,6 +411,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"band_half_width", options.bandHalfWidth},
                                    {"centreline_linearity", options.centrelineLinearity},
                                    {"edge_reach", options.edgeReach},
+                                   {"edge_rejoin_angle", options.edgeRejoinAngle},
                                    {"curved_seeds_first", options.lines.curvedSeedsFirst},
                                    {"threads", args->threads}}},
                                  {"scales", scales},

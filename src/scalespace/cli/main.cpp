@@ -59,6 +59,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
     {"FeatureCurveOptions::edgeReach", "--edge-reach"},
+    {"FeatureCurveOptions::edgeRejoinAngle", "--edge-rejoin-angle"},
     {"FeatureCurveOptions::joinGap", "--join-gap"},
     {"FeatureCurveOptions::minSalientCurvature", "--min-curvature"},
     {"FeatureCurveOptions::minVotingScales", "--min-scales"},

@@ -225,6 +225,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::edgeReach must be finite and >= 0 (0 = off)");
   require(o.edgeSpread >= 0 && o.edgeSpread <= 1,
           "FeatureCurveOptions::edgeSpread must be in [0, 1]");
+  require(o.edgeRejoinAngle >= 0 && o.edgeRejoinAngle <= 90,
+          "FeatureCurveOptions::edgeRejoinAngle must be in [0, 90] degrees (0 = off)");
   require(std::isfinite(o.joinGap) && o.joinGap >= 0,
           "FeatureCurveOptions::joinGap must be finite and >= 0");
   require(std::isfinite(o.noiseSalientFactor) && o.noiseSalientFactor >= 0,
@@ -470,9 +472,12 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
   });
   // (not in the thesis) Each curve split into edges at its corners.
   if (options.edgeReach > 0) {
-    CurveEdges split = splitCurvesAtCorners(
-        targets, targetGraph, result.curveId,
-        {options.edgeReach * e, options.edgeSpread, std::max(1.0, options.joinGap) * e});
+    CurveEdgeOptions edgeOptions;
+    edgeOptions.radius = options.edgeReach * e;
+    edgeOptions.maxSpread = options.edgeSpread;
+    edgeOptions.linkDistance = std::max(1.0, options.joinGap) * e;
+    edgeOptions.mergeAngleDegrees = options.edgeRejoinAngle;
+    CurveEdges split = splitCurvesAtCorners(targets, targetGraph, result.curveId, edgeOptions);
     result.edgeId = std::move(split.edgeId);
     result.edges.resize(split.points.size());
     for (std::size_t k = 0; k < split.points.size(); ++k) {

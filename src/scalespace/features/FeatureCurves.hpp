@@ -106,6 +106,10 @@ struct FeatureCurveOptions {
   /// and those beside it on both faces) spreads in two directions across. 0: no split.
   double edgeReach = 4;
   double edgeSpread = 0.15;
+  /// (Not in the thesis) adjacent edges of a curve whose lines agree within this angle (degrees)
+  /// are joined again where no third edge meets them (CurveEdgeOptions::mergeAngleDegrees): a
+  /// scan's noisy band breaks the linearity test here and there along a straight edge. 0: never.
+  double edgeRejoinAngle = 20;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
   /// Also return the salient vertices and, per target point, the scales that voted for it
