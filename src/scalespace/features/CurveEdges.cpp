@@ -64,7 +64,7 @@ struct LineSums {
     const Vec3 lambda = eigen.eigenvalues().cwiseMax(0.0);
     line.direction = eigen.eigenvectors().col(2);
     line.rms = std::sqrt(lambda(0) + lambda(1));
-    line.elongated = lambda(1) <= 0.5 * lambda(2);
+    line.elongated = lambda(2) > 0 && lambda(1) <= 0.5 * lambda(2);  // coincident points: no line
     line.blob = !line.elongated && lambda(2) <= radius * radius;
     line.extent = std::sqrt(lambda(2));
     return true;
@@ -115,8 +115,9 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
       std::sort(a.begin(), a.end());
       a.erase(std::unique(a.begin(), a.end()), a.end());
     }
-    // A third edge (elongated, at least `radius` long) touching both: a junction where it meets
-    // the line; the two pieces are edges of their own there, as on the mesh.
+    // A third edge (elongated, its RMS extent along its line at least half the radius: about
+    // 1.7 radius long) touching both: a junction where it meets the line; the two pieces are
+    // edges of their own there, as on the mesh.
     const auto junction = [&](int x, int y) {
       const std::vector<int>&ax = around[std::size_t(x)], &ay = around[std::size_t(y)];
       std::vector<int> both;
@@ -148,7 +149,8 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
       const double cosine =
           lx.elongated && ly.elongated ? std::abs(lx.direction.dot(ly.direction)) : parallel;
       if (lu.elongated && cosine >= parallel &&
-          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) && !junction(x, y))
+          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) + 1e-9 * r &&
+          !junction(x, y))
         candidates.push_back({cosine, std::min(x, y), std::max(x, y)});
     }
     if (candidates.empty()) break;

@@ -577,7 +577,7 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
     readAscii(header, data, file, builder, plan);
   else
     readBinary(header, data, file, builder, plan);
-  if (!builder.droppedOrdinals().empty()) {
+  if ((edges || triangles) && !builder.droppedOrdinals().empty()) {
     const std::vector<Index> renumbered =
         renumberAfterDrops(plan.vertexCount, builder.droppedOrdinals());
     if (edges) dropAndRenumber(*edges, renumbered);
