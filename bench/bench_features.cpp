@@ -103,7 +103,6 @@ using Triangle = std::array<Index, 3>;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kSpacingNeighbors = 16;            // e: mean distance to the 16th nearest neighbour
 constexpr std::size_t kPeerGraphNeighbors = 10;  // the peers' curves: components on the 10-NN graph
 constexpr std::size_t kCovarianceNeighbors = 16;
@@ -513,10 +512,14 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
   m.edges = findSharpEdges(m.mesh, angle, m.spacing);
   const auto index = makeSpatialIndex(m.clean.positions());
-  m.gt = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
-                              m.spacing);
   m.gtEdge = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                                   m.spacing, true);
+  // The curve of each point's edge (the same nearest sharp edge either way).
+  std::map<int, int> curveOfEdge;
+  for (const SharpEdge& e : m.edges.sharp) curveOfEdge[e.edge] = e.curve;
+  m.gt.resize(m.gtEdge.size());
+  for (std::size_t i = 0; i < m.gtEdge.size(); ++i)
+    m.gt[i] = m.gtEdge[i] < 0 ? -1 : curveOfEdge.at(m.gtEdge[i]);
   if (printPerCurve) {
     m.gt2 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                                  2 * m.spacing);

@@ -64,7 +64,6 @@ const Row kRows[] = {
     {"Jets", EstimatorKind::Jet, false, true, true, {0.445, 0.796, 0.449, 29.898}},
 };
 constexpr int kRowCount = sizeof(kRows) / sizeof(kRows[0]);
-constexpr double kPi = 3.14159265358979323846;
 
 struct Errors {
   double h = 0, k1 = 0, k2 = 0, angle = 0;

@@ -1,6 +1,7 @@
 // Curves split into edges at their corners (features/CurveEdges): an L of two straight arms is two
 // edges, a gently curved arc one, a gap along a straight edge does not split it.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -109,6 +110,10 @@ TEST(CurveEdges, AStraightEdgeBrokenByWideSpotsIsJoinedAgainButNotRoundACorner) 
   EXPECT_EQ(armX.size(), 1u);
   EXPECT_EQ(armY.size(), 1u);
   EXPECT_NE(*armX.begin(), *armY.begin());
+  {  // the joining is sequential: one thread gives the same edges
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(splitCurvesAtCorners(points, graph, curve, options()).edgeId, edges.edgeId);
+  }
   CurveEdgeOptions bad = options();
   bad.mergeThickening = 0.5;
   EXPECT_THROW(splitCurvesAtCorners(points, graph, curve, bad), OptionError);

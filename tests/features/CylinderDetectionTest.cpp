@@ -21,8 +21,6 @@ using namespace scalespace;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Tube {
   double radius = 1, length = 6;
   Vec3 axis = Vec3(1, 0.3, 0.2).normalized();

@@ -475,7 +475,7 @@ namespace {
 /// A house-shaped prism: the box [0,1]^3 without its bottom whose top is a gable roof, its ridge
 /// along x at y = 0.5, the roof planes turning by `ridgeDegrees` at it.
 PointCloud gableHouse(double ridgeDegrees, double density) {
-  const double h = 0.5 * std::tan(0.5 * ridgeDegrees * 3.14159265358979323846 / 180);
+  const double h = 0.5 * std::tan(0.5 * ridgeDegrees * kPi / 180);
   const auto roof = [h](double y) { return 1 + h * (1 - std::abs(2 * y - 1)); };
   RectangleSampler s;
   const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
@@ -495,7 +495,7 @@ PointCloud gableHouse(double ridgeDegrees, double density) {
 // (K t 2.37 at t = e, 2.75 at 3 e) and leaves the ridge salient at the finest scales only, 73% of
 // it labelled; with K from the finest scale (the default) the whole ridge is one convex curve.
 TEST(FeatureCurves, AWeakRidgeBesideStrongEdgesIsFoundWithTheFinestScalesK) {
-  const double degrees = 50, h = 0.5 * std::tan(0.5 * degrees * 3.14159265358979323846 / 180);
+  const double degrees = 50, h = 0.5 * std::tan(0.5 * degrees * kPi / 180);
   const PointCloud cloud = gableHouse(degrees, 8000);
   const Edge ridge{Vec3(0, 0.5, 1 + h), Vec3(1, 0.5, 1 + h)};
   FeatureCurveOptions thesis;

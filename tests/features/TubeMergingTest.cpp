@@ -12,8 +12,6 @@ using namespace scalespace;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Scene {
   std::vector<Vec3> positions, normals;
   std::vector<float> kappa1;

@@ -114,13 +114,13 @@ TEST(Ply, FacesAreCheckedAgainstTheVertices) {
   // A dropped vertex takes its faces along; the others are renumbered.
   ReadOptions drop;
   drop.dropNonFinite = true;
-  std::string withNan = head;
-  withNan.replace(withNan.find("vertex 3"), 8, "vertex 4");
-  withNan.replace(withNan.find("face 1"), 6, "face 2");
-  EXPECT_EQ(
-      readPly(withNan + "nan 0 0\n3 1 2 3\n3 2 1 0\n", "f.ply", drop, nullptr, nullptr, &triangles)
-          .size(),
-      3u);
+  const std::string withNan =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty "
+      "float z\nelement face 2\nproperty list uchar uint vertex_index\nend_header\n0 0 0\nnan 0 "
+      "0\n1 0 0\n0 1 0\n3 0 1 2\n3 3 2 0\n";
+  const PointCloud kept = readPly(withNan, "f.ply", drop, nullptr, nullptr, &triangles);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept.absolutePosition(1), Vec3(1, 0, 0));
   EXPECT_EQ(triangles, (std::vector<std::array<Index, 3>>{{2, 1, 0}}));
   // Without a face element, no triangles; without the list, an error naming what is missing.
   readPly(head.substr(0, head.find("element face")) + "end_header\n0 0 0\n1 0 0\n0 1 0\n", "f.ply",

@@ -17,8 +17,6 @@ using namespace scalespace;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Cloud {
   std::vector<Vec3> positions, normals;
 };

@@ -320,6 +320,18 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
     # The trimmed band only loses points.
     assert np.all(wide["curve_id"][features["curve_id"] >= 0] >= 0)
     assert (wide["curve_id"] >= 0).sum() > (features["curve_id"] >= 0).sum()
+    # The split into edges: off, one edge per curve, as the CLI's flag gives it.
+    cli("features", data / "house.ply", "-o", tmp_path / "e.ply", "--edge-reach", 0)
+    whole = ss.features(cloud.points, cloud.normals, edge_reach=0)
+    written = ss.read(str(tmp_path / "e.ply")).attributes["edge_id"]
+    np.testing.assert_array_equal(whole["edge_id"].astype(written.dtype), written)
+    assert len(whole["edges"]) == len(whole["curves"]) < len(features["edges"])
+    for kwargs, name in [({"edge_reach": -1}, "edge_reach"),
+                         ({"edge_rejoin_angle": 120}, "edge_rejoin_angle"),
+                         ({"centreline_reach": float("nan")}, "centreline_reach")]:
+        with pytest.raises(ss.OptionError, match=name) as e:
+            ss.features(cloud.points, cloud.normals, **kwargs)
+        assert "Options::" not in str(e.value)
     # The seeds' order: the random one of Sec. 3.3 through both, and it changes the lines.
     cli("lines", data / "house.ply", "-o", tmp_path / "r.ply", "--scale", 0.6,
         "--random-seed-order")

@@ -15,8 +15,6 @@
 namespace scalespace::quant {
 namespace {
 
-const double kPi = std::acos(-1.0);
-
 Vec3 randomUnit(std::mt19937_64& rng) {
   std::normal_distribution<double> g;
   for (;;) {

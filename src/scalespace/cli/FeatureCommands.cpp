@@ -269,8 +269,8 @@ void addFeaturesCommand(CLI::App& app) {
                   "this x e do not lie along a line are corners (0: one edge per curve)")
       ->capture_default_str();
   cmd->add_option("--edge-rejoin-angle", args->features.edgeRejoinAngle,
-                  "adjacent edges of a curve along one line (within this angle, degrees) are "
-                  "joined again where no third edge meets them (0: never)")
+                  "adjacent edges of a curve along one line (within this angle, degrees, in "
+                  "[0, 90]) are joined again where no third edge meets them (0: never)")
       ->capture_default_str();
   cmd->add_option("--band-half-width", args->features.bandHalfWidth,
                   "the points kept lie within this x e of the centreline")

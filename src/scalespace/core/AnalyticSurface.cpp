@@ -11,7 +11,6 @@
 namespace scalespace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Geometry of the shapes (see the header).
 const Vec3 kSphereCentre(0, 0, -1);
 constexpr double kSaddleK1 = 2, kSaddleK2 = -1;

@@ -11,8 +11,6 @@
 namespace scalespace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Layout (metres). Pipes run along x between x = -2 and 2 unless said otherwise.
 constexpr double kThinRadius = 0.03, kMediumRadius = 0.1, kThickRadius = 0.35;
 constexpr double kBentRadius = 0.12, kElbowRadius = 0.4;  // tube radius, bend radius of the axis

@@ -9,10 +9,12 @@
 #include <iterator>
 #include <map>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/PointMoments.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 
 namespace scalespace {
@@ -40,36 +42,27 @@ std::vector<std::vector<Index>> curveLinks(const KnnGraph& graph, const std::vec
   return links;
 }
 
-/// Sums that give a point set's line fit, and that of a union of sets, in O(1).
-struct LineSums {
-  double count = 0;
-  Vec3 sum = Vec3::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-
-  void add(const Vec3& p) { count += 1, sum += p, outer += p * p.transpose(); }
-  void add(const LineSums& o) { count += o.count, sum += o.sum, outer += o.outer; }
-  struct Line {
-    Vec3 direction;
-    double rms;      // of the points' distances to the line
-    bool elongated;  // the second eigenvalue at most half the first: the direction means something
-    bool blob;       // not elongated, and its RMS extent along the direction within `radius`
-    double extent;   // RMS extent along the direction
-  };
-  /// The line through the points (false below 3 points).
-  bool fit(double radius, Line& line) const {
-    if (count < 3) return false;
-    const Vec3 mean = sum / count;
-    const Eigen::Matrix3d covariance = outer / count - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-    const Vec3 lambda = eigen.eigenvalues().cwiseMax(0.0);
-    line.direction = eigen.eigenvectors().col(2);
-    line.rms = std::sqrt(lambda(0) + lambda(1));
-    line.elongated = lambda(2) > 0 && lambda(1) <= 0.5 * lambda(2);  // coincident points: no line
-    line.blob = !line.elongated && lambda(2) <= radius * radius;
-    line.extent = std::sqrt(lambda(2));
-    return true;
-  }
+/// A point set's least-squares line.
+struct Line {
+  Vec3 direction;
+  double rms;      // of the points' distances to the line
+  bool elongated;  // the second eigenvalue at most half the first: the direction means something
+  bool blob;       // not elongated, and its RMS extent along the direction within `radius`
+  double extent;   // RMS extent along the direction
 };
+
+/// The line through the points of `moments` (false below 3 points).
+bool fitLine(const PointMoments& moments, double radius, Line& line) {
+  if (moments.count < 3) return false;
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen(moments.covariance());
+  const Vec3 lambda = eigen.eigenvalues().cwiseMax(0.0);
+  line.direction = eigen.eigenvectors().col(2);
+  line.rms = std::sqrt(lambda(0) + lambda(1));
+  line.elongated = lambda(2) > 0 && lambda(1) <= 0.5 * lambda(2);  // coincident points: no line
+  line.blob = !line.elongated && lambda(2) <= radius * radius;
+  line.extent = std::sqrt(lambda(2));
+  return true;
+}
 
 /// Joins adjacent edges (edgeOf, ids below edgeCount) of one curve along one line, most parallel
 /// pairs first, each edge joined at most once per round, until no pair qualifies; edgeOf then
@@ -80,98 +73,124 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
                          std::size_t edgeCount) {
   if (!(options.mergeAngleDegrees > 0) || edgeCount < 2) return;
   const std::size_t m = at.size();
-  // Adjacent edges: points of one curve within the link distance of each other.
-  std::vector<std::pair<int, int>> adjacent;
-  std::vector<Neighbor> found;
-  for (std::size_t a = 0; a < m; ++a) {
-    index.radiusSearch(at[a], options.linkDistance, found);
-    for (const Neighbor& nb : found) {
-      const int x = edgeOf[a], y = edgeOf[nb.index];
-      if (x < y && curveId[labelled[a]] == curveId[labelled[nb.index]]) adjacent.push_back({x, y});
+  // Adjacent edges: points within the link distance of each other (found in parallel, then
+  // sorted: the same set for any thread count). Edges of one curve may join; those of another
+  // curve (a crease of the other sign) only mark junctions.
+  struct Touch {
+    int x, y;
+    bool sameCurve;
+    bool operator<(const Touch& o) const {
+      return std::tie(x, y, sameCurve) < std::tie(o.x, o.y, o.sameCurve);
     }
-  }
+    bool operator==(const Touch& o) const {
+      return x == o.x && y == o.y && sameCurve == o.sameCurve;
+    }
+  };
+  std::vector<std::vector<Touch>> near(m);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256), [&](const auto& range) {
+    std::vector<Neighbor> found;
+    for (std::size_t a = range.begin(); a != range.end(); ++a) {
+      index.radiusSearch(at[a], options.linkDistance, found);
+      for (const Neighbor& nb : found) {
+        const int x = edgeOf[a], y = edgeOf[nb.index];
+        if (x < y) near[a].push_back({x, y, curveId[labelled[a]] == curveId[labelled[nb.index]]});
+      }
+    }
+  });
+  std::vector<Touch> adjacent;
+  for (const auto& touches : near) adjacent.insert(adjacent.end(), touches.begin(), touches.end());
   std::sort(adjacent.begin(), adjacent.end());
   adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
   if (adjacent.empty()) return;
-  // Relative to the centroid of all points: the sums of squares stay well conditioned.
-  Vec3 origin = Vec3::Zero();
-  for (const Vec3& p : at) origin += p / double(m);
-  std::vector<LineSums> sums(edgeCount);
-  for (std::size_t a = 0; a < m; ++a) sums[std::size_t(edgeOf[a])].add(at[a] - origin);
+  std::vector<PointMoments> moments(edgeCount);
+  for (std::size_t a = 0; a < m; ++a) moments[std::size_t(edgeOf[a])].add(at[a]);
   DisjointSets sets(edgeCount);
-  const double parallel = std::cos(options.mergeAngleDegrees * 3.14159265358979323846 / 180);
+  const double parallel = std::cos(options.mergeAngleDegrees * kPi / 180);
+  const double r = options.radius;
   for (;;) {
-    struct Candidate {
-      double cosine;
-      int x, y;
-    };
-    std::vector<Candidate> candidates;
+    // The joined sets that touch (of one curve: `pairs`; of any: `around`), and each set's line.
+    std::vector<Touch> touches;
+    for (const Touch& t : adjacent) {
+      const int x = int(sets.find(Index(t.x))), y = int(sets.find(Index(t.y)));
+      if (x != y) touches.push_back({std::min(x, y), std::max(x, y), t.sameCurve});
+    }
+    std::sort(touches.begin(), touches.end());
+    touches.erase(std::unique(touches.begin(), touches.end()), touches.end());
+    std::vector<std::pair<int, int>> pairs;
     std::vector<std::vector<int>> around(edgeCount);  // per joined set, the sets it touches
-    for (const auto& [ex, ey] : adjacent) {
-      const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
-      if (x != y) around[std::size_t(x)].push_back(y), around[std::size_t(y)].push_back(x);
+    std::vector<Line> line(edgeCount);
+    std::vector<std::uint8_t> fitted(edgeCount, 0);  // 0: not yet, 1: a line, 2: too few points
+    for (const Touch& t : touches) {
+      if (t.sameCurve) pairs.push_back({t.x, t.y});
+      around[std::size_t(t.x)].push_back(t.y), around[std::size_t(t.y)].push_back(t.x);
+      for (const int z : {t.x, t.y})
+        if (!fitted[std::size_t(z)])
+          fitted[std::size_t(z)] =
+              fitLine(moments[std::size_t(z)], r, line[std::size_t(z)]) ? 1 : 2;
     }
     for (auto& a : around) {
       std::sort(a.begin(), a.end());
       a.erase(std::unique(a.begin(), a.end()), a.end());
     }
-    // A third edge (elongated, its RMS extent along its line at least half the radius: about
-    // 1.7 radius long) touching both: a junction where it meets the line; the two pieces are
-    // edges of their own there, as on the mesh.
+    // A third edge of any curve (elongated, its RMS extent along its line at least half the
+    // radius: about 1.7 radius long) touching both: a junction where it meets the line; the two
+    // pieces are edges of their own there, as on the mesh.
     const auto junction = [&](int x, int y) {
       const std::vector<int>&ax = around[std::size_t(x)], &ay = around[std::size_t(y)];
-      std::vector<int> both;
-      std::set_intersection(ax.begin(), ax.end(), ay.begin(), ay.end(), std::back_inserter(both));
-      for (const int z : both) {
-        LineSums::Line lz;
-        if (sums[std::size_t(z)].fit(options.radius, lz) && lz.elongated &&
-            lz.extent >= 0.5 * options.radius)
-          return true;
+      for (auto i = ax.begin(), j = ay.begin(); i != ax.end() && j != ay.end();) {
+        if (*i < *j) {
+          ++i;
+        } else if (*j < *i) {
+          ++j;
+        } else {
+          const Line& lz = line[std::size_t(*i)];
+          if (fitted[std::size_t(*i)] == 1 && lz.elongated && lz.extent >= 0.5 * r) return true;
+          ++i, ++j;
+        }
       }
       return false;
     };
-    for (const auto& [ex, ey] : adjacent) {
-      const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
-      if (x == y) continue;
-      LineSums both = sums[std::size_t(x)];
-      both.add(sums[std::size_t(y)]);
-      LineSums::Line lx, ly, lu;
-      const double r = options.radius;
-      if (!sums[std::size_t(x)].fit(r, lx) || !sums[std::size_t(y)].fit(r, ly) || !both.fit(r, lu))
-        continue;
+    struct Candidate {
+      double cosine;
+      int x, y;
+    };
+    std::vector<Candidate> candidates;
+    for (const auto& [x, y] : pairs) {
+      if (fitted[std::size_t(x)] != 1 || fitted[std::size_t(y)] != 1) continue;
+      const Line &lx = line[std::size_t(x)], &ly = line[std::size_t(y)];
       // A small blob (a patch of the band chained by its local directions) has no direction of
       // its own to compare: the union's thickness decides alone.
       if (!(lx.elongated || lx.blob) || !(ly.elongated || ly.blob) || (lx.blob && ly.blob))
         continue;
-      // Each piece and their union lie along a line: within half the radius of it (a curved
-      // edge's pieces are left as they are).
-      if (std::max({lx.rms, ly.rms, lu.rms}) > 0.5 * r) continue;
+      if (std::max(lx.rms, ly.rms) > 0.5 * r) continue;
       const double cosine =
           lx.elongated && ly.elongated ? std::abs(lx.direction.dot(ly.direction)) : parallel;
-      if (lu.elongated && cosine >= parallel &&
-          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) + 1e-9 * r &&
+      if (cosine < parallel) continue;
+      PointMoments both = moments[std::size_t(x)];
+      both.add(moments[std::size_t(y)]);
+      Line lu;
+      // Each piece and their union lie along a line, within half the radius of it (a curved
+      // edge's pieces are left as they are), and the union is about as thin as the thicker
+      // piece (a corner's arms are not: their union is as wide as they are long). The slack,
+      // 1e-6 of the extent, covers the eigensolver's error on exactly straight pieces.
+      if (fitLine(both, r, lu) && lu.elongated && lu.rms <= 0.5 * r &&
+          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) + 1e-6 * lu.extent &&
           !junction(x, y))
-        candidates.push_back({cosine, std::min(x, y), std::max(x, y)});
+        candidates.push_back({cosine, x, y});
     }
     if (candidates.empty()) break;
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& p, const Candidate& q) {
       return p.cosine != q.cosine ? p.cosine > q.cosine
                                   : std::make_pair(p.x, p.y) < std::make_pair(q.x, q.y);
     });
-    candidates.erase(std::unique(candidates.begin(), candidates.end(),
-                                 [](const Candidate& p, const Candidate& q) {
-                                   return p.x == q.x && p.y == q.y;
-                                 }),
-                     candidates.end());
     std::vector<std::uint8_t> joined(edgeCount, 0);
     for (const Candidate& c : candidates) {
       if (joined[std::size_t(c.x)] || joined[std::size_t(c.y)]) continue;
       joined[std::size_t(c.x)] = joined[std::size_t(c.y)] = 1;
+      PointMoments merged = moments[std::size_t(c.x)];
+      merged.add(moments[std::size_t(c.y)]);
       sets.unite(Index(c.x), Index(c.y));
-      const int root = int(sets.find(Index(c.x)));
-      LineSums merged = sums[std::size_t(c.x)];
-      merged.add(sums[std::size_t(c.y)]);
-      sums[std::size_t(root)] = merged;
+      moments[std::size_t(sets.find(Index(c.x)))] = merged;
     }
   }
   for (std::size_t a = 0; a < m; ++a) edgeOf[a] = int(sets.find(Index(edgeOf[a])));
@@ -188,7 +207,7 @@ CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGra
   if (!(options.maxSpread >= 0 && options.maxSpread <= 1))
     throw OptionError("CurveEdgeOptions::maxSpread must be in [0, 1]");
   if (!(options.mergeAngleDegrees >= 0 && options.mergeAngleDegrees <= 90))
-    throw OptionError("CurveEdgeOptions::mergeAngleDegrees must be in [0, 90]");
+    throw OptionError("CurveEdgeOptions::mergeAngleDegrees must be in [0, 90] degrees (0 = off)");
   if (!(options.mergeThickening >= 1) || !std::isfinite(options.mergeThickening))
     throw OptionError("CurveEdgeOptions::mergeThickening must be finite and >= 1");
   if (curveId.size() != positions.size() || graph.size() != positions.size())
@@ -253,7 +272,7 @@ CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGra
   // line (a curve's pieces that the votes left apart but FeatureCurveOptions::joinGap joined
   // are one edge when they continue each other); pieces shorter than half the radius are corners.
   const std::vector<std::vector<Index>> links = curveLinks(graph, curveId, labelled, compact);
-  const double parallel = std::cos(20 * 3.14159265358979323846 / 180);
+  const double parallel = std::cos(20 * kPi / 180);
   std::vector<std::vector<Index>> near(m);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256), [&](const auto& r) {
     std::vector<Neighbor> found;
@@ -342,11 +361,11 @@ CurveEdges splitCurvesAtCorners(const std::vector<Vec3>& positions, const KnnGra
     }
   }
 
-  // 4. Pieces of one straight edge rejoined: on a scan the band is wider and its directions
-  // noisier than on a CAD model, so the linearity test cuts a long edge into runs between
-  // non-linear patches (a table's front edge in 10 pieces). Adjacent edges of a curve whose lines
-  // agree and whose union is about as thin as each are one edge; a corner's arms are not (their
-  // union is as wide as they are long).
+  // 4. Pieces of one straight edge rejoined (not in the thesis): on a scan the band is wider and
+  // its directions noisier than on a CAD model, so the linearity test cuts a long edge into runs
+  // between non-linear patches. Adjacent edges of a curve whose lines agree and whose union is
+  // about as thin as each are one edge; a corner's arms are not (their union is as wide as they
+  // are long).
   mergeCollinearEdges(at, curveId, labelled, *index, options, edgeOf, edges.size());
   std::size_t edgeCount = 0;
   {

@@ -68,7 +68,7 @@ void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
                  std::vector<std::vector<Index>>& regions, const TubeCoverageOptions& coverage) {
   if (!coverage.enabled) return;
   std::vector<int> owner = tubeOwners(positions.size(), tubes, regions);
-  const double minCos = std::cos(coverage.maxAngleDegrees * 3.14159265358979323846 / 180);
+  const double minCos = std::cos(coverage.maxAngleDegrees * kPi / 180);
   std::vector<Index> frontier;
   for (std::size_t r = 0; r < regions.size(); ++r) {
     TubeFit& tube = tubes[r];

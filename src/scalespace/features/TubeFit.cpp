@@ -16,8 +16,6 @@ namespace scalespace {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 Vec3 anyPerpendicular(const Vec3& d) {
   return (std::abs(d.x()) < 0.9 ? d.cross(Vec3::UnitX()) : d.cross(Vec3::UnitY())).normalized();
 }

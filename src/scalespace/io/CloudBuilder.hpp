@@ -41,7 +41,7 @@ class CloudBuilder {
   bool addPoint(const Vec3& position, const Vec3& normal, const double* values, Where&& where) {
     if (!isUsablePosition(position)) {
       if (dropNonFinite_) {
-        droppedOrdinals_.push_back(positions_.size() + dropped_);
+        if (recordDrops_) droppedOrdinals_.push_back(positions_.size() + dropped_);
         ++dropped_;
         return false;
       }
@@ -53,8 +53,11 @@ class CloudBuilder {
     return true;
   }
 
-  /// The 0-based file order of each point skipped so far (readers that also hand back indices into
-  /// the points, such as PLY faces, renumber with it).
+  /// From now on, keeps the 0-based file order of each point skipped: readers that also hand back
+  /// indices into the points (PLY faces and edges) renumber with it. Off by default: a scan that
+  /// is mostly NaN (an organised PCD) would otherwise pay 8 bytes per dropped point for nothing.
+  void recordDroppedOrdinals() { recordDrops_ = true; }
+  /// The points skipped since recordDroppedOrdinals().
   const std::vector<std::size_t>& droppedOrdinals() const { return droppedOrdinals_; }
 
   /// Moves everything into a PointCloud (recentred positions) and fills `report` if given.
@@ -65,6 +68,7 @@ class CloudBuilder {
   const std::string& file_;
   bool dropNonFinite_;
   bool withNormals_ = false;
+  bool recordDrops_ = false;
   std::size_t dropped_ = 0;
   std::vector<std::size_t> droppedOrdinals_;
   std::vector<Vec3> positions_;

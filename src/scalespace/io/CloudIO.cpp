@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <utility>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/io/AtomicFile.hpp"
@@ -91,10 +92,8 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
       if (options.meshSamples == 0) return readPly(data, path, options, report);
       {
         std::size_t dropped = 0;
-        PointCloud cloud = io_detail::meshToCloud(meshFromPly(data, path, options, &dropped), path,
-                                                  options, report, "ply");
-        if (report) report->droppedNonFinite = dropped;
-        return cloud;
+        TriangleMesh mesh = meshFromPly(data, path, options, &dropped);
+        return io_detail::meshToCloud(std::move(mesh), path, options, report, "ply", dropped);
       }
     case CloudFormat::Stl:
       return readStl(data, path, options, report);

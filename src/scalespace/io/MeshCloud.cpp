@@ -7,7 +7,8 @@
 namespace scalespace::io_detail {
 
 PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOptions& options,
-                       ReadReport* report, const std::string& formatDescription) {
+                       ReadReport* report, const std::string& formatDescription,
+                       std::size_t droppedBefore) {
   const bool normals = mesh.normals.size() == mesh.vertices.size() && !mesh.vertices.empty();
   if (options.meshSamples == 0) {
     CloudBuilder builder(file, options);
@@ -54,7 +55,7 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
     throw FileError(file, "", e.what(), "check that the faces are not all degenerate");
   }
   if (report) {
-    report->droppedNonFinite = dropped;
+    report->droppedNonFinite = droppedBefore + dropped;
     report->format =
         formatDescription + ", " + std::to_string(options.meshSamples) + " area samples";
   }

@@ -561,7 +561,6 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
     edge = planEdge(header.elements[plan.edgeIndex], file);
     plan.edge = &edge;
     plan.edges = edges;
-    plan.vertexCount = header.elements[plan.vertexIndex].count;
   } else {
     plan.edgeIndex = std::size_t(-1);  // no edge stored
   }
@@ -573,6 +572,7 @@ PointCloud readPly(std::string_view data, const std::string& file, const ReadOpt
   } else {
     plan.faceIndex = std::size_t(-1);  // no face stored
   }
+  if (edges || triangles) builder.recordDroppedOrdinals();
   if (header.encoding == PlyEncoding::Ascii)
     readAscii(header, data, file, builder, plan);
   else

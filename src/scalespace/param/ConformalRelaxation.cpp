@@ -619,7 +619,7 @@ std::string relaxSphere(const std::vector<Vec3>& positions, const std::vector<Ve
         [&] { full.project(); });
     sphere = std::move(full);
   }
-  constexpr double kDegrees = 180 / 3.14159265358979323846;
+  constexpr double kDegrees = 180 / kPi;
   for (std::size_t i = 0; i < sphere.x.size(); ++i) {
     if (!(sphere.x[i].norm() > 0)) return "the relaxation put a point at the sphere's centre";
     const Vec3 dir = sphere.x[i].normalized();

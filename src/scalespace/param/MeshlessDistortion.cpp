@@ -13,8 +13,6 @@
 namespace scalespace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Ellipse {
   double anisotropy = 0, area = 0;
 };

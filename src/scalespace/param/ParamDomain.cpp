@@ -10,7 +10,6 @@
 namespace scalespace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegrees = 180 / kPi;
 
 /// A unit vector orthogonal to `axis` along the world x axis (y when x is nearly along it).

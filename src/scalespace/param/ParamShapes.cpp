@@ -12,8 +12,6 @@
 namespace scalespace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct ShapeName {
   ParamShape shape;
   const char* name;

@@ -131,10 +131,11 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     const py::handle& viewpoint, int scales, double spacing, double voteThreshold,
                     int minScales, double minCurvature, double noiseCurvature,
                     double salientThreshold, double minExtent, double joinGap,
-                    double centrelineReach, double bandHalfWidth, bool allSalient,
-                    bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
-                    bool withLines, const py::handle& triangles, std::size_t meshSamples,
-                    double sheetNormals, std::optional<int> threads, py::object progress) {
+                    double centrelineReach, double bandHalfWidth, double edgeReach,
+                    double edgeRejoinAngle, bool allSalient, bool salientPerScale, double beta,
+                    double gamma, bool curvedSeedsFirst, bool withLines,
+                    const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
+                    std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -147,6 +148,8 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.joinGap = joinGap;
   options.centrelineReach = centrelineReach;
   options.bandHalfWidth = bandHalfWidth;
+  options.edgeReach = edgeReach;
+  options.edgeRejoinAngle = edgeRejoinAngle;
   options.ridgeOnly = !allSalient;
   options.salientBoundFromFinest = !salientPerScale;
   options.lines.beta = beta;
@@ -258,7 +261,9 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "min_scales"_a = 3, "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0,
         "salient_threshold"_a = 0.5, "min_extent"_a = 1.0, "join_gap"_a = 1.5,
         "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
-        "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth, "all_salient"_a = false,
+        "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth,
+        "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
+        "edge_rejoin_angle"_a = FeatureCurveOptions{}.edgeRejoinAngle, "all_salient"_a = false,
         "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
         "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
         "triangles"_a = py::none(), "mesh_samples"_a = 100,
@@ -269,7 +274,10 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
 Returns a dict: feature_votes (N,), curve_id (N,: -1 none), convexity (N,: +1, -1, 0), spacing
 (e), max_vote, noise_rms (sigma read from the points), salient_curvature_floor (max(min_curvature,
 noise_curvature * sigma / e): the |k1| t a salient vertex needs), curves (per curve: points, length, convexity, the scales that voted), edge_id (N,: -1 none)
-and edges (per edge: points, curve, length; each curve split at its corners), scales (per
+and edges (per edge: points, curve, length; each curve split at its corners: where its points
+within edge_reach x e do not lie along a line; adjacent pieces along one line, within
+edge_rejoin_angle degrees, joined again where no third edge meets them; 0: no split / no
+rejoining), scales (per
 scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
 traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
 scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,

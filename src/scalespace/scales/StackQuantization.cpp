@@ -11,9 +11,7 @@
 
 namespace scalespace::quant {
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
+namespace {}  // namespace
 
 // ------------------------------------------------------------------------------------ float16
 

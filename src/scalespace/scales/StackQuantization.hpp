@@ -59,7 +59,7 @@ Vec3 decodeOctahedral(std::uint32_t code);
 constexpr int kAngleBits = 10;
 constexpr int kAngleSteps = 1 << kAngleBits;
 /// Worst angle between a tangent axis and its decoded angle, given an exact normal.
-constexpr double kAngleMaxError = 3.14159265358979323846 / (2 * kAngleSteps);
+constexpr double kAngleMaxError = kPi / (2 * kAngleSteps);
 
 /// The deterministic tangent basis (b1, b2) of a decoded normal n (Duff et al. 2017, "Building an
 /// orthonormal basis, revisited"): s = +1 if zSign >= 0 else -1, a = -1 / (s + n.z),
