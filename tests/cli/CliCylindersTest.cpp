@@ -128,6 +128,9 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("c.ply") + " --min-arc 500 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--min-arc"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --min-sector-fill 1.5 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--min-sector-fill"), std::string::npos) << r.err;
   r = run("cylinders " + path("c.ply") + " --max-gap -1 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--max-gap"), std::string::npos) << r.err;

@@ -230,7 +230,7 @@ TEST(Cylinders, ANoisyBoxWithEstimatedNormalsIsNoCylinder) {
 // A clean octahedron, normals estimated: around the axis through two opposite vertices its four
 // faces, joined at edges the fits round, pass every other tube test at one scale (libcgal-demo's
 // octahedron.off: a tube of radius 1.3 over half its points); its normals take four directions only
-// (TubeFitOptions::minNormalDirections).
+// (TubeFitOptions::minNormalDirections, minSectorFill).
 TEST(Cylinders, APrismsFewFaceDirectionsAreNoTube) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0, 1);
@@ -248,6 +248,7 @@ TEST(Cylinders, APrismsFewFaceDirectionsAreNoTube) {
   octahedron.setNormals(std::move(estimated.normals));
   CylinderOptions options;
   options.tube.minNormalDirections = 0;
+  options.tube.minSectorFill = 0;
   const std::size_t without = detectCylinders(octahedron, options).components.size();
   EXPECT_GE(without, 1u);  // the other tests alone let it through
   const CylinderDetection d = detectCylinders(octahedron, {});
@@ -256,6 +257,79 @@ TEST(Cylinders, APrismsFewFaceDirectionsAreNoTube) {
   for (const CylinderLevel& level : d.levels)
     faceted += level.rejections[std::size_t(TubeRejection::Faceted)];
   EXPECT_EQ(faceted, without);  // each tube the test turned down
+}
+
+// Points along x on a section given by `place` (angle -> point in the yz plane and its normal),
+// with normals turned about x by Gaussian noise of `normalNoise` radians; the scale's normals
+// radial from the axis through the origin, kappa1 1 / r: a region as the fits at one scale see a
+// tube of radius r.
+struct Section {
+  std::vector<Vec3> positions, normals, scaleNormals;
+  std::vector<float> kappa1;
+  std::vector<Index> points;
+};
+template <class Place>
+Section sampleSection(Place place, double r, double normalNoise, std::size_t count) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, normalNoise);
+  Section s;
+  for (std::size_t i = 0; i < count; ++i) {
+    Eigen::Vector2d q, n;
+    place(u(rng), q, n);
+    const double turn = g(rng);
+    const Eigen::Vector2d m(std::cos(turn) * n.x() - std::sin(turn) * n.y(),
+                            std::sin(turn) * n.x() + std::cos(turn) * n.y());
+    s.positions.push_back(Vec3(4 * u(rng), q.x(), q.y()));
+    s.normals.push_back(Vec3(0, m.x(), m.y()));
+    s.scaleNormals.push_back(Vec3(0, q.x(), q.y()).normalized());
+    s.kappa1.push_back(float(1 / r));
+    s.points.push_back(Index(i));
+  }
+  return s;
+}
+
+// A box edge rounded by the fits into a tube (the two faces of a right angle, r to 1.4 r from the
+// axis; normals leaning towards the other face near the corner, as normals estimated over many
+// neighbours do, and 9 degrees of noise) lies all round a 180-degree arc and passes every other
+// tube test; its normals crowd in two directions and fill under 0.7 of the arc's sectors
+// (TubeFitOptions::minSectorFill). A tube seen over the same arc with the same normal noise fills
+// them.
+TEST(Cylinders, ARoundedBoxEdgeIsNoTubeButAHalfPipeIs) {
+  const double r = 1, noise = 9 * kPi / 180, t = 0.5;
+  const double c = 0.99 * r;  // the faces: y = c (z in [-c, c]) and z = c (y in [-c, c])
+  const Section edge = sampleSection(
+      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const double along = (4 * a - 1) * c;  // [-c, 3c]: the two faces, end to end
+        // Normals estimated over many neighbours lean towards the other face near the corner.
+        const double blend = 0.5 * std::max(0.0, 1 - std::abs(along - c) / (0.2 * c));
+        const double angle = (along < c ? blend : 1 - blend) * kPi / 2;
+        n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
+      },
+      r, noise, 20000);
+  TubeFitOptions without;
+  without.minSectorFill = 0;
+  const TubeFit loose = fitTube(edge.positions, edge.normals, edge.scaleNormals, edge.kappa1,
+                                edge.points, t, without);
+  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
+  const TubeFit strict = fitTube(edge.positions, edge.normals, edge.scaleNormals, edge.kappa1,
+                                 edge.points, t, TubeFitOptions{});
+  EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
+  EXPECT_LT(strict.sectorFill, 0.7);
+
+  const Section pipe = sampleSection(
+      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const double angle = (a - 0.75) * kPi;  // the same half turn, from -135 to 45 degrees
+        n = Eigen::Vector2d(std::cos(angle + kPi / 2), std::sin(angle + kPi / 2));
+        q = r * n;
+      },
+      r, noise, 20000);
+  const TubeFit tube = fitTube(pipe.positions, pipe.normals, pipe.scaleNormals, pipe.kappa1,
+                               pipe.points, t, TubeFitOptions{});
+  EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
+  EXPECT_GT(tube.sectorFill, 0.9);
+  EXPECT_NEAR(tube.radius, r, 0.01);
 }
 
 // Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and

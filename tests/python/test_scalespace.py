@@ -369,7 +369,8 @@ def test_cylinders_equal_the_cli(pipes):
         for key in ("id", "birth_level", "death_level", "gap_levels", "persistence",
                     "representative_level", "point_count", "straight"):
             assert g[key] == e[key], key
-        for key in ("birth_scale", "death_scale", "radius", "rms", "length", "arc_degrees"):
+        for key in ("birth_scale", "death_scale", "radius", "rms", "length", "arc_degrees",
+                    "sector_fill"):
             np.testing.assert_allclose(g[key], e[key], rtol=1e-9, err_msg=key)
         np.testing.assert_allclose(g["axis"], e["axis"], rtol=1e-9, atol=1e-9)  # absolute
         np.testing.assert_allclose(g["radii"], e["radii"], rtol=1e-9)
@@ -450,6 +451,7 @@ def test_cylinders_bad_options_and_cancel(pipes):
     for kwargs, name in [({"epsilon": 1}, "epsilon"), ({"min_anisotropy": 2}, "min_anisotropy"),
                          ({"scale_count": 0}, "scale_count"), ({"min_arc": 400}, "min_arc"),
                          ({"max_rms": 0}, "max_rms"), ({"tmin": -1}, "tmin"),
+                         ({"min_sector_fill": 2}, "min_sector_fill"),
                          ({"max_gap": -1}, "max_gap"),
                          ({"scales": [0.2, 0.1]}, "scales")]:
         with pytest.raises(ss.OptionError, match=name) as e:

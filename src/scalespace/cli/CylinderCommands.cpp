@@ -93,6 +93,7 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
                            {"rms", t.rms},
                            {"length", t.length},
                            {"arc_degrees", t.arcDegrees},
+                           {"sector_fill", t.sectorFill},
                            {"axis", axis},
                            {"radii", t.radii}};
     if (t.straight) {  // the straight axis means nothing for a bent tube
@@ -147,6 +148,11 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--min-arc", args->cylinders.tube.minArcDegrees,
                   "a tube's points' normals must turn at least this much around its axis")
+      ->capture_default_str();
+  cmd->add_option("--min-sector-fill", args->cylinders.tube.minSectorFill,
+                  "a tube's normals must fill at least this share of the 10-degree sectors of "
+                  "the arc its points cover (0 to 1; a box edge rounded into a tube fills about "
+                  "half)")
       ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
@@ -243,6 +249,7 @@ void addCylindersCommand(CLI::App& app) {
           {"max_curvature_factor", o.filter.maxCurvatureFactor},
           {"max_mean_variation", o.filter.maxMeanVariation},
           {"min_arc_degrees", o.tube.minArcDegrees},
+          {"min_sector_fill", o.tube.minSectorFill},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
           {"curved_seeds_first", o.lines.curvedSeedsFirst},

@@ -70,6 +70,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"CylinderOptions::epsilon", "--epsilon"},
     {"CylinderOptions::minAnisotropy", "--min-anisotropy"},
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
+    {"TubeFitOptions::minSectorFill", "--min-sector-fill"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
     {"TubeFitOptions::maxRelativeRms", "--max-rms"},
     {"FlatteningOptions::scaleCount", "--scales"},

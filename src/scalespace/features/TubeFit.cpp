@@ -251,7 +251,7 @@ struct AxisEvaluation {
   std::vector<Vec3> axis;
   std::vector<double> radii;
   double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
-  double normalDirections = 0;
+  double normalDirections = 0, normalSectors = 0, evenSectorFill = 0;
 };
 
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
@@ -339,27 +339,63 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   for (std::size_t k = 0; k < points.size(); ++k)
     normalAngle[k] = azimuth(proj[k].segment, normals[points[k]]);
   e.normalArc = arc([&](std::size_t k) { return normalAngle[k]; });
-  // The effective number of 2-degree directions the normals take around the axis (the exponential
-  // of their histogram's entropy): a tube's turn continuously, a prism's sit on its few faces.
-  {
-    constexpr int kFine = 180;
-    std::array<std::uint32_t, kFine> fine{};
+  std::vector<double> positionAngle(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const std::size_t s = proj[k].segment;
+    const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
+    positionAngle[k] = azimuth(s, Vec3(positions[points[k]] - foot));
+  }
+  e.positionArc = arc([&](std::size_t k) { return positionAngle[k]; });
+  // The effective number of bins a set of azimuths takes (the exponential of their histogram's
+  // entropy).
+  const auto binOf = [](double angle, int bins) {
+    return std::size_t(std::min(bins - 1, int((angle + kPi) / (2 * kPi) * bins)));
+  };
+  const auto effectiveBins = [&](const std::vector<double>& angles, int bins) {
+    std::vector<std::uint32_t> histogram(std::size_t(bins), 0);
     std::uint32_t counted = 0;
-    for (const double angle : normalAngle) {
+    for (const double angle : angles) {
       if (std::isnan(angle)) continue;
-      ++fine[std::size_t(std::min(kFine - 1, int((angle + kPi) / (2 * kPi) * kFine)))];
+      ++histogram[binOf(angle, bins)];
       ++counted;
     }
     double entropy = 0;
-    for (const std::uint32_t c : fine)
+    for (const std::uint32_t c : histogram)
       if (c > 0) entropy -= double(c) / counted * std::log(double(c) / counted);
-    e.normalDirections = std::exp(entropy);
+    return std::exp(entropy);
+  };
+  // The 2-degree directions the normals take around the axis: a tube's turn continuously, a
+  // prism's sit on its few faces.
+  e.normalDirections = effectiveBins(normalAngle, 180);
+  // How fully the normals take the 10-degree sectors of the arc: a tube's turn with its points
+  // and fill it, tessellated or not (a 40-gon's facets are 9 degrees apart); a box edge's faces,
+  // rounded into a tube at a scale above them, lie all round the arc with their normals in two
+  // directions however far noise smears them. Two readings, the larger kept: the effective
+  // number of sectors the normals take over the arc's sectors, and the same with each sector of
+  // points weighted alike over the sectors they cover (a tube sampled unevenly around its axis,
+  // as a locally refined mesh's vertices are, has its normals where its points are dense).
+  constexpr int kSectors = 36;
+  e.normalSectors = effectiveBins(normalAngle, kSectors);
+  {
+    const auto sectorOf = [&](double angle) { return binOf(angle, kSectors); };
+    std::array<double, kSectors> pointsIn{}, normalsIn{};
+    double counted = 0;
+    for (const double angle : positionAngle)
+      if (!std::isnan(angle)) pointsIn[sectorOf(angle)] += 1, counted += 1;
+    const double enough = std::max(2.0, 0.25 * counted / kSectors);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (std::isnan(positionAngle[k]) || std::isnan(normalAngle[k])) continue;
+      const double inSector = pointsIn[sectorOf(positionAngle[k])];
+      if (inSector >= enough) normalsIn[sectorOf(normalAngle[k])] += 1 / inSector;
+    }
+    double total = 0, entropy = 0;
+    int covered = 0;
+    for (const double c : pointsIn) covered += c >= enough;
+    for (const double w : normalsIn) total += w;
+    for (const double w : normalsIn)
+      if (w > 0) entropy -= w / total * std::log(w / total);
+    e.evenSectorFill = covered > 0 && total > 0 ? std::exp(entropy) / covered : 0;
   }
-  e.positionArc = arc([&](std::size_t k) {
-    const std::size_t s = proj[k].segment;
-    const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
-    return azimuth(s, Vec3(positions[points[k]] - foot));
-  });
 }
 
 // Re-centres each vertex of a curved axis on its cross-section: the circle fitted to the points
@@ -450,6 +486,8 @@ void validateTubeFitOptions(const TubeFitOptions& options) {
         "TubeFitOptions::maxRelativeRms must be finite and > 0");
   check(std::isfinite(options.minNormalDirections) && options.minNormalDirections >= 0,
         "TubeFitOptions::minNormalDirections must be finite and >= 0");
+  check(options.minSectorFill >= 0 && options.minSectorFill <= 1,
+        "TubeFitOptions::minSectorFill must be in [0, 1]");
   check(std::isfinite(options.straightRmsRatio) && options.straightRmsRatio >= 1,
         "TubeFitOptions::straightRmsRatio must be finite and >= 1");
 }
@@ -520,6 +558,8 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   fit.radius = fit.straight ? fit.straightRadius : chosen.meanDistance;
   fit.arcDegrees = std::min(chosen.normalArc, chosen.positionArc);
   fit.normalDirections = chosen.normalDirections;
+  fit.sectorFill = std::max(fit.arcDegrees > 0 ? chosen.normalSectors / (fit.arcDegrees / 10) : 0,
+                            chosen.evenSectorFill);
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 
@@ -532,7 +572,8 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   else if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t)))
     fit.rejection = TubeRejection::Rough;
   else if (fit.normalDirections <
-           std::min(options.minNormalDirections, 0.5 * double(points.size())))
+               std::min(options.minNormalDirections, 0.5 * double(points.size())) ||
+           fit.sectorFill < options.minSectorFill)
     fit.rejection = TubeRejection::Faceted;
   else
     fit.rejection = TubeRejection::None;

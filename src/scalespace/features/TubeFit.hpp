@@ -48,6 +48,14 @@ struct TubeFitOptions {
   /// at one scale. A tessellated cylinder of 40 facets (pipe.off) gives 36-73. Noise spreads a
   /// prism's normals and hides its faces.
   double minNormalDirections = 24;
+  /// And they must fill the arc: sectorFill, the effective number of 10-degree sectors their
+  /// azimuths take (exponential of the histogram's entropy) over the arc's sectors, or the same
+  /// with each sector of points weighted alike over the sectors the points cover (a tube sampled
+  /// unevenly around its axis), the larger, >= minSectorFill. A tube's normals turn with its
+  /// points; the faces of a box edge, rounded by the fits into a tube at a scale above them, lie
+  /// all round the arc while their normals, however far noise or normals estimated over many
+  /// neighbours smear them, crowd in two directions.
+  double minSectorFill = 0.75;
   /// The axis is straight unless the curved axis fits the points better: straight when the RMS
   /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
   /// the radius of it).
@@ -81,6 +89,7 @@ struct TubeFit {
   double straightRadius = 0;  // radius of the straight fit
   double arcDegrees = 0;  // the arc around the axis covered by both the points and their normals
   double normalDirections = 0;  // TubeFitOptions::minNormalDirections' measure
+  double sectorFill = 0;        // TubeFitOptions::minSectorFill's measure
   double length = 0;            // of the axis polyline
   std::size_t pointCount = 0;
 };

@@ -90,6 +90,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"RelaxationOptions::sphereRigidity", "sphere_rigidity"},
     {"CylinderOptions::minAnisotropy", "min_anisotropy"},
     {"TubeFitOptions::minArcDegrees", "min_arc"},
+    {"TubeFitOptions::minSectorFill", "min_sector_fill"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
     {"TubeFitOptions::maxRelativeRms", "max_rms"},
     {"the thread count (threads option)", "threads"},

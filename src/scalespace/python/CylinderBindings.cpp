@@ -80,6 +80,7 @@ class Cylinders {
       d["rms"] = t.rms;
       d["length"] = t.length;
       d["arc_degrees"] = t.arcDegrees;
+      d["sector_fill"] = t.sectorFill;
       d["direction"] = t.straight ? py::object(vec3Array(t.direction)) : py::object(py::none());
       d["centre"] = t.straight ? py::object(vec3Array(t.centre + origin_)) : py::object(py::none());
       d["axis"] = vectorsToArray(t.axis, origin_);
@@ -146,8 +147,8 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
                                        const py::handle& viewpoint,
                                        const std::optional<std::vector<double>>& scales,
                                        int scaleCount, double tmin, double tmax, double epsilon,
-                                       double minAnisotropy, double minArc, double maxRms,
-                                       bool oneCurvatureSign, int maxGap,
+                                       double minAnisotropy, double minArc, double minSectorFill,
+                                       double maxRms, bool oneCurvatureSign, int maxGap,
                                        std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
@@ -158,6 +159,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.epsilon = epsilon;
   options.minAnisotropy = minAnisotropy;
   options.tube.minArcDegrees = minArc;
+  options.tube.minSectorFill = minSectorFill;
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
   options.maxGapLevels = maxGap;
@@ -223,7 +225,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
   m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
         "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5,
-        "min_arc"_a = TubeFitOptions{}.minArcDegrees, "max_rms"_a = 0.25,
+        "min_arc"_a = TubeFitOptions{}.minArcDegrees,
+        "min_sector_fill"_a = TubeFitOptions{}.minSectorFill, "max_rms"_a = 0.25,
         "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
         "max_gap"_a = CylinderOptions{}.maxGapLevels, "threads"_a = py::none(),
         "progress"_a = py::none(),
@@ -234,7 +237,8 @@ Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube f
 scales themselves (increasing), else scale_count log-spaced ones in [tmin, tmax] (0: twice the
 median distance to the 10th neighbour, a tenth of the diagonal). epsilon: the region growing
 tolerance of Eq. 3.10; min_anisotropy: the least sigma of a region's points; min_arc: degrees
-the points' normals must turn around the axis; max_rms: a tube's RMS distance to its surface
+the points' normals must turn around the axis; min_sector_fill: the share of the 10-degree
+sectors of that arc the normals must fill (a box edge rounded into a tube fills about half); max_rms: a tube's RMS distance to its surface
 over its radius. one_curvature_sign: a region only grows over points curving the way its seed
 does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
 normals; off: Eq. 3.10 alone). max_gap: a component bridges up to this many levels where its
