@@ -8,8 +8,8 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <string>
-#include <tuple>
 #include <utility>
 
 #include "scalespace/core/DisjointSets.hpp"
@@ -51,9 +51,10 @@ struct Line {
   double extent;   // RMS extent along the direction
 };
 
-/// The line through the points of `moments` (false below 3 points).
-bool fitLine(const PointMoments& moments, double radius, Line& line) {
-  if (moments.count < 3) return false;
+/// The line through the points of `moments` (none below 3 points).
+std::optional<Line> fitLine(const PointMoments& moments, double radius) {
+  if (moments.count < 3) return std::nullopt;
+  Line line;
   Eigen::SelfAdjointEigenSolver<Mat3> eigen(moments.covariance());
   const Vec3 lambda = eigen.eigenvalues().cwiseMax(0.0);
   line.direction = eigen.eigenvectors().col(2);
@@ -61,7 +62,7 @@ bool fitLine(const PointMoments& moments, double radius, Line& line) {
   line.elongated = lambda(2) > 0 && lambda(1) <= 0.5 * lambda(2);  // coincident points: no line
   line.blob = !line.elongated && lambda(2) <= radius * radius;
   line.extent = std::sqrt(lambda(2));
-  return true;
+  return line;
 }
 
 /// Joins adjacent edges (edgeOf, ids below edgeCount) of one curve along one line, most parallel
@@ -76,29 +77,19 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
   // Adjacent edges: points within the link distance of each other (found in parallel, then
   // sorted: the same set for any thread count). Edges of one curve may join; those of another
   // curve (a crease of the other sign) only mark junctions.
-  struct Touch {
-    int x, y;
-    bool sameCurve;
-    bool operator<(const Touch& o) const {
-      return std::tie(x, y, sameCurve) < std::tie(o.x, o.y, o.sameCurve);
-    }
-    bool operator==(const Touch& o) const {
-      return x == o.x && y == o.y && sameCurve == o.sameCurve;
-    }
-  };
-  std::vector<std::vector<Touch>> near(m);
+  std::vector<int> curveOfEdge(edgeCount, -1);
+  for (std::size_t a = 0; a < m; ++a) curveOfEdge[std::size_t(edgeOf[a])] = curveId[labelled[a]];
+  std::vector<std::vector<std::pair<int, int>>> near(m);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256), [&](const auto& range) {
     std::vector<Neighbor> found;
     for (std::size_t a = range.begin(); a != range.end(); ++a) {
       index.radiusSearch(at[a], options.linkDistance, found);
-      for (const Neighbor& nb : found) {
-        const int x = edgeOf[a], y = edgeOf[nb.index];
-        if (x < y) near[a].push_back({x, y, curveId[labelled[a]] == curveId[labelled[nb.index]]});
-      }
+      for (const Neighbor& nb : found)
+        if (edgeOf[a] < edgeOf[nb.index]) near[a].push_back({edgeOf[a], edgeOf[nb.index]});
     }
   });
-  std::vector<Touch> adjacent;
-  for (const auto& touches : near) adjacent.insert(adjacent.end(), touches.begin(), touches.end());
+  std::vector<std::pair<int, int>> adjacent;
+  for (const auto& pairs : near) adjacent.insert(adjacent.end(), pairs.begin(), pairs.end());
   std::sort(adjacent.begin(), adjacent.end());
   adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
   if (adjacent.empty()) return;
@@ -108,45 +99,31 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
   const double parallel = std::cos(options.mergeAngleDegrees * kPi / 180);
   const double r = options.radius;
   for (;;) {
-    // The joined sets that touch (of one curve: `pairs`; of any: `around`), and each set's line.
-    std::vector<Touch> touches;
-    for (const Touch& t : adjacent) {
-      const int x = int(sets.find(Index(t.x))), y = int(sets.find(Index(t.y)));
-      if (x != y) touches.push_back({std::min(x, y), std::max(x, y), t.sameCurve});
-    }
-    std::sort(touches.begin(), touches.end());
-    touches.erase(std::unique(touches.begin(), touches.end()), touches.end());
+    // The joined sets that touch, and each set's line (none below 3 points).
     std::vector<std::pair<int, int>> pairs;
+    for (const auto& [ex, ey] : adjacent) {
+      const int x = int(sets.find(Index(ex))), y = int(sets.find(Index(ey)));
+      if (x != y) pairs.push_back({std::min(x, y), std::max(x, y)});
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
     std::vector<std::vector<int>> around(edgeCount);  // per joined set, the sets it touches
-    std::vector<Line> line(edgeCount);
-    std::vector<std::uint8_t> fitted(edgeCount, 0);  // 0: not yet, 1: a line, 2: too few points
-    for (const Touch& t : touches) {
-      if (t.sameCurve) pairs.push_back({t.x, t.y});
-      around[std::size_t(t.x)].push_back(t.y), around[std::size_t(t.y)].push_back(t.x);
-      for (const int z : {t.x, t.y})
-        if (!fitted[std::size_t(z)])
-          fitted[std::size_t(z)] =
-              fitLine(moments[std::size_t(z)], r, line[std::size_t(z)]) ? 1 : 2;
-    }
-    for (auto& a : around) {
-      std::sort(a.begin(), a.end());
-      a.erase(std::unique(a.begin(), a.end()), a.end());
-    }
+    for (const auto& [x, y] : pairs)
+      around[std::size_t(x)].push_back(y), around[std::size_t(y)].push_back(x);
+    for (auto& a : around) std::sort(a.begin(), a.end());  // pairs are unique: so are these
+    std::vector<std::optional<Line>> line(edgeCount);
+    for (std::size_t e = 0; e < edgeCount; ++e)
+      if (sets.find(Index(e)) == e) line[e] = fitLine(moments[e], r);
     // A third edge of any curve (elongated, its RMS extent along its line at least half the
     // radius: about 1.7 radius long) touching both: a junction where it meets the line; the two
     // pieces are edges of their own there, as on the mesh.
     const auto junction = [&](int x, int y) {
-      const std::vector<int>&ax = around[std::size_t(x)], &ay = around[std::size_t(y)];
-      for (auto i = ax.begin(), j = ay.begin(); i != ax.end() && j != ay.end();) {
-        if (*i < *j) {
-          ++i;
-        } else if (*j < *i) {
-          ++j;
-        } else {
-          const Line& lz = line[std::size_t(*i)];
-          if (fitted[std::size_t(*i)] == 1 && lz.elongated && lz.extent >= 0.5 * r) return true;
-          ++i, ++j;
-        }
+      const std::vector<int>& ay = around[std::size_t(y)];
+      for (const int z : around[std::size_t(x)]) {
+        const std::optional<Line>& lz = line[std::size_t(z)];
+        if (lz && lz->elongated && lz->extent >= 0.5 * r &&
+            std::binary_search(ay.begin(), ay.end(), z))
+          return true;
       }
       return false;
     };
@@ -156,8 +133,10 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
     };
     std::vector<Candidate> candidates;
     for (const auto& [x, y] : pairs) {
-      if (fitted[std::size_t(x)] != 1 || fitted[std::size_t(y)] != 1) continue;
-      const Line &lx = line[std::size_t(x)], &ly = line[std::size_t(y)];
+      if (curveOfEdge[std::size_t(x)] != curveOfEdge[std::size_t(y)] || !line[std::size_t(x)] ||
+          !line[std::size_t(y)])
+        continue;
+      const Line &lx = *line[std::size_t(x)], &ly = *line[std::size_t(y)];
       // A small blob (a patch of the band chained by its local directions) has no direction of
       // its own to compare: the union's thickness decides alone.
       if (!(lx.elongated || lx.blob) || !(ly.elongated || ly.blob) || (lx.blob && ly.blob))
@@ -168,13 +147,13 @@ void mergeCollinearEdges(const std::vector<Vec3>& at, const std::vector<int>& cu
       if (cosine < parallel) continue;
       PointMoments both = moments[std::size_t(x)];
       both.add(moments[std::size_t(y)]);
-      Line lu;
+      const std::optional<Line> lu = fitLine(both, r);
       // Each piece and their union lie along a line, within half the radius of it (a curved
       // edge's pieces are left as they are), and the union is about as thin as the thicker
       // piece (a corner's arms are not: their union is as wide as they are long). The slack,
       // 1e-6 of the extent, covers the eigensolver's error on exactly straight pieces.
-      if (fitLine(both, r, lu) && lu.elongated && lu.rms <= 0.5 * r &&
-          lu.rms <= options.mergeThickening * std::max(lx.rms, ly.rms) + 1e-6 * lu.extent &&
+      if (lu && lu->elongated && lu->rms <= 0.5 * r &&
+          lu->rms <= options.mergeThickening * std::max(lx.rms, ly.rms) + 1e-6 * lu->extent &&
           !junction(x, y))
         candidates.push_back({cosine, x, y});
     }
