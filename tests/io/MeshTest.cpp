@@ -211,17 +211,25 @@ TEST(Mesh, NonFiniteVerticesAreDroppedWithTheirFaces) {
   EXPECT_EQ(report.droppedNonFinite, 1u);
   for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(cloud.absolutePosition(i).z(), 0.0);
 
-  // The same mesh as a PLY: the vertex goes with its face, the other face's indices are kept.
+  // The same mesh as a PLY: the vertex goes with its face, the other face's indices are kept
+  // (renumbered past the dropped vertex: read unshifted, face 1 2 3 would take the far vertex
+  // (5, 5) in place of (0, 1)).
   test::ScratchDir dir;
   test::writeText(dir.file("d.ply"),
-                  "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
+                  "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float "
                   "y\nproperty float z\nelement face 2\nproperty list uchar int "
-                  "vertex_indices\nend_header\n0 0 inf\n0 0 0\n1 0 0\n0 1 0\n3 1 2 3\n3 0 1 2\n");
+                  "vertex_indices\nend_header\n0 0 inf\n0 0 0\n2 0 0\n0 1 0\n5 5 0\n3 1 2 3\n"
+                  "3 0 1 2\n");
   ReadReport plyReport;
   const PointCloud fromPly = readCloud(dir.file("d.ply"), options, &plyReport);
   EXPECT_EQ(fromPly.size(), 30u);
   EXPECT_EQ(plyReport.droppedNonFinite, 1u);
-  for (std::size_t i = 0; i < fromPly.size(); ++i) EXPECT_EQ(fromPly.absolutePosition(i).z(), 0.0);
+  for (std::size_t i = 0; i < fromPly.size(); ++i) {
+    const Vec3 p = fromPly.absolutePosition(i);
+    EXPECT_EQ(p.z(), 0.0);
+    EXPECT_TRUE(p.x() >= -1e-6 && p.y() >= -1e-6 && p.x() / 2 + p.y() <= 1 + 1e-6)
+        << p.transpose();  // in the triangle (0, 0), (2, 0), (0, 1)
+  }
   options.dropNonFinite = false;
   EXPECT_THROW(readCloud(dir.file("d.ply"), options), FileError);
 }
