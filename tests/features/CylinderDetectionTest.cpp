@@ -332,6 +332,33 @@ TEST(Cylinders, ARoundedBoxEdgeIsNoTubeButAHalfPipeIs) {
   EXPECT_NEAR(tube.radius, r, 0.01);
 }
 
+// A square prism seen all round, normals with 12 degrees of noise (a noisy scan's, estimated over
+// few neighbours): its section is round enough for the RMS test and its four face directions,
+// each smeared over a few 15-degree bins, fill those bins evenly; counted over the span round the
+// axis they take (all of it, but for the gaps between the faces), they fill about 0.6 of it
+// (TubeFitOptions::minSectorFill; libcgal-demo's octahedron with noise 1e-3 of the diagonal was a
+// tube of radius 1.1 over four scales).
+TEST(Cylinders, ANoisySquarePrismIsFacetedThoughItsNormalsFillTheBinsTheyTake) {
+  const double a = 0.85, noise = 12 * kPi / 180, t = 0.5;
+  const Section prism = sampleSection(
+      [&](double s, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const int face = std::min(3, int(4 * s));
+        const double angle = face * kPi / 2, along = (8 * s - 2 * face - 1) * a;
+        n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        q = a * n + along * Eigen::Vector2d(-n.y(), n.x());
+      },
+      a, noise, 20000);
+  TubeFitOptions without;
+  without.minSectorFill = 0;
+  const TubeFit loose = fitTube(prism.positions, prism.normals, prism.scaleNormals, prism.kappa1,
+                                prism.points, t, without);
+  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
+  const TubeFit strict = fitTube(prism.positions, prism.normals, prism.scaleNormals, prism.kappa1,
+                                 prism.points, t, TubeFitOptions{});
+  EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
+  EXPECT_LT(strict.sectorFill, 0.7);
+}
+
 // Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and
 // the surface is their union's, a concave groove where they meet), with exact normals; which
 // cylinder each point lies on in `lobe`.

@@ -51,10 +51,13 @@ struct TubeFitOptions {
   /// And they must fill the arc: sectorFill, the effective number of 10-degree sectors their
   /// azimuths take (exponential of the histogram's entropy) over the arc's sectors, or the same
   /// with each sector of points weighted alike over the sectors the points cover (a tube sampled
-  /// unevenly around its axis), the larger, >= minSectorFill. A tube's normals turn with its
-  /// points; the faces of a box edge, rounded by the fits into a tube at a scale above them, lie
-  /// all round the arc while their normals, however far noise or normals estimated over many
-  /// neighbours smear them, crowd in two directions.
+  /// unevenly around its axis), the larger, >= minSectorFill. The arc of the first reading is
+  /// the lower fill of two counts: the 15-degree bins the normals and the points fill, and per
+  /// axis segment the span they take round the axis, gaps included. A tube's normals turn with
+  /// its points; the faces of a box edge, rounded by the fits into a tube at a scale above them,
+  /// lie all round the arc while their normals, however far noise or normals estimated over many
+  /// neighbours smear them, crowd in two directions; a noisy prism's smeared face directions fill
+  /// the bins they take, not the span with the gaps between them.
   double minSectorFill = 0.75;
   /// The axis is straight unless the curved axis fits the points better: straight when the RMS
   /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
