@@ -289,6 +289,20 @@ Section sampleSection(Place place, double r, double normalNoise, std::size_t cou
   return s;
 }
 
+// The section passes every tube test at scale t but the fill (TubeFitOptions::minSectorFill),
+// which turns it down with a fill under 0.7.
+void expectFacetedByTheFillAlone(const Section& s, double t) {
+  TubeFitOptions without;
+  without.minSectorFill = 0;
+  const TubeFit loose =
+      fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, without);
+  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
+  const TubeFit strict =
+      fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, TubeFitOptions{});
+  EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
+  EXPECT_LT(strict.sectorFill, 0.7);
+}
+
 // A box edge rounded by the fits into a tube (the two faces of a right angle, r to 1.4 r from the
 // axis; normals leaning towards the other face near the corner, as normals estimated over many
 // neighbours do, and 9 degrees of noise) lies all round a 180-degree arc and passes every other
@@ -308,15 +322,7 @@ TEST(Cylinders, ARoundedBoxEdgeIsNoTubeButAHalfPipeIs) {
         q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
       },
       r, noise, 20000);
-  TubeFitOptions without;
-  without.minSectorFill = 0;
-  const TubeFit loose = fitTube(edge.positions, edge.normals, edge.scaleNormals, edge.kappa1,
-                                edge.points, t, without);
-  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
-  const TubeFit strict = fitTube(edge.positions, edge.normals, edge.scaleNormals, edge.kappa1,
-                                 edge.points, t, TubeFitOptions{});
-  EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
-  EXPECT_LT(strict.sectorFill, 0.7);
+  expectFacetedByTheFillAlone(edge, t);
 
   const Section pipe = sampleSection(
       [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
@@ -348,15 +354,7 @@ TEST(Cylinders, ANoisySquarePrismIsFacetedThoughItsNormalsFillTheBinsTheyTake) {
         q = a * n + along * Eigen::Vector2d(-n.y(), n.x());
       },
       a, noise, 20000);
-  TubeFitOptions without;
-  without.minSectorFill = 0;
-  const TubeFit loose = fitTube(prism.positions, prism.normals, prism.scaleNormals, prism.kappa1,
-                                prism.points, t, without);
-  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
-  const TubeFit strict = fitTube(prism.positions, prism.normals, prism.scaleNormals, prism.kappa1,
-                                 prism.points, t, TubeFitOptions{});
-  EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
-  EXPECT_LT(strict.sectorFill, 0.7);
+  expectFacetedByTheFillAlone(prism, t);
 }
 
 // Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and
