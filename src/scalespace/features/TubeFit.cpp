@@ -299,32 +299,35 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   // Arcs are counted per axis segment, each in its own frame, and the median over the segments
   // holding enough points is kept: along a polyline that wanders (the axis of a box's rounded
   // footprint turning at its corners) one frame would smear two face normals over many angles.
-  // Per segment: its arc (degrees), NaN where it holds too few points.
+  // Per segment, NaN where it holds too few points: the arc (degrees) of the bins holding at least
+  // a quarter of the mean count, and its span, all but the longest run of bins under that count
+  // round the circle (the gaps between a prism's faces included).
   const auto binOf = [](double angle, int bins) {
     return std::size_t(std::min(bins - 1, int((angle + kPi) / (2 * kPi) * bins)));
   };
-  auto segmentArcs = [&](const std::vector<double>& angles, bool span) {
+  struct SegmentArcs {
+    std::vector<double> filled, span;
+  };
+  auto segmentArcs = [&](const std::vector<double>& angles) {
     std::vector<std::array<std::uint32_t, kBins>> bins(m - 1);
     for (auto& b : bins) b.fill(0);
     for (std::size_t k = 0; k < points.size(); ++k)
       if (!std::isnan(angles[k])) ++bins[proj[k].segment][binOf(angles[k], kBins)];
-    std::vector<double> arcs(m - 1, std::numeric_limits<double>::quiet_NaN());
+    SegmentArcs arcs{std::vector<double>(m - 1, std::numeric_limits<double>::quiet_NaN()),
+                     std::vector<double>(m - 1, std::numeric_limits<double>::quiet_NaN())};
     for (std::size_t s = 0; s + 1 < m; ++s) {
       std::uint32_t counted = 0;
       for (const std::uint32_t c : bins[s]) counted += c;
       if (counted < 2 * kBins) continue;
       const double enough = std::max(2.0, 0.25 * counted / kBins);
-      int filled = 0;
+      int filled = 0, longest = 0, run = 0;
       for (const std::uint32_t c : bins[s]) filled += double(c) >= enough;
-      if (span && filled > 0) {  // all but the longest run of bins below `enough`, round the circle
-        int longest = 0, run = 0;
-        for (int k = 0; k < 2 * kBins; ++k) {
-          run = double(bins[s][std::size_t(k % kBins)]) < enough ? run + 1 : 0;
-          longest = std::max(longest, std::min(run, kBins));
-        }
-        filled = kBins - longest;
+      for (int k = 0; k < 2 * kBins; ++k) {
+        run = double(bins[s][std::size_t(k % kBins)]) < enough ? run + 1 : 0;
+        longest = std::max(longest, std::min(run, kBins));
       }
-      arcs[s] = 360.0 * filled / kBins;
+      arcs.filled[s] = 360.0 * filled / kBins;
+      arcs.span[s] = 360.0 * (kBins - longest) / kBins;
     }
     return arcs;
   };
@@ -358,11 +361,10 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
     positionAngle[k] = azimuth(s, Vec3(positions[points[k]] - foot));
   }
-  const std::vector<double> normalArcs = segmentArcs(normalAngle, false),
-                            positionArcs = segmentArcs(positionAngle, false);
-  e.normalArc = median(normalArcs);
-  e.positionArc = median(positionArcs);
-  const bool perSegment = !std::isnan(e.normalArc) && !std::isnan(e.positionArc);
+  const SegmentArcs normalArcs = segmentArcs(normalAngle),
+                    positionArcs = segmentArcs(positionAngle);
+  e.normalArc = median(normalArcs.filled);
+  e.positionArc = median(positionArcs.filled);
   if (std::isnan(e.normalArc)) e.normalArc = wholeArc(normalAngle);
   if (std::isnan(e.positionArc)) e.positionArc = wholeArc(positionAngle);
   // The effective number of bins a set of azimuths takes (the exponential of their histogram's
@@ -397,25 +399,19 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   // the bins they take evenly; the span holds the gaps between its faces as well (libcgal-demo's
   // octahedron under noise 1e-3 of the diagonal: 0.9-1.0 over the bins, 0.4-0.6 over the span).
   constexpr int kSectors = 36;
-  if (perSegment) {
-    std::vector<std::vector<std::uint32_t>> sectors(m - 1, std::vector<std::uint32_t>(kSectors, 0));
-    for (std::size_t k = 0; k < points.size(); ++k)
-      if (!std::isnan(normalAngle[k])) ++sectors[proj[k].segment][binOf(normalAngle[k], kSectors)];
-    const std::vector<double> normalSpans = segmentArcs(normalAngle, true),
-                              positionSpans = segmentArcs(positionAngle, true);
-    std::vector<double> fills(m - 1, std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t s = 0; s + 1 < m; ++s) {
-      if (std::isnan(normalSpans[s]) || std::isnan(positionSpans[s])) continue;
-      const double arc = std::min(normalSpans[s], positionSpans[s]);
-      if (arc > 0) fills[s] = histogramBins(sectors[s]) / (arc / 10);
-    }
-    e.normalSectorFill = median(fills);
+  std::vector<std::vector<std::uint32_t>> sectors(m - 1, std::vector<std::uint32_t>(kSectors, 0));
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (!std::isnan(normalAngle[k])) ++sectors[proj[k].segment][binOf(normalAngle[k], kSectors)];
+  std::vector<double> spanFills(m - 1, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t s = 0; s + 1 < m; ++s) {
+    if (std::isnan(normalArcs.span[s]) || std::isnan(positionArcs.span[s])) continue;
+    const double span = std::min(normalArcs.span[s], positionArcs.span[s]);
+    if (span > 0) spanFills[s] = histogramBins(sectors[s]) / (span / 10);
   }
   const double arc = std::min(e.normalArc, e.positionArc);
-  const double overArc = arc > 0 ? effectiveBins(normalAngle, kSectors) / (arc / 10) : 0;
-  e.normalSectorFill = !perSegment || std::isnan(e.normalSectorFill)
-                           ? overArc
-                           : std::min(overArc, e.normalSectorFill);
+  const double binFill = arc > 0 ? effectiveBins(normalAngle, kSectors) / (arc / 10) : 0;
+  const double spanFill = median(spanFills);
+  e.normalSectorFill = std::isnan(spanFill) ? binFill : std::min(binFill, spanFill);
   {
     const auto sectorOf = [&](double angle) { return binOf(angle, kSectors); };
     std::array<double, kSectors> pointsIn{}, normalsIn{};
