@@ -9,9 +9,12 @@
 //                   the features' seed order; the cylinders' default is the random order)
 //                   [--one-curvature-sign] (ours: CylinderOptions::oneCurvatureSign on)
 //                   [--estimate-normals] (every method gets normals estimated from the positions
-//                   as `scalespace cylinders` does for a file without them: PCA, oriented by the
-//                   MST with the visibility correction, facing the one-sided scan's scanner.
+//                   as `scalespace cylinders` does for a file without them:
+//                   cylinderNormalOptions(), sheet normals signed by the PCA normals oriented by
+//                   the MST with the visibility correction, facing the one-sided scan's scanner.
 //                   Default: the scene's exact normals)
+//                   [--pca-normals] (with --estimate-normals: PCA normals, oriented by their own
+//                   tree, as `cylinders` did before 2026-11-30)
 //                   [--normal-k K] (with --estimate-normals: K neighbours, fixed; default: 10,
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
@@ -41,7 +44,9 @@
 
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PipeScene.hpp"
+#include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/features/CylinderDetection.hpp"
 
 using namespace scalespace;
@@ -290,24 +295,24 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
 
 // What a user without normals gets: the CLI's estimation and orientation (cli/ensureNormals), a
 // one-sided scan facing its scanner. Prints how many normals face away from the exact ones.
-void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k) {
+void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k, bool pca) {
   const std::vector<Vec3> exact = cloud.normals();
-  NormalEstimationOptions estimation;
-  if (k > 0) estimation.k = estimation.maxK = k;
-  NormalEstimationResult estimated = estimateNormals(cloud.positions(), estimation);
-  NormalOrientationOptions orientation;
-  if (scanner) orientation.faceViewpoint = true, orientation.viewpoint = *scanner;
-  orientNormals(cloud.positions(), estimated.normals, orientation, estimated.valid);
+  OrientedNormalsOptions options = pca ? OrientedNormalsOptions{} : cylinderNormalOptions();
+  if (k > 0) options.estimation.k = options.estimation.maxK = k;
+  if (scanner) options.orientation.faceViewpoint = true, options.orientation.viewpoint = *scanner;
+  const auto index = makeSpatialIndex(cloud.positions());
+  OrientedNormals estimated = estimateOrientedNormals(cloud.positions(), *index, options);
   std::size_t against = 0, off = 0;
   for (std::size_t i = 0; i < exact.size(); ++i) {
     const double c = exact[i].dot(estimated.normals[i]);
     against += c < 0;
-    off += std::abs(c) < std::cos(30 * 3.14159265358979323846 / 180);
+    off += std::abs(c) < std::cos(30 * kPi / 180);
   }
   std::printf(
-      "  estimated normals (k = %zu): %.2f%% against the exact ones, %.2f%% more than 30 deg off\n",
-      estimated.k, 100.0 * double(against) / double(exact.size()),
-      100.0 * double(off) / double(exact.size()));
+      "  estimated normals (%s, k = %zu): %.2f%% against the exact ones, %.2f%% more than 30 deg "
+      "off\n",
+      pca ? "PCA" : "sheet planes signed by PCA", estimated.estimation.k,
+      100.0 * double(against) / double(exact.size()), 100.0 * double(off) / double(exact.size()));
   // Per object: the pipes by name, the planes (floor, wall, box) as one.
   const auto& pipe = cloud.findAttribute("gt_pipe")->values;
   std::map<int, std::pair<std::size_t, std::size_t>> per;  // pipe (-1: planes) -> (against, all)
@@ -329,7 +334,7 @@ void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k)
 
 int main(int argc, char** argv) {
   std::size_t points = 1000000;
-  bool peers = true, cleanOnly = false, estimate = false;
+  bool peers = true, cleanOnly = false, estimate = false, pcaNormals = false;
   std::size_t normalK = 0;  // NormalEstimationOptions' defaults
   std::string only;         // "full" or "one-sided": that scan alone
   CylinderOptions ours;
@@ -356,6 +361,8 @@ int main(int argc, char** argv) {
       ours.oneCurvatureSign = true;
     else if (a == "--estimate-normals")
       estimate = true;
+    else if (a == "--pca-normals")
+      pcaNormals = true;
     else if (a == "--min-arc" && i + 1 < argc)
       ours.tube.minArcDegrees = std::stod(argv[++i]);
     else if (a == "--max-gap" && i + 1 < argc)
@@ -366,8 +373,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
                    "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
-                   "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] [--normal-k "
-                   "K] [--min-arc DEGREES] [--max-gap LEVELS]\n");
+                   "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
+                   "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS]\n");
       return 2;
     }
   }
@@ -388,7 +395,7 @@ int main(int argc, char** argv) {
                   oneSided ? "one-sided" : "full", noise, cloud.size());
       if (estimate) {
         const Vec3 scanner = cloud.viewpoint().value_or(Vec3::Zero()) - cloud.origin();
-        estimateSceneNormals(cloud, cloud.viewpoint() ? &scanner : nullptr, normalK);
+        estimateSceneNormals(cloud, cloud.viewpoint() ? &scanner : nullptr, normalK, pcaNormals);
       }
       std::vector<Method> methods{runOurs(cloud, ours)};
       if (peers) {

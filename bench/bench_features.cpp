@@ -7,7 +7,8 @@
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
-//                  [--no-visibility] [--sheet-normals X (0.05; 0: PCA)]
+//                  [--no-visibility] [--sheet-normals X (0.05; 0: PCA)] [--sign-from-pca]
+//                  (SheetSign::FromPlanes: the sheet normals take the oriented PCA normals' sign)
 //                  (NormalOrientationOptions::acrossWeight and ::visibility of the estimated
 //                  normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
@@ -93,6 +94,7 @@
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/features/FeatureCurves.hpp"
 #include "scalespace/fit/FitPoints.hpp"
@@ -466,18 +468,18 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
 double sheetNormals = 0.05;  // --sheet-normals, as `scalespace features` (kFeatureSheetNormals)
 bool visibility = NormalOrientationOptions{}.visibility;  // --no-visibility
+SheetSign sheetSign = SheetSign::OwnTree;                 // --sign-from-pca: FromPlanes
 
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
-void estimateOrientedNormals(PointCloud& cloud) {
+void estimateSceneNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationOptions estimation;
-  estimation.sheetTolerance = sheetNormals;
-  NormalEstimationResult est = estimateNormals(cloud.positions(), *index, estimation);
-  NormalOrientationOptions orientation;
-  orientation.acrossWeight = acrossWeight;
-  orientation.visibility = visibility;
-  orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid);
-  cloud.setNormals(std::move(est.normals));
+  OrientedNormalsOptions options;
+  options.estimation.sheetTolerance = sheetNormals;
+  options.orientation.acrossWeight = acrossWeight;
+  options.orientation.visibility = visibility;
+  options.sheetSign = sheetSign;
+  OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options);
+  cloud.setNormals(std::move(normals.normals));
 }
 
 PointCloud noisyCopy(const PointCloud& clean, double sigma) {
@@ -544,7 +546,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.clean = sampleMesh(m.mesh, points, kSampleSeed);
   const std::vector<Vec3> truth = m.clean.normals();
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
-  estimateOrientedNormals(m.clean);
+  estimateSceneNormals(m.clean);
   m.meshNormals = truth;
   if (printPerCurve) printOrientation(m, m.clean, "clean");
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
@@ -1331,6 +1333,8 @@ int main(int argc, char** argv) {
       sheetNormals = std::atof(argv[++i]);
     } else if (a == "--no-visibility") {
       visibility = false;
+    } else if (a == "--sign-from-pca") {
+      sheetSign = SheetSign::FromPlanes;
     } else if (a == "--mesh-normals") {
       meshNormals = true;
     } else if (a == "--robust-fit") {
@@ -1370,7 +1374,7 @@ int main(int argc, char** argv) {
           runMethods(m, m.clean, peers, rows);
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
-          estimateOrientedNormals(cloud);
+          estimateSceneNormals(cloud);
           if (printPerCurve) printOrientation(m, cloud, "noisy");
           runMethods(m, cloud, peers, rows);
         }

@@ -3,6 +3,7 @@
 // user's folder never written into.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -172,4 +173,36 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   // --one-sided belongs to the pipes scene.
   r = run("generate box --one-sided -q -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);
+}
+
+// A cloud without normals gets cylinderNormalOptions(): sheet normals with the PCA normals' signs,
+// the same as `normals --sheet 0.05 --sign-from-pca` gives.
+TEST_F(Cli, CylindersEstimateSheetNormalsSignedByThePcaNormals) {
+  ASSERT_EQ(run("generate pipes -n 40000 -q -o " + path("p.ply")).code, 0);
+  PointCloud bare = readCloud(path("p.ply"));
+  bare.setNormals({});
+  writeCloud(bare, path("bare.ply"));
+  auto r = run("cylinders " + path("bare.ply") + " --scales 2 --tmin 0.04 --tmax 0.08 -o " +
+               path("direct"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("sheet planes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("MST of the PCA normals"), std::string::npos) << r.err;
+  r = run("normals " + path("bare.ply") + " --sheet 0.05 --sign-from-pca -q -o " + path("n.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("cylinders " + path("n.ply") + " --scales 2 --tmin 0.04 --tmax 0.08 -q -o " +
+          path("given"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const PointCloud direct = readCloud(path("direct/cloud.ply"));
+  const PointCloud given = readCloud(path("given/cloud.ply"));
+  ASSERT_EQ(direct.size(), given.size());
+  EXPECT_EQ(direct.findAttribute("cylinder_id")->values,
+            given.findAttribute("cylinder_id")->values);
+  EXPECT_EQ(direct.normals(), given.normals());
+  const auto& labels = direct.findAttribute("cylinder_id")->values;
+  EXPECT_GT(std::count_if(labels.begin(), labels.end(), [](double v) { return v >= 0; }), 5000);
+
+  r = run("normals " + path("bare.ply") + " --sign-from-pca -q -o " + path("m.ply"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--sign-from-pca needs sheet normals (--sheet > 0)"), std::string::npos)
+      << r.err;
 }

@@ -134,13 +134,18 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)
     # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone, sheets
-    for weight, visibility, sheet in ((1, True, 0), (0, True, 0), (0, False, 0), (0, True, 0.05)):
-        flag = "--visibility" if visibility else "--no-visibility"
+    # oriented by their own tree and by the PCA normals'
+    for weight, visibility, sheet, sign in ((1, True, 0, False), (0, True, 0, False),
+                                            (0, False, 0, False), (0, True, 0.05, False),
+                                            (0, True, 0.05, True)):
+        flags = ["--visibility" if visibility else "--no-visibility"]
+        flags += ["--sign-from-pca"] if sign else []
         cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight,
-            flag, "--sheet", sheet)
+            *flags, "--sheet", sheet)
         expected = columns(tmp_path / "n.ply")
         normals, reliable = ss.estimate_normals(points, across_weight=weight,
-                                                visibility=visibility, sheet=sheet)
+                                                visibility=visibility, sheet=sheet,
+                                                sign_from_pca=sign)
         for c, name in enumerate(("nx", "ny", "nz")):
             np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
         np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)
@@ -149,6 +154,8 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     with pytest.raises(ss.OptionError, match="sheet") as e:
         ss.estimate_normals(points, sheet=-1)
     assert "Options::" not in str(e.value)
+    with pytest.raises(ss.OptionError, match="sign_from_pca needs sheet normals"):
+        ss.estimate_normals(points, sign_from_pca=True)
 
 
 def test_noisy_normals_take_more_neighbours_as_the_cli_does(tmp_path):

@@ -12,6 +12,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/io/AtomicFile.hpp"
 #include "scalespace/io/CloudIO.hpp"
@@ -72,25 +73,28 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
   orientation.viewpoint = *cloud.viewpoint() - cloud.origin();  // recentred, as the points
 }
 
-void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation) {
+void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options) {
   if (cloud.hasNormals()) return;
+  const NormalEstimationOptions& estimation = options.estimation;
   if (!quiet)
     std::fprintf(stderr,
                  "input has no normals: estimating (%s, %zu neighbours, up to %zu under noise) and "
-                 "orienting (MST%s)\n",
+                 "orienting (MST%s%s)\n",
                  estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k,
                  std::max(estimation.k, estimation.maxK),
+                 estimation.sheetTolerance > 0 && options.sheetSign == SheetSign::FromPlanes
+                     ? " of the PCA normals"
+                     : "",
                  cloud.viewpoint() ? ", facing the file's viewpoint" : "");
   auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationResult est =
-      estimateNormals(cloud.positions(), *index, estimation, makeProgressBar(quiet));
-  if (!quiet && est.k != estimation.k)
-    std::fprintf(stderr, "normals: noisy input, estimated over %zu neighbours\n", est.k);
-  NormalOrientationOptions orientation;
-  faceFileViewpoint(cloud, orientation);
-  orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid,
-                makeProgressBar(quiet));
-  cloud.setNormals(std::move(est.normals));
+  OrientedNormalsOptions run = options;
+  faceFileViewpoint(cloud, run.orientation);
+  OrientedNormals normals =
+      estimateOrientedNormals(cloud.positions(), *index, run, makeProgressBar(quiet));
+  if (!quiet && normals.estimation.k != estimation.k)
+    std::fprintf(stderr, "normals: noisy input, estimated over %zu neighbours\n",
+                 normals.estimation.k);
+  cloud.setNormals(std::move(normals.normals));
 }
 
 namespace {

@@ -9,6 +9,7 @@
 
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PointCloud.hpp"
 
 namespace scalespace::cli {
@@ -42,7 +43,7 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
 /// viewpoint if any) normals when the cloud has none; says so on stderr unless quiet. The APSS
 /// fits need oriented normals.
 
-void ensureNormals(PointCloud& cloud, bool quiet, const NormalEstimationOptions& estimation = {});
+void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options = {});
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {

@@ -20,6 +20,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PipeScene.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
 #include "scalespace/fit/CurvatureEstimation.hpp"
@@ -182,6 +183,7 @@ struct NormalArgs {
   double acrossWeight = NormalOrientationOptions{}.acrossWeight;
   bool visibility = NormalOrientationOptions{}.visibility;
   double sheet = NormalEstimationOptions{}.sheetTolerance;
+  bool signFromPlanes = false;
 };
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
@@ -202,6 +204,10 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                  "noise RMS) of one through the point and two neighbours instead of the PCA "
                  "plane: one side's at a crease or across a thin part (0 = PCA; features: 0.05)")
       ->capture_default_str();
+  cmd.add_flag("--sign-from-pca", a.signFromPlanes,
+               "with --sheet: orient the PCA normals and give each sheet normal its point's sign "
+               "(where surfaces touch, the sheet normals' own tree can turn one inside out; "
+               "cylinders does this)");
   cmd.add_option("--across-weight", a.acrossWeight,
                  "mst: extra cost of a graph edge across a thin part (offset along both normals), "
                  "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
@@ -253,16 +259,20 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
     throw OptionError("--k " + std::to_string(a.k) +
                       " must be smaller than the number of points (" +
                       std::to_string(cloud.size()) + ")");
-  const NormalOrientationOptions orientation = orientationFrom(a, cloud);
+  if (a.signFromPlanes && !(a.sheet > 0))
+    throw OptionError("--sign-from-pca needs sheet normals (--sheet > 0)");
+  OrientedNormalsOptions options;
+  options.orientation = orientationFrom(a, cloud);
+  options.estimation.k = a.k;
+  options.estimation.maxK = a.maxK;
+  options.estimation.sheetTolerance = a.sheet;
+  options.sheetSign = a.signFromPlanes ? SheetSign::FromPlanes : SheetSign::OwnTree;
+  const NormalOrientationOptions& orientation = options.orientation;
   const auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationOptions eo;
-  eo.k = a.k;
-  eo.maxK = a.maxK;
-  eo.sheetTolerance = a.sheet;
-  NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
-  NormalOrientationResult ori =
-      orientNormals(cloud.positions(), est.normals, *index, orientation, est.valid, progress);
-  cloud.setNormals(std::move(est.normals));
+  OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options, progress);
+  const NormalEstimationResult& est = normals.estimation;
+  const NormalOrientationResult& ori = normals.orientation;
+  cloud.setNormals(std::move(normals.normals));
   AttributeColumn& flag = cloud.addAttribute("normal_reliable", ScalarType::UInt8);
   for (std::size_t i = 0; i < cloud.size(); ++i) flag.values[i] = ori.reliable[i];
   if (!quiet)

@@ -178,7 +178,7 @@ void addCylindersCommand(CLI::App& app) {
     if (args->minPersistence < 0) throw OptionError("--min-persistence must be >= 0");
     checkOutput(args->output, OutputKind::CylindersResult, {args->input.path});
     PointCloud cloud = loadCloud(args->input, args->quiet);
-    ensureNormals(cloud, args->quiet);
+    ensureNormals(cloud, args->quiet, cylinderNormalOptions());
     const CylinderDetection detection =
         detectCylinders(cloud, args->cylinders, makeProgressBar(args->quiet));
 

@@ -331,9 +331,9 @@ void addFeaturesCommand(CLI::App& app) {
       result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
-      NormalEstimationOptions estimation;
-      estimation.sheetTolerance = args->sheetNormals;
-      ensureNormals(cloud, args->quiet, estimation);
+      OrientedNormalsOptions normals;
+      normals.estimation.sheetTolerance = args->sheetNormals;
+      ensureNormals(cloud, args->quiet, normals);
       result = detectFeatureCurves(cloud, options, progress);
     }
     PointCloud& out = mesh ? targets : cloud;

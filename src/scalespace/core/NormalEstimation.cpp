@@ -223,6 +223,7 @@ NormalEstimationResult estimateNormals(const std::vector<Vec3>& points, const Sp
     result.noiseRms = validRms[validRms.size() / 2];
   }
   if (sheets) {
+    result.planeNormals = result.normals;
     const double noiseBand = options.sheetNoiseFactor * result.noiseRms;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, n, 1024),

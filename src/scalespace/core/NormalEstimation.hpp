@@ -45,6 +45,9 @@ struct NormalEstimationOptions {
 
 struct NormalEstimationResult {
   std::vector<Vec3> normals;  // unit length for every point (flagged ones included), unoriented
+  /// With sheet normals (NormalEstimationOptions::sheetTolerance > 0): every point's PCA normal,
+  /// unoriented (core/OrientedNormals orients by them). Empty otherwise.
+  std::vector<Vec3> planeNormals;
   /// Surface variation lambda0 / (lambda0 + lambda1 + lambda2) in [0, 1/3] [Pauly 2002, Eq. 5]:
   /// 0 on a plane, larger on curved or noisy parts; 1/3 where flagged.
   std::vector<double> surfaceVariation;

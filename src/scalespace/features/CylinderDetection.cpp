@@ -144,6 +144,13 @@ std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph
 
 }  // namespace
 
+OrientedNormalsOptions cylinderNormalOptions() {
+  OrientedNormalsOptions options;
+  options.estimation.sheetTolerance = 0.05;
+  options.sheetSign = SheetSign::FromPlanes;
+  return options;
+}
+
 void validateCylinderOptions(const CylinderOptions& options) {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw OptionError(message);

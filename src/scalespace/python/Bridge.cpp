@@ -392,16 +392,31 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress, double acrossWeight,
                                             bool visibility, double sheetTolerance,
-                                            std::size_t maxK) {
+                                            std::size_t maxK, bool signFromPlanes) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
+  if (signFromPlanes && !(sheetTolerance > 0))
+    throw OptionError("sign_from_pca needs sheet normals (sheet > 0)");
+  OrientedNormalsOptions options;
+  options.estimation.k = k;
+  options.estimation.maxK = maxK;
+  options.estimation.sheetTolerance = sheetTolerance;
+  options.orientation.k = k;
+  options.orientation.acrossWeight = acrossWeight;
+  options.orientation.visibility = visibility;
+  options.sheetSign = signFromPlanes ? SheetSign::FromPlanes : SheetSign::OwnTree;
+  return estimateAndOrient(cloud, options, orient, viewpoint, progress);
+}
+
+std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOptions options,
+                                            const std::string& orient,
+                                            const std::optional<Vec3>& viewpoint,
+                                            const ProgressCallback& progress) {
+  const std::size_t k = options.estimation.k;
   if (k >= cloud.size())
     throw OptionError("k " + std::to_string(k) + " must be smaller than the number of points (" +
                       std::to_string(cloud.size()) + ")");
-  NormalOrientationOptions o;
-  o.k = k;
-  o.acrossWeight = acrossWeight;
-  o.visibility = visibility;
+  NormalOrientationOptions& o = options.orientation;
   if (orient == "mst") {
     o.method = OrientationMethod::MinimumSpanningTree;
     if (viewpoint) {  // each component faces it, as the CLI does with a PCD's VIEWPOINT
@@ -416,15 +431,9 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
     throw OptionError("orient takes 'mst' or 'viewpoint', got '" + orient + "'");
   }
   const auto index = makeSpatialIndex(cloud.positions());
-  NormalEstimationOptions eo;
-  eo.k = k;
-  eo.maxK = maxK;
-  eo.sheetTolerance = sheetTolerance;
-  NormalEstimationResult est = estimateNormals(cloud.positions(), *index, eo, progress);
-  NormalOrientationResult ori =
-      orientNormals(cloud.positions(), est.normals, *index, o, est.valid, progress);
-  cloud.setNormals(std::move(est.normals));
-  return std::move(ori.reliable);
+  OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options, progress);
+  cloud.setNormals(std::move(normals.normals));
+  return std::move(normals.orientation.reliable);
 }
 
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name) {

@@ -20,6 +20,7 @@
 
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/python/InputPool.hpp"
@@ -148,7 +149,14 @@ std::vector<std::uint8_t> estimateAndOrient(
     double acrossWeight = NormalOrientationOptions{}.acrossWeight,
     bool visibility = NormalOrientationOptions{}.visibility,
     double sheetTolerance = NormalEstimationOptions{}.sheetTolerance,
-    std::size_t maxK = NormalEstimationOptions{}.maxK);
+    std::size_t maxK = NormalEstimationOptions{}.maxK, bool signFromPlanes = false);
+
+/// Same with the estimation and orientation of `options` (e.g. cylinderNormalOptions()); `orient`
+/// and `viewpoint` as above replace its orientation method and viewpoint.
+std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOptions options,
+                                            const std::string& orient,
+                                            const std::optional<Vec3>& viewpoint,
+                                            const ProgressCallback& progress);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);

@@ -168,7 +168,8 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   PooledCloud cloud = makeCloud(asPoints(points), normals);
   Call call(std::move(progress), threads);
   CylinderDetection detection = call([&] {
-    if (!cloud.hasNormals()) estimateAndOrient(cloud, 10, "mst", view, call.progress());
+    if (!cloud.hasNormals())
+      estimateAndOrient(cloud, cylinderNormalOptions(), "mst", view, call.progress());
     return detectCylinders(cloud, options, call.progress());
   });
   return std::make_unique<Cylinders>(std::move(detection), cloud.origin());
@@ -243,7 +244,7 @@ over its radius. one_curvature_sign: a region only grows over points curving the
 does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
 normals; off: Eq. 3.10 alone). max_gap: a component bridges up to this many levels where its
 tube was not found (0: consecutive levels only, as the thesis). Without
-normals they are estimated (PCA, 10 neighbours) and oriented (MST), as
+normals they are estimated (sheet planes, 10 neighbours) and oriented (MST of the PCA normals), as
 the CLI does. Returns a Cylinders.)doc");
 }
 
