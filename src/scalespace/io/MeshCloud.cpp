@@ -17,7 +17,9 @@ PointCloud meshToCloud(TriangleMesh mesh, const std::string& file, const ReadOpt
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
       builder.addPoint(mesh.vertices[v], normals ? mesh.normals[v] : Vec3::Zero(), nullptr,
                        [&] { return mesh.vertexWhere(v); });
-    return builder.finish(report, formatDescription);
+    PointCloud cloud = builder.finish(report, formatDescription);
+    if (report) report->droppedNonFinite += droppedBefore;
+    return cloud;
   }
 
   // Sampling: a non-finite vertex is an error, or (dropNonFinite) removes its faces.
