@@ -6,6 +6,8 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
+//                  [--min-piece-extent X] [--min-extent X] (FeatureCurveOptions::
+//                  minPieceExtent, minCurveExtent)
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
 //                  [--no-visibility] [--sheet-normals X (0.05; 0: PCA)] [--sign-from-pca]
 //                  (SheetSign::FromPlanes: the sheet normals take the oriented PCA normals' sign)
@@ -1319,6 +1321,10 @@ int main(int argc, char** argv) {
       ourOptions.lines.borderOffset = std::atof(argv[++i]);
     } else if (a == "--curvature-gap" && hasValue) {
       ourOptions.lines.minCurvatureGap = std::atof(argv[++i]);
+    } else if (a == "--min-piece-extent" && hasValue) {
+      ourOptions.minPieceExtent = std::atof(argv[++i]);
+    } else if (a == "--min-extent" && hasValue) {
+      ourOptions.minCurveExtent = std::atof(argv[++i]);
     } else if (a == "--join-gap" && hasValue) {
       ourOptions.joinGap = std::atof(argv[++i]);
     } else if (a == "--centreline-reach" && hasValue) {

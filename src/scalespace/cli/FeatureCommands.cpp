@@ -276,7 +276,10 @@ void addFeaturesCommand(CLI::App& app) {
                   "the points kept lie within this x e of the centreline")
       ->capture_default_str();
   cmd->add_option("--min-extent", args->features.minCurveExtent,
-                  "drop curves spanning less than this x e (0 keeps all)")
+                  "drop curves spanning less than this x e, after the joining (0 keeps all)")
+      ->capture_default_str();
+  cmd->add_option("--min-piece-extent", args->features.minPieceExtent,
+                  "drop regions spanning less than this x e before the joining (0 keeps all)")
       ->capture_default_str();
   addSeedOrderFlag(*cmd, args->features.lines);
   cmd->add_option("--mesh-samples", args->samplesPerVertex,
@@ -405,6 +408,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"noise_salient_factor", options.noiseSalientFactor},
                                    {"min_voting_scales", options.minVotingScales},
                                    {"ridge_only", options.ridgeOnly},
+                                   {"min_piece_extent", options.minPieceExtent},
                                    {"min_curve_extent", options.minCurveExtent},
                                    {"join_gap", options.joinGap},
                                    {"centreline_reach", options.centrelineReach},

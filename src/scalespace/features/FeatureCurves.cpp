@@ -247,6 +247,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::centrelineLinearity must be in [0, 1]");
   require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
           "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
+  require(std::isfinite(o.minPieceExtent) && o.minPieceExtent >= 0,
+          "FeatureCurveOptions::minPieceExtent must be finite and >= 0");
   require(o.graphNeighbors >= 1 && std::size_t(o.graphNeighbors) <= kMaxNeighborCount,
           "FeatureCurveOptions::graphNeighbors must be in [1, " +
               std::to_string(kMaxNeighborCount) + "]");
@@ -421,41 +423,46 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
   });
   Segmentation seg =
       growRegionsFromSeeds(targetGraph, std::move(seeds), eligible, SameSign{result.convexity});
-  // Specks below the minimum extent are dropped; the others keep their order (by decreasing
-  // strongest vote) and are renumbered.
-  std::vector<int> renumber(seg.regions.size(), -1);
-  std::vector<std::vector<Index>> kept;
-  for (std::size_t c = 0; c < seg.regions.size(); ++c) {
-    Vec3 lo = targets[seg.regions[c].front()], hi = lo;
-    for (const Index p : seg.regions[c]) {
+  // Regions spanning less than minPieceExtent * e are dropped first (specks where a line grazed a
+  // corner or noise); they neither join nor bridge others.
+  const auto extent = [&](const std::vector<Index>& points) {
+    Vec3 lo = targets[points.front()], hi = lo;
+    for (const Index p : points) {
       lo = lo.cwiseMin(targets[p]);
       hi = hi.cwiseMax(targets[p]);
     }
-    if ((hi - lo).norm() < options.minCurveExtent * e) continue;
-    renumber[c] = int(kept.size());
-    kept.push_back(std::move(seg.regions[c]));
-  }
+    return (hi - lo).norm();
+  };
+  std::vector<std::size_t> pieces;
+  for (std::size_t c = 0; c < seg.regions.size(); ++c)
+    if (extent(seg.regions[c]) >= options.minPieceExtent * e) pieces.push_back(c);
   // 5. (not in the thesis) Lines stop short of corners (near-umbilic points, sharp turns), so where
   // creases meet the votes leave a gap and the regions cut a connected set of creases into
-  // pieces; pieces of the same sign within joinGap * e of each other are one curve.
-  std::vector<std::int8_t> keptSign(kept.size());
-  for (std::size_t c = 0; c < kept.size(); ++c) keptSign[c] = result.convexity[kept[c].front()];
-  const std::vector<std::vector<std::size_t>> joined =
-      options.joinGap > 0 ? curvesWithinGap(targets, kept, keptSign, options.joinGap * e)
-                          : std::vector<std::vector<std::size_t>>();
-  if (!joined.empty()) {
-    std::vector<int> joinedOf(kept.size());
-    std::vector<std::vector<Index>> merged(joined.size());
-    for (std::size_t g = 0; g < joined.size(); ++g) {
-      for (const std::size_t c : joined[g]) {
-        joinedOf[c] = int(g);
-        merged[g].insert(merged[g].end(), kept[c].begin(), kept[c].end());
-      }
-      std::sort(merged[g].begin(), merged[g].end());
-    }
-    for (int& r : renumber)
-      if (r >= 0) r = joinedOf[std::size_t(r)];
-    kept = std::move(merged);
+  // pieces; pieces of the same sign within joinGap * e of each other are one curve. Then the
+  // curves spanning less than minCurveExtent * e are dropped: a short piece that joins a crease is
+  // part of it, one that joins nothing is a speck. The others keep their order (by decreasing
+  // strongest vote of their first piece) and are renumbered.
+  std::vector<std::vector<Index>> pieceRegions;
+  std::vector<std::int8_t> pieceSign;
+  for (const std::size_t c : pieces) {
+    pieceRegions.push_back(seg.regions[c]);
+    pieceSign.push_back(result.convexity[seg.regions[c].front()]);
+  }
+  std::vector<std::vector<std::size_t>> groups;
+  if (options.joinGap > 0)
+    groups = curvesWithinGap(targets, pieceRegions, pieceSign, options.joinGap * e);
+  else
+    for (std::size_t k = 0; k < pieces.size(); ++k) groups.push_back({k});
+  std::vector<int> renumber(seg.regions.size(), -1);
+  std::vector<std::vector<Index>> kept;
+  for (const std::vector<std::size_t>& group : groups) {
+    std::vector<Index> merged;
+    for (const std::size_t k : group)
+      merged.insert(merged.end(), pieceRegions[k].begin(), pieceRegions[k].end());
+    if (extent(merged) < options.minCurveExtent * e) continue;
+    for (const std::size_t k : group) renumber[pieces[k]] = int(kept.size());
+    std::sort(merged.begin(), merged.end());
+    kept.push_back(std::move(merged));
   }
   result.curveId = std::move(seg.labels);
   for (std::size_t i = 0; i < n; ++i) {

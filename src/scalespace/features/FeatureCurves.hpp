@@ -90,9 +90,14 @@ struct FeatureCurveOptions {
   /// Where the vertices within reach do not lie along a line (the largest eigenvalue of their
   /// covariance under this share of its trace: corners) the point is kept.
   double centrelineLinearity = 0.8;
-  /// Curves whose points span less than this times e (bounding-box diagonal) are dropped; 0
-  /// keeps every region (the thesis).
-  double minCurveExtent = 1;
+  /// Regions whose points span less than minPieceExtent times e (bounding-box diagonal) are
+  /// dropped before the joining below (specks of 1-4 points where a line grazed a corner), and
+  /// the curves spanning less than minCurveExtent times e after it: a short piece that joins a
+  /// crease stays, one that joins nothing is a speck (bench_features, 11 models: 1 -> 3 raised
+  /// the mean MCC 0.898 -> 0.900 clean and 0.771 -> 0.778 noisy, per-curve recall the same; the
+  /// real table scan 1,811 -> 540 curves). 0 keeps every region (the thesis).
+  double minPieceExtent = 1;
+  double minCurveExtent = 3;
   /// (Not in the thesis) curves of the same sign whose points come within joinGap * e of each
   /// other are one curve: lines stop short of corners, so the votes leave gaps where creases meet
   /// and the region growing cut one connected set of creases (what the thesis calls a curve) into

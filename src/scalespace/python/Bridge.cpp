@@ -67,6 +67,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::salientThreshold", "salient_threshold"},
     {"FeatureCurveOptions::voteThreshold", "vote_threshold"},
     {"FeatureCurveOptions::minCurveExtent", "min_extent"},
+    {"FeatureCurveOptions::minPieceExtent", "min_piece_extent"},
     {"FeatureCurveOptions::joinGap", "join_gap"},
     {"FeatureCurveOptions::minSalientCurvature", "min_curvature"},
     {"FeatureCurveOptions::noiseSalientFactor", "noise_curvature"},

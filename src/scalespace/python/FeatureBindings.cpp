@@ -130,8 +130,8 @@ TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
 py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     const py::handle& viewpoint, int scales, double spacing, double voteThreshold,
                     int minScales, double minCurvature, double noiseCurvature,
-                    double salientThreshold, double minExtent, double joinGap,
-                    double centrelineReach, double bandHalfWidth, double edgeReach,
+                    double salientThreshold, double minExtent, double minPieceExtent,
+                    double joinGap, double centrelineReach, double bandHalfWidth, double edgeReach,
                     double edgeRejoinAngle, bool allSalient, bool salientPerScale, double beta,
                     double gamma, bool curvedSeedsFirst, bool withLines,
                     const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
@@ -145,6 +145,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.noiseSalientFactor = noiseCurvature;
   options.salientThreshold = salientThreshold;
   options.minCurveExtent = minExtent;
+  options.minPieceExtent = minPieceExtent;
   options.joinGap = joinGap;
   options.centrelineReach = centrelineReach;
   options.bandHalfWidth = bandHalfWidth;
@@ -259,7 +260,8 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
   m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "viewpoint"_a = py::none(), "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05,
         "min_scales"_a = 3, "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0,
-        "salient_threshold"_a = 0.5, "min_extent"_a = 1.0, "join_gap"_a = 1.5,
+        "salient_threshold"_a = 0.5, "min_extent"_a = FeatureCurveOptions{}.minCurveExtent,
+        "min_piece_extent"_a = FeatureCurveOptions{}.minPieceExtent, "join_gap"_a = 1.5,
         "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
         "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth,
         "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
@@ -282,7 +284,9 @@ scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_l
 traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
 scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
 join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False restore the
-thesis' rules. centreline_reach, band_half_width: a curve keeps the points within
+thesis' rules (with min_extent=0, min_piece_extent=0: every region kept; else regions spanning
+under min_piece_extent x e are dropped before the joining, curves under min_extent x e after
+it). centreline_reach, band_half_width: a curve keeps the points within
 band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e.
 triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
