@@ -18,12 +18,11 @@ OrientedNormals estimateOrientedNormals(const std::vector<Vec3>& points, const S
                                     out.estimation.valid, progress);
     return out;
   }
-  std::vector<Vec3> signs = planes;
   out.orientation =
-      orientNormals(points, signs, index, options.orientation, out.estimation.valid, progress);
+      orientNormals(points, planes, index, options.orientation, out.estimation.valid, progress);
   const double guess = options.orientation.creaseThreshold;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const double c = signs[i].dot(out.normals[i]);
+    const double c = planes[i].dot(out.normals[i]);
     if (c < 0) out.normals[i] = -out.normals[i];
     if (std::abs(c) < guess && out.orientation.reliable[i]) {
       out.orientation.reliable[i] = 0;

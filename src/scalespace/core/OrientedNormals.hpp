@@ -31,8 +31,10 @@ struct OrientedNormalsOptions {
 };
 
 struct OrientedNormals {
-  std::vector<Vec3> normals;          // unit, oriented
-  NormalEstimationResult estimation;  // its `normals` moved to the field above
+  std::vector<Vec3> normals;  // unit, oriented
+  /// Its `normals` moved to the field above; with SheetSign::FromPlanes its planeNormals come
+  /// back oriented.
+  NormalEstimationResult estimation;
   /// Of the normals the tree ran on: with SheetSign::FromPlanes its flippedCount counts PCA
   /// normals, and `reliable` also flags the sheet normals whose sign is a guess.
   NormalOrientationResult orientation;

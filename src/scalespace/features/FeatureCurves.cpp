@@ -433,21 +433,21 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     }
     return (hi - lo).norm();
   };
-  std::vector<std::size_t> pieces;
-  for (std::size_t c = 0; c < seg.regions.size(); ++c)
-    if (extent(seg.regions[c]) >= options.minPieceExtent * e) pieces.push_back(c);
+  std::vector<std::size_t> pieces;  // region of each piece
+  std::vector<std::vector<Index>> pieceRegions;
+  std::vector<std::int8_t> pieceSign;
+  for (std::size_t c = 0; c < seg.regions.size(); ++c) {
+    if (extent(seg.regions[c]) < options.minPieceExtent * e) continue;
+    pieces.push_back(c);
+    pieceSign.push_back(result.convexity[seg.regions[c].front()]);
+    pieceRegions.push_back(std::move(seg.regions[c]));
+  }
   // 5. (not in the thesis) Lines stop short of corners (near-umbilic points, sharp turns), so where
   // creases meet the votes leave a gap and the regions cut a connected set of creases into
   // pieces; pieces of the same sign within joinGap * e of each other are one curve. Then the
   // curves spanning less than minCurveExtent * e are dropped: a short piece that joins a crease is
   // part of it, one that joins nothing is a speck. The others keep their order (by decreasing
   // strongest vote of their first piece) and are renumbered.
-  std::vector<std::vector<Index>> pieceRegions;
-  std::vector<std::int8_t> pieceSign;
-  for (const std::size_t c : pieces) {
-    pieceRegions.push_back(seg.regions[c]);
-    pieceSign.push_back(result.convexity[seg.regions[c].front()]);
-  }
   std::vector<std::vector<std::size_t>> groups;
   if (options.joinGap > 0)
     groups = curvesWithinGap(targets, pieceRegions, pieceSign, options.joinGap * e);
