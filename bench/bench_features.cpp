@@ -6,6 +6,7 @@
 //                  [--models a,b,c] [--clean-only | --noise-only] [--angle DEG (30)] [--no-peers]
 //                  [--salient X] [--vote-threshold X] [--min-curvature X] [--min-scales N]
 //                  [--vote-radius X] [--all-salient] [--noise-curvature X] [--join-gap X]
+//                  [--bound-cap X] (FeatureCurveOptions::salientBoundCap)
 //                  [--min-piece-extent X] [--min-extent X] (FeatureCurveOptions::
 //                  minPieceExtent, minCurveExtent)
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
@@ -692,8 +693,7 @@ void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<
     const auto li = makeSpatialIndex(pos);
     std::vector<double> best;
     std::size_t any = 0, pass = 0;
-    const double bound = std::max((1 - ourOptions.salientThreshold) * r.scales[s].salientBound * t,
-                                  r.salientCurvatureFloor);
+    const double bound = r.scales[s].vertexBound * t;
     for (const Index p : points) {
       li->radiusSearch(m.clean.positions()[p], m.spacing, found);
       double b = 0;
@@ -873,11 +873,11 @@ void explainMiss(const Model& m, const FeatureCurveResult& r, const std::vector<
     std::printf("\n");
     std::printf(
         "#     scale %zu (t %.2f e): line vertex within e %.0f%%, max |k1|t q50 %.2f q90 %.2f; "
-        "bound %.2f (0.5 K t %.2f, floor %.2f) passed by %.0f%%\n",
+        "bound %.2f (0.5 K t %.2f, cap %.2f, floor %.2f) passed by %.0f%%\n",
         s, t / m.spacing, 100.0 * double(any) / double(n), best[n / 2],
         best[std::min(n - 1, n * 9 / 10)], bound,
-        (1 - ourOptions.salientThreshold) * r.scales[s].salientBound * t, r.salientCurvatureFloor,
-        100.0 * double(pass) / double(n));
+        (1 - ourOptions.salientThreshold) * r.scales[s].salientBound * t,
+        ourOptions.salientBoundCap, r.salientCurvatureFloor, 100.0 * double(pass) / double(n));
   }
   std::printf("#     salient within e per scale:");
   for (std::size_t s = 0; s < r.scales.size(); ++s)
@@ -1301,6 +1301,8 @@ int main(int argc, char** argv) {
       ourOptions.voteThreshold = std::atof(argv[++i]);
     } else if (a == "--min-curvature" && hasValue) {
       ourOptions.minSalientCurvature = std::atof(argv[++i]);
+    } else if (a == "--bound-cap" && hasValue) {
+      ourOptions.salientBoundCap = std::atof(argv[++i]);
     } else if (a == "--all-salient") {
       ourOptions.ridgeOnly = false;
     } else if (a == "--noise-curvature" && hasValue) {

@@ -527,3 +527,36 @@ TEST(FeatureCurves, AWeakRidgeBesideStrongEdgesIsFoundWithTheFinestScalesK) {
     EXPECT_GT(labelsAlong(cloud.positions(), finest, eave, 0.5 * finest.spacing, 1).fraction, 0.95);
   }
 }
+
+// A 30-degree ridge beside 90-degree eaves: K t (1.23 at every scale), set by the eaves, keeps the
+// ridge's |kappa1| t under the relative bound and none of it is labelled; salientBoundCap 0.7
+// bounds it at what a 30-degree crease gives (measured: 1.00 of the ridge; 0.95 at 0.75, 0.62
+// at 0.8).
+TEST(FeatureCurves, ACappedSalientBoundFindsAWeakRidgeBesideStrongEdges) {
+  const double degrees = 30, h = 0.5 * std::tan(0.5 * degrees * kPi / 180);
+  const PointCloud cloud = gableHouse(degrees, 8000);
+  const Edge ridge{Vec3(0, 0.5, 1 + h), Vec3(1, 0.5, 1 + h)};
+  ASSERT_EQ(FeatureCurveOptions{}.salientBoundCap, 0) << "the thesis' relative bound by default";
+  FeatureCurveOptions capped;
+  capped.salientBoundCap = 0.7;
+  const FeatureCurveResult relative = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  const FeatureCurveResult withCap = detectFeatureCurves(cloud, capped);
+  for (std::size_t s = 0; s < withCap.scales.size(); ++s) {
+    const FeatureCurveScale& scale = withCap.scales[s];
+    EXPECT_GT(0.5 * scale.salientBound * scale.scale, 1.0);
+    EXPECT_NEAR(scale.vertexBound * scale.scale, 0.7, 1e-12);
+    EXPECT_NEAR(relative.scales[s].vertexBound, 0.5 * relative.scales[s].salientBound, 1e-12);
+  }
+  EXPECT_LT(labelsAlong(cloud.positions(), relative, ridge, 0.5 * relative.spacing, 1).fraction,
+            0.1);
+  const EdgeLabels found = labelsAlong(cloud.positions(), withCap, ridge, 0.5 * withCap.spacing, 1);
+  EXPECT_GT(found.fraction, 0.95);
+  EXPECT_EQ(found.curves.size(), 1u);
+  for (const double y : {0.0, 1.0}) {
+    const Edge eave{Vec3(0, y, 1), Vec3(1, y, 1)};
+    EXPECT_GT(labelsAlong(cloud.positions(), withCap, eave, 0.5 * withCap.spacing, 1).fraction,
+              0.95);
+  }
+  capped.salientBoundCap = -1;
+  EXPECT_THROW(detectFeatureCurves(cloud, capped), OptionError);
+}

@@ -242,6 +242,10 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--vote-threshold", args->features.voteThreshold,
                   "curves hold points with |votes| > this x the largest")
       ->capture_default_str();
+  cmd->add_option("--salient-cap", args->features.salientBoundCap,
+                  "salient vertices with |k1| t >= this pass whatever K is (0 = the thesis' "
+                  "relative bound alone)")
+      ->capture_default_str();
   cmd->add_option("--min-curvature", args->features.minSalientCurvature,
                   "salient vertices also have |k1| t >= this (0 = the thesis' rule alone)")
       ->capture_default_str();
@@ -362,6 +366,7 @@ void addFeaturesCommand(CLI::App& app) {
     for (const FeatureCurveScale& s : result.scales)
       scales.push_back({{"scale", s.scale},
                         {"salient_bound", s.salientBound},
+                        {"vertex_bound", s.vertexBound},
                         {"lines", s.lines},
                         {"vertices", s.vertices},
                         {"salient_vertices", s.salientVertices}});
@@ -403,6 +408,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"salient_threshold", options.salientThreshold},
                                    {"salient_percentile", options.salientPercentile},
                                    {"salient_bound_from_finest", options.salientBoundFromFinest},
+                                   {"salient_bound_cap", options.salientBoundCap},
                                    {"vote_threshold", options.voteThreshold},
                                    {"min_salient_curvature", options.minSalientCurvature},
                                    {"noise_salient_factor", options.noiseSalientFactor},

@@ -56,6 +56,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::spacing", "--spacing"},
     {"FeatureCurveOptions::scaleCount", "--scales"},
     {"FeatureCurveOptions::salientThreshold", "--salient"},
+    {"FeatureCurveOptions::salientBoundCap", "--salient-cap"},
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
     {"FeatureCurveOptions::edgeReach", "--edge-reach"},

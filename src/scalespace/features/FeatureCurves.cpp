@@ -221,6 +221,8 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::salientThreshold must be in [0, 1]");
   require(std::isfinite(o.minSalientCurvature) && o.minSalientCurvature >= 0,
           "FeatureCurveOptions::minSalientCurvature must be finite and >= 0");
+  require(std::isfinite(o.salientBoundCap) && o.salientBoundCap >= 0,
+          "FeatureCurveOptions::salientBoundCap must be finite and >= 0 (0 = off)");
   require(std::isfinite(o.edgeReach) && o.edgeReach >= 0,
           "FeatureCurveOptions::edgeReach must be finite and >= 0 (0 = off)");
   require(o.edgeSpread >= 0 && o.edgeSpread <= 1,
@@ -353,8 +355,11 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     if (options.salientBoundFromFinest && s > 0)
       summary.salientBound =
           result.scales.front().salientBound * result.scales.front().scale / lineOptions.scale;
-    const double bound = std::max((1 - options.salientThreshold) * summary.salientBound,
-                                  result.salientCurvatureFloor / lineOptions.scale);
+    double relative = (1 - options.salientThreshold) * summary.salientBound;
+    if (options.salientBoundCap > 0)
+      relative = std::min(relative, options.salientBoundCap / lineOptions.scale);
+    const double bound = std::max(relative, result.salientCurvatureFloor / lineOptions.scale);
+    summary.vertexBound = bound;
     std::vector<const CurvatureLineVertex*> candidates;
     for (const CurvatureLine& line : lines.lines)
       for (const CurvatureLineVertex& v : line.vertices) {

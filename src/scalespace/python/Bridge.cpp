@@ -65,6 +65,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::spacing", "spacing"},
     {"FeatureCurveOptions::scaleCount", "scales"},
     {"FeatureCurveOptions::salientThreshold", "salient_threshold"},
+    {"FeatureCurveOptions::salientBoundCap", "salient_cap"},
     {"FeatureCurveOptions::voteThreshold", "vote_threshold"},
     {"FeatureCurveOptions::minCurveExtent", "min_extent"},
     {"FeatureCurveOptions::minPieceExtent", "min_piece_extent"},

@@ -130,12 +130,12 @@ TriangleMesh meshFrom(const Points& vertices, const py::handle& triangles) {
 py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     const py::handle& viewpoint, int scales, double spacing, double voteThreshold,
                     int minScales, double minCurvature, double noiseCurvature,
-                    double salientThreshold, double minExtent, double minPieceExtent,
-                    double joinGap, double centrelineReach, double bandHalfWidth, double edgeReach,
-                    double edgeRejoinAngle, bool allSalient, bool salientPerScale, double beta,
-                    double gamma, bool curvedSeedsFirst, bool withLines,
-                    const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
-                    std::optional<int> threads, py::object progress) {
+                    double salientThreshold, double salientCap, double minExtent,
+                    double minPieceExtent, double joinGap, double centrelineReach,
+                    double bandHalfWidth, double edgeReach, double edgeRejoinAngle, bool allSalient,
+                    bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
+                    bool withLines, const py::handle& triangles, std::size_t meshSamples,
+                    double sheetNormals, std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -144,6 +144,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.minSalientCurvature = minCurvature;
   options.noiseSalientFactor = noiseCurvature;
   options.salientThreshold = salientThreshold;
+  options.salientBoundCap = salientCap;
   options.minCurveExtent = minExtent;
   options.minPieceExtent = minPieceExtent;
   options.joinGap = joinGap;
@@ -230,6 +231,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
     py::dict e;
     e["scale"] = s.scale;
     e["salient_bound"] = s.salientBound;
+    e["vertex_bound"] = s.vertexBound;
     e["lines"] = s.lines;
     e["vertices"] = s.vertices;
     e["salient_vertices"] = s.salientVertices;
@@ -260,7 +262,8 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
   m.def("features", &featuresPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "viewpoint"_a = py::none(), "scales"_a = 5, "spacing"_a = 0.0, "vote_threshold"_a = 0.05,
         "min_scales"_a = 3, "min_curvature"_a = 0.6, "noise_curvature"_a = 8.0,
-        "salient_threshold"_a = 0.5, "min_extent"_a = FeatureCurveOptions{}.minCurveExtent,
+        "salient_threshold"_a = 0.5, "salient_cap"_a = FeatureCurveOptions{}.salientBoundCap,
+        "min_extent"_a = FeatureCurveOptions{}.minCurveExtent,
         "min_piece_extent"_a = FeatureCurveOptions{}.minPieceExtent, "join_gap"_a = 1.5,
         "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
         "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth,
@@ -280,9 +283,10 @@ and edges (per edge: points, curve, length; each curve split at its corners: whe
 within edge_reach x e do not lie along a line; adjacent pieces along one line, within
 edge_rejoin_angle degrees, joined again where no third edge meets them; 0: no split / no
 rejoining), scales (per
-scale: scale, salient_bound, lines, vertices, salient_vertices), and with with_lines the lines
-traced (as lines() returns them). salient_per_scale=True takes K at each scale, not the finest
-scale's K t over t. all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
+scale: scale, salient_bound (K), vertex_bound (the |k1| the salient vertices passed), lines,
+vertices, salient_vertices), and with with_lines the lines traced (as lines() returns them).
+salient_cap: a vertex with |k1| t >= salient_cap passes whatever K is (0: off). salient_per_scale=True takes K at each scale, not the finest
+scale's K t over t. salient_cap=0, all_salient=True, min_scales=1, min_curvature=0, noise_curvature=0,
 join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False restore the
 thesis' rules (with min_extent=0, min_piece_extent=0: every region kept; else regions spanning
 under min_piece_extent x e are dropped before the joining, curves under min_extent x e after
