@@ -333,15 +333,17 @@ def test_lines_and_features_equal_the_cli(data, tmp_path):
     written = ss.read(str(tmp_path / "e.ply")).attributes["edge_id"]
     np.testing.assert_array_equal(whole["edge_id"].astype(written.dtype), written)
     assert len(whole["edges"]) == len(whole["curves"]) < len(features["edges"])
-    # The capped salient bound: the same votes through both, the bound per scale in the dict.
-    cli("features", data / "house.ply", "-o", tmp_path / "c.ply", "--salient-cap", 0.7)
-    capped = ss.features(cloud.points, cloud.normals, salient_cap=0.7)
+    # The salient bound without its cap (the thesis' relative bound): the same votes through
+    # both; the bound each scale's vertices passed, capped or not, in the dict.
+    cli("features", data / "house.ply", "-o", tmp_path / "c.ply", "--salient-cap", 0)
+    relative = ss.features(cloud.points, cloud.normals, salient_cap=0)
     written = ss.read(str(tmp_path / "c.ply")).attributes["feature_votes"]
-    np.testing.assert_array_equal(capped["feature_votes"].astype(written.dtype), written)
-    for s in capped["scales"]:
-        assert s["vertex_bound"] * s["scale"] == pytest.approx(
-            max(min(0.5 * s["salient_bound"] * s["scale"], 0.7),
-                capped["salient_curvature_floor"]), rel=1e-12)
+    np.testing.assert_array_equal(relative["feature_votes"].astype(written.dtype), written)
+    for result, cap in ((features, 0.7), (relative, np.inf)):
+        for s in result["scales"]:
+            assert s["vertex_bound"] * s["scale"] == pytest.approx(
+                max(min(0.5 * s["salient_bound"] * s["scale"], cap),
+                    result["salient_curvature_floor"]), rel=1e-12)
     for kwargs, name in [({"salient_cap": -1}, "salient_cap"),
                          ({"edge_reach": -1}, "edge_reach"),
                          ({"edge_rejoin_angle": 120}, "edge_rejoin_angle"),

@@ -77,9 +77,11 @@ double bandLength(const std::vector<Vec3>& positions, const std::vector<Index>& 
 /// them: no vertex of the same sign within t, displaced across the first one's line (its offset
 /// along that line's tangent under half its length), is more curved. Parallel lines flank a
 /// crease over a band as wide as t; only the one on the crease is kept (non-maximum suppression,
-/// as an edge detector thins its gradient).
+/// as an edge detector thins its gradient). A vertex under `crossSignBelow` (|kappa1|) is also
+/// suppressed by a more curved one of the other sign: the fits across a crease read a weaker
+/// curvature of the opposite sign on its flanks (FeatureCurveOptions::salientBoundCap).
 std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLineVertex*>& vertices,
-                                           double t) {
+                                           double t, double crossSignBelow) {
   std::vector<Vec3> positions(vertices.size());
   for (std::size_t i = 0; i < vertices.size(); ++i) positions[i] = vertices[i]->position;
   std::vector<std::uint8_t> keep(vertices.size(), 1);
@@ -89,10 +91,12 @@ std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLine
     std::vector<Neighbor> found;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const CurvatureLineVertex& v = *vertices[i];
+      const bool anySign = std::abs(v.kappa1) < crossSignBelow;
       index->radiusSearch(v.position, t, found);
       for (const Neighbor& nb : found) {
         const CurvatureLineVertex& u = *vertices[nb.index];
-        if ((u.kappa1 > 0) != (v.kappa1 > 0) || !(std::abs(u.kappa1) > std::abs(v.kappa1)))
+        if ((!anySign && (u.kappa1 > 0) != (v.kappa1 > 0)) ||
+            !(std::abs(u.kappa1) > std::abs(v.kappa1)))
           continue;
         const Vec3 d = u.position - v.position;
         if (std::abs(d.dot(v.tangent)) < 0.5 * d.norm()) {
@@ -355,10 +359,13 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     if (options.salientBoundFromFinest && s > 0)
       summary.salientBound =
           result.scales.front().salientBound * result.scales.front().scale / lineOptions.scale;
-    double relative = (1 - options.salientThreshold) * summary.salientBound;
-    if (options.salientBoundCap > 0)
-      relative = std::min(relative, options.salientBoundCap / lineOptions.scale);
-    const double bound = std::max(relative, result.salientCurvatureFloor / lineOptions.scale);
+    const double relative = (1 - options.salientThreshold) * summary.salientBound;
+    const double floor = result.salientCurvatureFloor / lineOptions.scale;
+    const double bound =
+        std::max(options.salientBoundCap > 0
+                     ? std::min(relative, options.salientBoundCap / lineOptions.scale)
+                     : relative,
+                 floor);
     summary.vertexBound = bound;
     std::vector<const CurvatureLineVertex*> candidates;
     for (const CurvatureLine& line : lines.lines)
@@ -366,9 +373,10 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
         ++summary.vertices;
         if (std::abs(v.kappa1) > bound) candidates.push_back(&v);
       }
-    const std::vector<std::uint8_t> keep = options.ridgeOnly
-                                               ? acrossLineMaxima(candidates, lineOptions.scale)
-                                               : std::vector<std::uint8_t>(candidates.size(), 1);
+    const std::vector<std::uint8_t> keep =
+        options.ridgeOnly
+            ? acrossLineMaxima(candidates, lineOptions.scale, std::max(relative, floor))
+            : std::vector<std::uint8_t>(candidates.size(), 1);
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       if (!keep[c]) continue;
       ++summary.salientVertices;

@@ -5,7 +5,8 @@
 //   2. salient vertices: |kappa1| > (1 - salientThreshold) K, K the 90th percentile of |kappa1| at
 //      that scale over the seeds with a minimal direction (docs/THESIS_NOTES.md, "Salient filter",
 //      for this reading of the thesis' "||kappa1| - K| / K > 0.5"), and |kappa1| t >=
-//      max(minSalientCurvature, noiseSalientFactor sigma / e), sigma the cloud's noise;
+//      max(minSalientCurvature, noiseSalientFactor sigma / e), sigma the cloud's noise; the
+//      relative bound capped at |kappa1| t = salientBoundCap;
 //   3. each salient vertex votes for the target points (cloud points or mesh vertices) within e,
 //      with weight (1 - (d/e)^2)^2, signed by kappa1 (convex +, concave -);
 //   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
@@ -61,10 +62,12 @@ struct FeatureCurveOptions {
   /// salientThreshold) K t never exceeds salientBoundCap: a vertex with |kappa1| t >= the cap (and
   /// the floors above) is salient whatever K is. K is set by a cloud's strongest edges, so on a
   /// part with 150-degree edges a 30-degree crease (|kappa1| t 0.71-0.83 over e..3e) stayed under
-  /// 0.5 K t = 1.2 at every scale. bench_features' creases model, clean: MCC 0.816 -> 0.872,
-  /// per-curve recall 0.71 -> 0.86 with 0.7; the noisy models are bounded by the noise floor.
+  /// 0.5 K t = 1.2 at every scale. A vertex the cap lets in must be the most curved across the
+  /// nearby lines of either sign (ridgeOnly): the fits beside a convex edge read a concave
+  /// curvature on its flanks. bench_features' creases model, clean: MCC 0.816 -> 0.872,
+  /// per-curve recall 0.71 -> 0.86; the noisy models are bounded by the noise floor.
   /// 0 turns it off (the thesis' relative bound).
-  double salientBoundCap = 0;
+  double salientBoundCap = 0.7;
   /// (Not in the thesis) and |kappa1| t >= noiseSalientFactor * sigma / e, sigma the cloud's
   /// sensor noise (scales/PointNoise.hpp): a noise-aware floor for minSalientCurvature. Noise of
   /// sigma gives flat faces a |kappa1| t that grows with sigma / e, and at 1e-3 of the diagonal
