@@ -12,6 +12,9 @@
 //                  [--bound-per-scale] [--random-seed-order] [--robust-fit] [--across-weight X]
 //                  [--no-visibility] [--sheet-normals X (0.05; 0: PCA)] [--sign-from-pca]
 //                  (SheetSign::FromPlanes: the sheet normals take the oriented PCA normals' sign)
+//                  [--own-tree-sign] (SheetSign::OwnTree: the sheet normals' own tree; the
+//                  default is `features`' SheetSign::ByRays: both, the one the rays find facing
+//                  inward at fewer points kept)
 //                  (NormalOrientationOptions::acrossWeight and ::visibility of the estimated
 //                  normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
@@ -471,17 +474,26 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
 double sheetNormals = 0.05;  // --sheet-normals, as `scalespace features` (kFeatureSheetNormals)
 bool visibility = NormalOrientationOptions{}.visibility;  // --no-visibility
-SheetSign sheetSign = SheetSign::OwnTree;                 // --sign-from-pca: FromPlanes
+// As `features` (featureNormalOptions(): ByRays); --sign-from-pca: FromPlanes; --own-tree-sign:
+// OwnTree (before 2026-11-30).
+SheetSign sheetSign = featureNormalOptions().sheetSign;
+
+bool printPerCurve = false;  // --per-curve
 
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
 void estimateSceneNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
-  OrientedNormalsOptions options;
-  options.estimation.sheetTolerance = sheetNormals;
+  OrientedNormalsOptions options = featureNormalOptions(sheetNormals);
   options.orientation.acrossWeight = acrossWeight;
   options.orientation.visibility = visibility;
   options.sheetSign = sheetSign;
   OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options);
+  if (sheetSign == SheetSign::ByRays && printPerCurve)
+    std::printf(
+        "# signs by the rays: differing at %zu points, inward own tree %zu, PCA signs %zu of "
+        "%zu: kept %s\n",
+        normals.rays.differing, normals.rays.firstInward, normals.rays.secondInward,
+        normals.rays.sampled, normals.signSource == SheetSign::OwnTree ? "own tree" : "PCA signs");
   cloud.setNormals(std::move(normals.normals));
 }
 
@@ -496,8 +508,7 @@ PointCloud noisyCopy(const PointCloud& clean, double sigma) {
   return noisy;
 }
 
-bool printPerCurve = false;  // --per-curve
-bool meshNormals = false;    // --mesh-normals
+bool meshNormals = false;  // --mesh-normals
 FeatureCurveOptions ourOptions;
 // --per-curve: ours' last result, for the reasons a curve is missed.
 std::unique_ptr<FeatureCurveResult> lastOurs;
@@ -1343,6 +1354,8 @@ int main(int argc, char** argv) {
       visibility = false;
     } else if (a == "--sign-from-pca") {
       sheetSign = SheetSign::FromPlanes;
+    } else if (a == "--own-tree-sign") {
+      sheetSign = SheetSign::OwnTree;
     } else if (a == "--mesh-normals") {
       meshNormals = true;
     } else if (a == "--robust-fit") {

@@ -134,18 +134,19 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)
     # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone, sheets
-    # oriented by their own tree and by the PCA normals'
-    for weight, visibility, sheet, sign in ((1, True, 0, False), (0, True, 0, False),
-                                            (0, False, 0, False), (0, True, 0.05, False),
-                                            (0, True, 0.05, True)):
+    # oriented by their own tree, by the PCA normals', and by whichever the rays prefer
+    for weight, visibility, sheet, sign in ((1, True, 0, ""), (0, True, 0, ""),
+                                            (0, False, 0, ""), (0, True, 0.05, ""),
+                                            (0, True, 0.05, "pca"), (0, True, 0.05, "rays")):
         flags = ["--visibility" if visibility else "--no-visibility"]
-        flags += ["--sign-from-pca"] if sign else []
+        flags += {"": [], "pca": ["--sign-from-pca"], "rays": ["--sign-by-rays"]}[sign]
         cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight,
             *flags, "--sheet", sheet)
         expected = columns(tmp_path / "n.ply")
         normals, reliable = ss.estimate_normals(points, across_weight=weight,
                                                 visibility=visibility, sheet=sheet,
-                                                sign_from_pca=sign)
+                                                sign_from_pca=sign == "pca",
+                                                sign_by_rays=sign == "rays")
         for c, name in enumerate(("nx", "ny", "nz")):
             np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
         np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)
@@ -156,6 +157,10 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     assert "Options::" not in str(e.value)
     with pytest.raises(ss.OptionError, match="sign_from_pca needs sheet normals"):
         ss.estimate_normals(points, sign_from_pca=True)
+    with pytest.raises(ss.OptionError, match="sign_by_rays needs sheet normals"):
+        ss.estimate_normals(points, sign_by_rays=True)
+    with pytest.raises(ss.OptionError, match="one of sign_from_pca and sign_by_rays"):
+        ss.estimate_normals(points, sheet=0.05, sign_from_pca=True, sign_by_rays=True)
 
 
 def test_noisy_normals_take_more_neighbours_as_the_cli_does(tmp_path):
@@ -203,7 +208,8 @@ def test_a_pcd_viewpoint_orients_the_normals_as_the_cli_does(tmp_path):
     features = ss.features(cloud.points, viewpoint=cloud.viewpoint)
     np.testing.assert_array_equal(features["convexity"],
                                   ss.read(str(tmp_path / "f.ply")).attributes["convexity"])
-    sheets, _ = ss.estimate_normals(cloud.points, viewpoint=cloud.viewpoint, sheet=0.05)
+    sheets, _ = ss.estimate_normals(cloud.points, viewpoint=cloud.viewpoint, sheet=0.05,
+                                    sign_by_rays=True)
     np.testing.assert_array_equal(features["convexity"],
                                   ss.features(cloud.points, sheets)["convexity"])
     assert (features["convexity"] < 0).sum() > 100 and (features["convexity"] > 0).sum() == 0
@@ -550,10 +556,10 @@ def test_render_lines_features(data):
         0.6, 8 * features["noise_rms"] / features["spacing"])
     with pytest.raises(ss.OptionError, match="noise_curvature must be finite and >= 0"):
         ss.features(cloud.points, noise_curvature=-1)
-    # Without normals, features estimates sheet normals (0.05) or, with sheet_normals=0, PCA ones,
-    # as estimate_normals does.
+    # Without normals, features estimates sheet normals (0.05, the sign the rays prefer) or, with
+    # sheet_normals=0, PCA ones, as estimate_normals does.
     for sheet, result in ((0.05, features), (0, ss.features(cloud.points, sheet_normals=0))):
-        normals, _ = ss.estimate_normals(cloud.points, sheet=sheet)
+        normals, _ = ss.estimate_normals(cloud.points, sheet=sheet, sign_by_rays=sheet > 0)
         np.testing.assert_array_equal(
             result["curve_id"], ss.features(cloud.points, normals)["curve_id"])
     with pytest.raises(ss.OptionError, match="sheet_normals must be finite and >= 0"):

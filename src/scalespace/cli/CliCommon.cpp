@@ -82,8 +82,10 @@ void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& 
                  "orienting (MST%s%s)\n",
                  estimation.sheetTolerance > 0 ? "sheet planes" : "PCA", estimation.k,
                  std::max(estimation.k, estimation.maxK),
-                 estimation.sheetTolerance > 0 && options.sheetSign == SheetSign::FromPlanes
-                     ? " of the PCA normals"
+                 estimation.sheetTolerance <= 0               ? ""
+                 : options.sheetSign == SheetSign::FromPlanes ? " of the PCA normals"
+                 : options.sheetSign == SheetSign::ByRays
+                     ? " of the sheet or the PCA normals, whichever the rays contradict less"
                      : "",
                  cloud.viewpoint() ? ", facing the file's viewpoint" : "");
   auto index = makeSpatialIndex(cloud.positions());

@@ -184,6 +184,7 @@ struct NormalArgs {
   bool visibility = NormalOrientationOptions{}.visibility;
   double sheet = NormalEstimationOptions{}.sheetTolerance;
   bool signFromPlanes = false;
+  bool signByRays = false;
 };
 
 void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
@@ -208,6 +209,10 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                "with --sheet: orient the PCA normals and give each sheet normal its point's sign "
                "(where surfaces touch, the sheet normals' own tree can turn one inside out; "
                "cylinders does this)");
+  cmd.add_flag("--sign-by-rays", a.signByRays,
+               "with --sheet: orient the sheet normals both ways (their own tree, the PCA "
+               "normals' signs) and keep the one the visibility rays find facing inward less "
+               "often (features does this)");
   cmd.add_option("--across-weight", a.acrossWeight,
                  "mst: extra cost of a graph edge across a thin part (offset along both normals), "
                  "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
@@ -261,12 +266,18 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
                       std::to_string(cloud.size()) + ")");
   if (a.signFromPlanes && !(a.sheet > 0))
     throw OptionError("--sign-from-pca needs sheet normals (--sheet > 0)");
+  if (a.signByRays && !(a.sheet > 0))
+    throw OptionError("--sign-by-rays needs sheet normals (--sheet > 0)");
+  if (a.signByRays && a.signFromPlanes)
+    throw OptionError("give one of --sign-from-pca and --sign-by-rays");
   OrientedNormalsOptions options;
   options.orientation = orientationFrom(a, cloud);
   options.estimation.k = a.k;
   options.estimation.maxK = a.maxK;
   options.estimation.sheetTolerance = a.sheet;
-  options.sheetSign = a.signFromPlanes ? SheetSign::FromPlanes : SheetSign::OwnTree;
+  options.sheetSign = a.signByRays       ? SheetSign::ByRays
+                      : a.signFromPlanes ? SheetSign::FromPlanes
+                                         : SheetSign::OwnTree;
   const NormalOrientationOptions& orientation = options.orientation;
   const auto index = makeSpatialIndex(cloud.positions());
   OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options, progress);
@@ -281,6 +292,15 @@ void estimateAndOrient(PointCloud& cloud, const NormalArgs& a, const ProgressCal
                  "reliable orientation (normal_reliable = 0)%s\n",
                  cloud.size(), est.k, est.invalidCount, ori.flippedCount, ori.unreliableCount,
                  orientation.faceViewpoint ? "; the tree's parts face the file's VIEWPOINT" : "");
+  if (!quiet && options.sheetSign == SheetSign::ByRays)
+    std::fprintf(stderr,
+                 "normals: signs of %s (the two differ at %zu points; of %zu sampled, the rays "
+                 "find %zu facing inward with the sheet normals' own tree, %zu with the PCA "
+                 "signs)\n",
+                 normals.signSource == SheetSign::OwnTree ? "the sheet normals' own tree"
+                                                          : "the PCA normals",
+                 normals.rays.differing, normals.rays.sampled, normals.rays.firstInward,
+                 normals.rays.secondInward);
 }
 
 void addNormalsCommand(CLI::App& app) {

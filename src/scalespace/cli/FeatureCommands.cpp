@@ -338,9 +338,7 @@ void addFeaturesCommand(CLI::App& app) {
       result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
-      OrientedNormalsOptions normals;
-      normals.estimation.sheetTolerance = args->sheetNormals;
-      ensureNormals(cloud, args->quiet, normals);
+      ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
       result = detectFeatureCurves(cloud, options, progress);
     }
     PointCloud& out = mesh ? targets : cloud;

@@ -738,4 +738,68 @@ NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vect
   return orientNormals(points, normals, *index, options, valid, progress);
 }
 
+RayComparison compareByRays(const std::vector<Vec3>& points, const std::vector<Vec3>& first,
+                            const std::vector<Vec3>& second, const SpatialIndex& index,
+                            const NormalOrientationOptions& options, std::size_t maxPoints) {
+  if (first.size() != points.size() || second.size() != points.size())
+    throw OptionError("compareByRays: " + std::to_string(first.size()) + " and " +
+                      std::to_string(second.size()) + " normals for " +
+                      std::to_string(points.size()) + " points");
+  if (options.k < 1) throw OptionError("NormalOrientationOptions::k must be >= 1");
+  RayComparison result;
+  const std::size_t n = points.size();
+  const auto usable = [&](std::size_t i) {
+    return points[i].allFinite() && first[i].allFinite() && second[i].allFinite() &&
+           first[i].squaredNorm() > 0 && second[i].squaredNorm() > 0;
+  };
+  std::vector<Index> differing;
+  for (std::size_t i = 0; i < n; ++i)
+    if (usable(i) && first[i].dot(second[i]) < 0) differing.push_back(Index(i));
+  result.differing = differing.size();
+  if (differing.empty()) return result;
+  // The cell: the median distance to the k-th neighbour over about kSpacingSample points.
+  constexpr std::size_t kSpacingSample = 10000;
+  std::vector<Index> probes;
+  for (std::size_t i = 0; i < n; i += std::max<std::size_t>(1, n / kSpacingSample))
+    if (points[i].allFinite()) probes.push_back(Index(i));
+  std::vector<double> kth(probes.size(), 0.0);
+  tbb::enumerable_thread_specific<std::vector<Neighbor>> scratch;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, probes.size(), 256), [&](const auto& r) {
+    std::vector<Neighbor>& nbrs = scratch.local();
+    for (std::size_t s = r.begin(); s != r.end(); ++s) {
+      index.knnSearch(points[probes[s]], options.k + 1, nbrs);
+      if (!nbrs.empty()) kth[s] = std::sqrt(nbrs.back().distSq);
+    }
+  });
+  std::vector<double> positive;
+  for (const double d : kth)
+    if (d > 0) positive.push_back(d);
+  if (positive.empty()) return result;
+  std::nth_element(positive.begin(), positive.begin() + positive.size() / 2, positive.end());
+  const double cell = options.visibilityCell * positive[positive.size() / 2];
+  if (!(cell > 0) || !std::isfinite(cell)) return result;
+  const OccupancyGrid grid(points, cell, std::size_t(1) << 27);
+  const std::size_t stride =
+      std::max<std::size_t>(1, (differing.size() + std::max<std::size_t>(maxPoints, 1) - 1) /
+                                   std::max<std::size_t>(maxPoints, 1));
+  std::vector<Index> sample;
+  for (std::size_t s = 0; s < differing.size(); s += stride) sample.push_back(differing[s]);
+  // One pair of ray fans per point serves both: its two normals point to opposite sides.
+  std::vector<std::int8_t> vote(sample.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sample.size(), 256), [&](const auto& r) {
+    for (std::size_t s = r.begin(); s != r.end(); ++s) {
+      const Vec3& p = points[sample[s]];
+      const Vec3 nrm = first[sample[s]].normalized();
+      const int out = escapingRays(grid, p, nrm), in = escapingRays(grid, p, -nrm);
+      vote[s] = out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0);
+    }
+  });
+  result.sampled = sample.size();
+  for (const std::int8_t v : vote) {
+    result.firstInward += v < 0 ? 1 : 0;
+    result.secondInward += v > 0 ? 1 : 0;
+  }
+  return result;
+}
+
 }  // namespace scalespace

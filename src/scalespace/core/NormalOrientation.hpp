@@ -98,6 +98,24 @@ struct NormalOrientationResult {
   std::vector<std::uint8_t> reliable;  // one per point, see the file comment
 };
 
+/// Two orientations of one cloud's normals compared by the visibility rays (not a step of the
+/// orientation): at the points where their signs differ (a sample of them, every stride-th, about
+/// `maxPoints`), how many of each the rays find facing inward (at least three more of the five
+/// rays of the visibility pass escape behind the normal than in front). The points where the two
+/// agree count alike for both and are not cast. Cells of
+/// NormalOrientationOptions::visibilityCell times the median distance to the k-th neighbour (over
+/// a sample of the points). The orientation with fewer inward is the one the rays contradict less.
+/// Deterministic for any thread count. Throws OptionError on size mismatches or k < 1.
+struct RayComparison {
+  std::size_t differing = 0;  // points whose two normals point to opposite sides
+  std::size_t sampled = 0;    // of those, the ones that cast rays
+  std::size_t firstInward = 0, secondInward = 0;
+};
+RayComparison compareByRays(const std::vector<Vec3>& points, const std::vector<Vec3>& first,
+                            const std::vector<Vec3>& second, const SpatialIndex& index,
+                            const NormalOrientationOptions& options = {},
+                            std::size_t maxPoints = 100000);
+
 /// Orients `normals` (one per point, modified in place) with `index` built on `points`. `valid`
 /// (empty = all valid) is e.g. NormalEstimationResult::valid. Deterministic for any thread count.
 /// Throws OptionError on size mismatches or k < 1, Cancelled if `progress` returns false (the

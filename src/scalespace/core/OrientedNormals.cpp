@@ -18,6 +18,14 @@ OrientedNormals estimateOrientedNormals(const std::vector<Vec3>& points, const S
                                     out.estimation.valid, progress);
     return out;
   }
+  // SheetSign::ByRays: the sheet normals' own tree on a copy, kept below if the rays prefer it.
+  std::vector<Vec3> ownTree;
+  NormalOrientationResult ownTreeOrientation;
+  if (options.sheetSign == SheetSign::ByRays) {
+    ownTree = out.normals;
+    ownTreeOrientation =
+        orientNormals(points, ownTree, index, options.orientation, out.estimation.valid, progress);
+  }
   out.orientation =
       orientNormals(points, planes, index, options.orientation, out.estimation.valid, progress);
   const double guess = options.orientation.creaseThreshold;
@@ -27,6 +35,15 @@ OrientedNormals estimateOrientedNormals(const std::vector<Vec3>& points, const S
     if (std::abs(c) < guess && out.orientation.reliable[i]) {
       out.orientation.reliable[i] = 0;
       ++out.orientation.unreliableCount;
+    }
+  }
+  out.signSource = SheetSign::FromPlanes;
+  if (options.sheetSign == SheetSign::ByRays) {
+    out.rays = compareByRays(points, ownTree, out.normals, index, options.orientation);
+    if (out.rays.firstInward <= out.rays.secondInward) {
+      out.normals = std::move(ownTree);
+      out.orientation = std::move(ownTreeOrientation);
+      out.signSource = SheetSign::OwnTree;
     }
   }
   return out;

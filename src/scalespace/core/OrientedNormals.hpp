@@ -22,6 +22,10 @@ namespace scalespace {
 enum class SheetSign {
   OwnTree,     // the sheet normals themselves
   FromPlanes,  // the PCA normals; each sheet normal takes its point's sign (file comment)
+  /// Both, keeping the one whose normals the visibility rays find facing inward at fewer points
+  /// (compareByRays; ties: OwnTree). Neither wins everywhere: a CAD part's thin blade keeps its
+  /// sides apart only with its own tree, a rotor's rims only with the PCA signs.
+  ByRays,
 };
 
 struct OrientedNormalsOptions {
@@ -38,6 +42,10 @@ struct OrientedNormals {
   /// Of the normals the tree ran on: with SheetSign::FromPlanes its flippedCount counts PCA
   /// normals, and `reliable` also flags the sheet normals whose sign is a guess.
   NormalOrientationResult orientation;
+  /// The sign source the normals have (with SheetSign::ByRays, the one kept), and with ByRays
+  /// the rays' comparison of the two (first: the own tree, second: the PCA signs).
+  SheetSign signSource = SheetSign::OwnTree;
+  RayComparison rays;
 };
 
 /// Estimates and orients the normals of `points` with `index` (built on the same points).

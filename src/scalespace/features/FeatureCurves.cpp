@@ -206,6 +206,13 @@ std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& p
 
 }  // namespace
 
+OrientedNormalsOptions featureNormalOptions(double sheetTolerance) {
+  OrientedNormalsOptions options;
+  options.estimation.sheetTolerance = sheetTolerance;
+  options.sheetSign = SheetSign::ByRays;
+  return options;
+}
+
 void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
   require(std::isfinite(o.spacing) && o.spacing >= 0,
           "FeatureCurveOptions::spacing must be finite and >= 0 (0 = from the cloud)");

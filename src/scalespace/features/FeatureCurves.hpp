@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"
+#include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/Progress.hpp"
 #include "scalespace/core/Types.hpp"
@@ -34,6 +35,13 @@ namespace scalespace {
 /// there do not mix both sides (bench_features: the clean CAD models' per-curve recall 0.85 ->
 /// 0.91; docs/THESIS_NOTES.md, "Feature curves").
 constexpr double kFeatureSheetNormals = 0.05;
+
+/// The normals `features` estimates for a cloud without any (CLI, Python): sheet normals of
+/// `sheetTolerance` (0: PCA), oriented by their own tree or signed by the oriented PCA normals,
+/// whichever the visibility rays find facing inward at fewer points (SheetSign::ByRays). Neither
+/// wins on every part: bench_features' clean blade (a thin part) needs the own tree (MCC 0.936
+/// against 0.695), its rotor the PCA signs (0.871 against 0.822); the rays pick both.
+OrientedNormalsOptions featureNormalOptions(double sheetTolerance = kFeatureSheetNormals);
 
 struct FeatureCurveOptions {
   /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance

@@ -394,11 +394,13 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress, double acrossWeight,
                                             bool visibility, double sheetTolerance,
-                                            std::size_t maxK, bool signFromPlanes) {
+                                            std::size_t maxK, SheetSign sheetSign) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
-  if (signFromPlanes && !(sheetTolerance > 0))
+  if (sheetSign == SheetSign::FromPlanes && !(sheetTolerance > 0))
     throw OptionError("sign_from_pca needs sheet normals (sheet > 0)");
+  if (sheetSign == SheetSign::ByRays && !(sheetTolerance > 0))
+    throw OptionError("sign_by_rays needs sheet normals (sheet > 0)");
   OrientedNormalsOptions options;
   options.estimation.k = k;
   options.estimation.maxK = maxK;
@@ -406,7 +408,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   options.orientation.k = k;
   options.orientation.acrossWeight = acrossWeight;
   options.orientation.visibility = visibility;
-  options.sheetSign = signFromPlanes ? SheetSign::FromPlanes : SheetSign::OwnTree;
+  options.sheetSign = sheetSign;
   return estimateAndOrient(cloud, options, orient, viewpoint, progress);
 }
 

@@ -149,7 +149,7 @@ std::vector<std::uint8_t> estimateAndOrient(
     double acrossWeight = NormalOrientationOptions{}.acrossWeight,
     bool visibility = NormalOrientationOptions{}.visibility,
     double sheetTolerance = NormalEstimationOptions{}.sheetTolerance,
-    std::size_t maxK = NormalEstimationOptions{}.maxK, bool signFromPlanes = false);
+    std::size_t maxK = NormalEstimationOptions{}.maxK, SheetSign sheetSign = SheetSign::OwnTree);
 
 /// Same with the estimation and orientation of `options` (e.g. cylinderNormalOptions()); `orient`
 /// and `viewpoint` as above replace its orientation method and viewpoint.

@@ -93,15 +93,18 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
                     const py::handle& viewpoint, double acrossWeight, bool visibility, double sheet,
-                    bool signFromPca, std::optional<std::size_t> maxK, std::optional<int> threads,
-                    py::object progress) {
+                    bool signFromPca, bool signByRays, std::optional<std::size_t> maxK,
+                    std::optional<int> threads, py::object progress) {
+  if (signFromPca && signByRays) throw OptionError("give one of sign_from_pca and sign_by_rays");
   PooledCloud cloud = makeCloud(asPoints(points), py::none());
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   Call call(std::move(progress), threads);
   std::vector<std::uint8_t> reliable = call([&] {
     return estimateAndOrient(cloud, k, orient, view, call.progress(), acrossWeight, visibility,
                              sheet, maxK.value_or(std::max(k, NormalEstimationOptions{}.maxK)),
-                             signFromPca);
+                             signByRays    ? SheetSign::ByRays
+                             : signFromPca ? SheetSign::FromPlanes
+                                           : SheetSign::OwnTree);
   });
   py::array_t<bool> reliableArray(py::ssize_t(reliable.size()));
   for (std::size_t i = 0; i < reliable.size(); ++i) reliableArray.mutable_data()[i] = reliable[i];
@@ -282,7 +285,8 @@ void bindClouds(py::module_& m) {
         "viewpoint"_a = py::none(), "across_weight"_a = NormalOrientationOptions{}.acrossWeight,
         "visibility"_a = NormalOrientationOptions{}.visibility,
         "sheet"_a = NormalEstimationOptions{}.sheetTolerance, "sign_from_pca"_a = false,
-        "max_k"_a = py::none(), "threads"_a = py::none(), "progress"_a = py::none(),
+        "sign_by_rays"_a = false, "max_k"_a = py::none(), "threads"_a = py::none(),
+        "progress"_a = py::none(),
         R"doc(Estimates (PCA over k neighbours) and orients normals, as `scalespace normals`.
 
 max_k: under noise comparable to the sampling, k doubles up to max_k (default 80) while the
@@ -300,7 +304,9 @@ k-th neighbour's distance (or 8 noise RMS) of, refitted to them, instead of the 
 side's plane at a crease or on a part thinner than the sampling (0: PCA; features uses 0.05).
 sign_from_pca (with sheet): orient the PCA normals and give each sheet normal its point's sign;
 where two surfaces touch (the strands of a cable) the sheet normals' own tree can turn one inside
-out (cylinders does this).
+out (cylinders does this). sign_by_rays (with sheet): orient both ways (the sheet normals' own tree,
+the PCA signs) and keep the one the visibility rays find facing inward less often (features does
+this).
 Returns (normals (N, 3) float64, reliable (N,) bool: False where the orientation is a guess).)doc");
   m.def("curvature", &curvaturePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scale_k"_a = py::none(), "estimator"_a = "w3", "mls"_a = false,

@@ -179,9 +179,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   FeatureCurveResult result = call([&] {
     if (!mesh) {
       if (!cloud.hasNormals())
-        estimateAndOrient(cloud, 10, "mst", view, call.progress(),
-                          NormalOrientationOptions{}.acrossWeight,
-                          NormalOrientationOptions{}.visibility, sheetNormals);
+        estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress());
       return detectFeatureCurves(cloud, options, call.progress());
     }
     MeshFeatureCurves onMesh =
