@@ -214,6 +214,10 @@ int escapingRays(const OccupancyGrid& grid, const Vec3& p, const Vec3& unitNorma
   return count;
 }
 
+/// A point's vote on its normal from the rays escaping in front (`out`) and behind (`in`): +1
+/// when at least three more escape in front, -1 the other way round, else 0.
+std::int8_t voteOf(int out, int in) { return out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0); }
+
 /// Each graph edge that agrees with a piece's sign outweighs two of the rays' votes against it.
 /// Measured on libcgal-demo's points_3 (bench/README.md, "visibility"): with 1, the floor of
 /// building.ply, under its roof and open below, is turned down (its points against the file's
@@ -274,7 +278,7 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                         const Vec3 nrm = oriented[i].normalized();
                         const int out = escapingRays(grid, points[i], nrm);
                         const int in = escapingRays(grid, points[i], -nrm);
-                        vote[i] = out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0);
+                        vote[i] = voteOf(out, in);
                         openBoth[i] = out >= 3 && in >= 3 ? 1 : 0;
                       }
                       tracker.advance(range.size());
@@ -779,9 +783,8 @@ RayComparison compareByRays(const std::vector<Vec3>& points, const std::vector<V
   const double cell = options.visibilityCell * positive[positive.size() / 2];
   if (!(cell > 0) || !std::isfinite(cell)) return result;
   const OccupancyGrid grid(points, cell, std::size_t(1) << 27);
-  const std::size_t stride =
-      std::max<std::size_t>(1, (differing.size() + std::max<std::size_t>(maxPoints, 1) - 1) /
-                                   std::max<std::size_t>(maxPoints, 1));
+  const std::size_t cap = std::max<std::size_t>(maxPoints, 1);
+  const std::size_t stride = (differing.size() + cap - 1) / cap;
   std::vector<Index> sample;
   for (std::size_t s = 0; s < differing.size(); s += stride) sample.push_back(differing[s]);
   // One pair of ray fans per point serves both: its two normals point to opposite sides.
@@ -790,8 +793,7 @@ RayComparison compareByRays(const std::vector<Vec3>& points, const std::vector<V
     for (std::size_t s = r.begin(); s != r.end(); ++s) {
       const Vec3& p = points[sample[s]];
       const Vec3 nrm = first[sample[s]].normalized();
-      const int out = escapingRays(grid, p, nrm), in = escapingRays(grid, p, -nrm);
-      vote[s] = out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0);
+      vote[s] = voteOf(escapingRays(grid, p, nrm), escapingRays(grid, p, -nrm));
     }
   });
   result.sampled = sample.size();
