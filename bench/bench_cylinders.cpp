@@ -18,6 +18,10 @@
 //                   [--normal-k K] (with --estimate-normals: K neighbours, fixed; default: 10,
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
+//                   [--noisy-only] (the scans with noise 1e-3 alone)
+//                   [--no-split] (ours: TubeSplitOptions::enabled off, Eq. 3.10's regions as
+//                   grown) [--split-cell F] [--split-density F] [--split-steps N]
+//                   (TubeSplitOptions::cellFactor, minDensity, densitySteps)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -334,7 +338,7 @@ void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k,
 
 int main(int argc, char** argv) {
   std::size_t points = 1000000;
-  bool peers = true, cleanOnly = false, estimate = false, pcaNormals = false;
+  bool peers = true, cleanOnly = false, noisyOnly = false, estimate = false, pcaNormals = false;
   std::size_t normalK = 0;  // NormalEstimationOptions' defaults
   std::string only;         // "full" or "one-sided": that scan alone
   CylinderOptions ours;
@@ -349,6 +353,16 @@ int main(int argc, char** argv) {
       peers = false;
     else if (a == "--clean-only")
       cleanOnly = true;
+    else if (a == "--noisy-only")
+      noisyOnly = true;
+    else if (a == "--no-split")
+      ours.split.enabled = false;
+    else if (a == "--split-cell" && i + 1 < argc)
+      ours.split.cellFactor = std::stod(argv[++i]);
+    else if (a == "--split-density" && i + 1 < argc)
+      ours.split.minDensity = std::stod(argv[++i]);
+    else if (a == "--split-steps" && i + 1 < argc)
+      ours.split.densitySteps = std::stoi(argv[++i]);
     else if (a == "--scan" && i + 1 < argc)
       only = argv[++i];
     else if (a == "--scales" && i + 1 < argc)
@@ -371,10 +385,11 @@ int main(int argc, char** argv) {
       normalK = std::stoul(argv[++i]);
     else {
       std::fprintf(stderr,
-                   "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] "
+                   "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
                    "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
                    "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
-                   "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS]\n");
+                   "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS] "
+                   "[--no-split] [--split-cell F] [--split-density F] [--split-steps N]\n");
       return 2;
     }
   }
@@ -383,7 +398,8 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<Score>> totals;
   for (const bool oneSided : {false, true})
     for (const double noise : {0.0, 1e-3}) {
-      if ((cleanOnly && noise > 0) || (!only.empty() && only != (oneSided ? "one-sided" : "full")))
+      if ((cleanOnly && noise > 0) || (noisyOnly && noise == 0) ||
+          (!only.empty() && only != (oneSided ? "one-sided" : "full")))
         continue;
       PipeSceneOptions options;
       options.pointCount = points;

@@ -164,6 +164,9 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_flag("--one-curvature-sign", args->cylinders.oneCurvatureSign,
                 "a region only grows over points curving the way its seed does, which stops it at "
                 "the groove between a noisy cable's strands; needs consistently oriented normals");
+  cmd->add_flag("!--no-axis-split", args->cylinders.split.enabled,
+                "do not split a region whose points' curvature reads tubes thinner than its own "
+                "by the axes they propose (the strands of a noisy cable grown into one region)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");

@@ -16,6 +16,7 @@
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/features/LineAnisotropy.hpp"
 #include "scalespace/features/TubeMerging.hpp"
+#include "scalespace/features/TubeSplitting.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
 namespace scalespace {
@@ -94,6 +95,37 @@ void extendTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
     }
     std::sort(regions[r].begin(), regions[r].end());
     tube.pointCount = regions[r].size();
+  }
+}
+
+/// Each region that splits into tubes thinner than its own (features/TubeSplitting) gives its
+/// points to those tubes, appended after the regions (TubeRejection::Split; the points of no tube
+/// are left free, for extendTubes). `splitFrom` gets, per region, the region it was split from (-1:
+/// none). Tried on the tubes as well as the rough regions: the strands grown into one region at a
+/// scale where each is a tube can, fitted as one tube of the cable's radius, pass the RMS test.
+void splitRegionsByAxes(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                        const LineAnisotropyField& field, double t, const CylinderOptions& options,
+                        std::vector<TubeFit>& tubes, std::vector<std::vector<Index>>& regions,
+                        std::vector<int>& splitFrom) {
+  const std::size_t count = regions.size();
+  splitFrom.assign(count, -1);
+  std::vector<std::vector<ThinTube>> parts(count);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const auto& range) {
+    for (std::size_t r = range.begin(); r != range.end(); ++r) {
+      if (!options.split.enabled) continue;
+      parts[r] = splitIntoThinnerTubes(positions, normals, field.normal, field.kappa1, regions[r],
+                                       tubes[r], t, options.tube, options.split);
+    }
+  });
+  for (std::size_t r = 0; r < count; ++r) {
+    if (parts[r].empty()) continue;
+    tubes[r].rejection = TubeRejection::Split;
+    regions[r].clear();
+    for (ThinTube& part : parts[r]) {
+      regions.push_back(std::move(part.points));
+      tubes.push_back(std::move(part.tube));
+      splitFrom.push_back(int(r));
+    }
   }
 }
 
@@ -177,6 +209,7 @@ void validateCylinderOptions(const CylinderOptions& options) {
   require(options.maxGapLevels >= 0, "CylinderOptions::maxGapLevels must be >= 0");
   validateLineFilterOptions(options.filter);
   validateTubeFitOptions(options.tube);
+  validateTubeSplitOptions(options.split);
   require(std::isfinite(options.coverage.rmsFactor) && options.coverage.rmsFactor >= 0,
           "TubeCoverageOptions::rmsFactor must be finite and >= 0");
   require(std::isfinite(options.coverage.radiusFraction) && options.coverage.radiusFraction >= 0,
@@ -238,15 +271,18 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
                           tubes[r] = fitTube(positions, cloud.normals(), field.normal, field.kappa1,
                                              seg.regions[r], t, options.tube);
                       });
+    std::vector<int> splitFrom;
+    splitRegionsByAxes(positions, cloud.normals(), field, t, options, tubes, seg.regions,
+                       splitFrom);
     mergeTouchingTubes(graph, positions, cloud.normals(), field, t, options.tube, tubes,
-                       seg.regions);
+                       seg.regions, splitFrom);
     extendTubes(graph, positions, cloud.normals(), tubes, seg.regions, options.coverage);
     CylinderLevel level;
     level.scale = t;
     level.lines = lines.lines.size();
     level.regularLines = regular.size();
     level.regions = seg.regions.size();
-    level.rejections.assign(std::size_t(TubeRejection::Merged) + 1, 0);
+    level.rejections.assign(std::size_t(TubeRejection::Split) + 1, 0);
     for (const TubeFit& tube : tubes)
       if (!tube.isTube()) ++level.rejections[std::size_t(tube.rejection)];
     RegionLevel regionLevel;

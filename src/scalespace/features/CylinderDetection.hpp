@@ -11,8 +11,11 @@
 //      (optionally, not in the thesis, only over points curving as the seed does:
 //      oneCurvatureSign);
 //   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped;
-//   5. (not in the thesis) touching tubes whose union is still a tube merge, and each tube takes
-//      the free points lying on it next to it (TubeCoverageOptions).
+//   5. (not in the thesis) a region whose points' curvature reads tubes thinner than its own is
+//      split by the axes they propose into those tubes (features/TubeSplitting: a noisy cable's
+//      strands grown into one region), touching tubes whose union is still a tube merge (the
+//      parts of one split region excepted), and each tube takes the free points lying on it next
+//      to it (TubeCoverageOptions).
 // Then, as the planes of Ch. 2, the tubes of consecutive scales with Jaccard index > 0.5 are
 // linked into components with a birth and a death scale (core/RegionGraph).
 #include <vector>
@@ -24,6 +27,7 @@
 #include "scalespace/features/CurvatureLines.hpp"
 #include "scalespace/features/LineRegularity.hpp"
 #include "scalespace/features/TubeFit.hpp"
+#include "scalespace/features/TubeSplitting.hpp"
 
 namespace scalespace {
 
@@ -65,6 +69,9 @@ struct CylinderOptions {
   double minAnisotropy = 0.5;  // sigma of a region's points
   int graphNeighbors = 10;     // k of the k-NN graph (Sec. 2.3.1's 10)
   TubeFitOptions tube;
+  /// (Not in the thesis.) A rough region is split by the axes its points propose: the strands of
+  /// a noisy cable that Eq. 3.10 grew into one region across their contacts.
+  TubeSplitOptions split;
   TubeCoverageOptions coverage;
   double minJaccard = 0.5;  // Sec. 2.3.2
   /// A component bridges up to this many levels where its tube was not found (core/RegionGraph):
@@ -88,7 +95,7 @@ void validateCylinderOptions(const CylinderOptions& options);
 
 struct CylinderLevel {
   double scale = 0;
-  std::size_t lines = 0, regularLines = 0, regions = 0;
+  std::size_t lines = 0, regularLines = 0, regions = 0;  // regions: grown, and split parts
   /// How many regions each test of the tube fit turned down, indexed by TubeRejection.
   std::vector<std::size_t> rejections;
   /// The tubes of this level, same order as the graph's regions at this level.

@@ -504,6 +504,8 @@ const char* tubeRejectionName(TubeRejection rejection) {
       return "faceted";
     case TubeRejection::Merged:
       return "merged";
+    case TubeRejection::Split:
+      return "split";
   }
   return "?";
 }

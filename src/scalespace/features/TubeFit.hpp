@@ -66,7 +66,8 @@ struct TubeFitOptions {
 };
 
 /// Why a region is no tube (None: it is one; Merged: it joined a touching tube,
-/// features/CylinderDetection). Merged is the last.
+/// features/TubeMerging; Split: a rough region whose points went to the tubes of the axes they
+/// propose, features/TubeSplitting). Split is the last.
 enum class TubeRejection : std::uint8_t {
   None,
   TooSmall,
@@ -75,7 +76,8 @@ enum class TubeRejection : std::uint8_t {
   Thin,
   Rough,
   Faceted,
-  Merged
+  Merged,
+  Split
 };
 const char* tubeRejectionName(TubeRejection rejection);
 

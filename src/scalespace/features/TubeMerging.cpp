@@ -20,7 +20,7 @@ std::vector<int> tubeOwners(std::size_t pointCount, const std::vector<TubeFit>& 
 void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
                         const std::vector<Vec3>& normals, const LineAnisotropyField& field,
                         double t, const TubeFitOptions& options, std::vector<TubeFit>& tubes,
-                        std::vector<std::vector<Index>>& regions) {
+                        std::vector<std::vector<Index>>& regions, const std::vector<int>& apart) {
   const std::vector<int> owner = tubeOwners(positions.size(), tubes, regions);
   std::map<std::pair<int, int>, std::size_t> edges;
   for (std::size_t p = 0; p < positions.size(); ++p) {
@@ -37,6 +37,15 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
   });
   std::vector<int> root(regions.size());
   for (std::size_t r = 0; r < root.size(); ++r) root[r] = int(r);
+  // The groups each merged set holds (a set inherits its members' groups).
+  std::vector<std::vector<int>> groups(regions.size());
+  for (std::size_t r = 0; r < apart.size() && r < groups.size(); ++r)
+    if (apart[r] >= 0) groups[r].push_back(apart[r]);
+  const auto share = [](const std::vector<int>& x, const std::vector<int>& y) {
+    for (const int g : x)
+      if (std::find(y.begin(), y.end(), g) != y.end()) return true;
+    return false;
+  };
   auto find = [&](int r) {
     while (root[std::size_t(r)] != r)
       r = root[std::size_t(r)] = root[std::size_t(root[std::size_t(r)])];
@@ -44,7 +53,7 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
   };
   for (const auto& [count, ab] : pairs) {
     const int a = find(ab.first), b = find(ab.second);
-    if (a == b) continue;
+    if (a == b || share(groups[std::size_t(a)], groups[std::size_t(b)])) continue;
     const TubeFit &ta = tubes[std::size_t(a)], &tb = tubes[std::size_t(b)];
     const double big = std::max(ta.radius, tb.radius);
     if (std::abs(ta.radius - tb.radius) > 0.25 * big) continue;
@@ -59,6 +68,9 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
     root[std::size_t(gone)] = keep;
     regions[std::size_t(keep)] = std::move(both);
     regions[std::size_t(gone)].clear();
+    groups[std::size_t(keep)].insert(groups[std::size_t(keep)].end(),
+                                     groups[std::size_t(gone)].begin(),
+                                     groups[std::size_t(gone)].end());
     tubes[std::size_t(keep)] = std::move(merged);
     tubes[std::size_t(gone)].rejection = TubeRejection::Merged;
   }

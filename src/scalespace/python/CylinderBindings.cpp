@@ -148,8 +148,9 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
                                        const std::optional<std::vector<double>>& scales,
                                        int scaleCount, double tmin, double tmax, double epsilon,
                                        double minAnisotropy, double minArc, double minSectorFill,
-                                       double maxRms, bool oneCurvatureSign, int maxGap,
-                                       std::optional<int> threads, py::object progress) {
+                                       double maxRms, bool oneCurvatureSign, bool splitByAxes,
+                                       int maxGap, std::optional<int> threads,
+                                       py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -162,6 +163,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.tube.minSectorFill = minSectorFill;
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
+  options.split.enabled = splitByAxes;
   options.maxGapLevels = maxGap;
   validateCylinderOptions(options);
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
@@ -229,6 +231,7 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "min_arc"_a = TubeFitOptions{}.minArcDegrees,
         "min_sector_fill"_a = TubeFitOptions{}.minSectorFill, "max_rms"_a = 0.25,
         "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
+        "split_by_axes"_a = TubeSplitOptions{}.enabled,
         "max_gap"_a = CylinderOptions{}.maxGapLevels, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
@@ -242,7 +245,9 @@ the points' normals must turn around the axis; min_sector_fill: the share of the
 sectors of that arc the normals must fill (a box edge rounded into a tube fills about half); max_rms: a tube's RMS distance to its surface
 over its radius. one_curvature_sign: a region only grows over points curving the way its seed
 does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
-normals; off: Eq. 3.10 alone). max_gap: a component bridges up to this many levels where its
+normals; off: Eq. 3.10 alone). split_by_axes: a region whose points' curvature reads tubes
+thinner than its own is split by the axes they propose (x - n / kappa1) into those tubes: the
+strands of a noisy cable grown into one region across their contacts. max_gap: a component bridges up to this many levels where its
 tube was not found (0: consecutive levels only, as the thesis). Without
 normals they are estimated (sheet planes, 10 neighbours) and oriented (MST of the PCA normals), as
 the CLI does. Returns a Cylinders.)doc");
