@@ -21,7 +21,8 @@
 //                   [--noisy-only] (the scans with noise 1e-3 alone)
 //                   [--no-split] (ours: TubeSplitOptions::enabled off, Eq. 3.10's regions as
 //                   grown) [--split-cell F] [--split-density F] [--split-steps N]
-//                   (TubeSplitOptions::cellFactor, minDensity, densitySteps)
+//                   [--split-link F] (TubeSplitOptions::cellFactor, minDensity, densitySteps,
+//                   linkRadius)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -361,6 +362,8 @@ int main(int argc, char** argv) {
       ours.split.cellFactor = std::stod(argv[++i]);
     else if (a == "--split-density" && i + 1 < argc)
       ours.split.minDensity = std::stod(argv[++i]);
+    else if (a == "--split-link" && i + 1 < argc)
+      ours.split.linkRadius = std::stod(argv[++i]);
     else if (a == "--split-steps" && i + 1 < argc)
       ours.split.densitySteps = std::stoi(argv[++i]);
     else if (a == "--scan" && i + 1 < argc)
@@ -384,12 +387,13 @@ int main(int argc, char** argv) {
     else if (a == "--normal-k" && i + 1 < argc)
       normalK = std::stoul(argv[++i]);
     else {
-      std::fprintf(stderr,
-                   "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
-                   "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
-                   "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
-                   "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS] "
-                   "[--no-split] [--split-cell F] [--split-density F] [--split-steps N]\n");
+      std::fprintf(
+          stderr,
+          "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
+          "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
+          "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
+          "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS] "
+          "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F]\n");
       return 2;
     }
   }

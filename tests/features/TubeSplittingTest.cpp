@@ -25,7 +25,8 @@ struct Scene {
 /// touch, as a cable's do). A point within `contact` of another strand gets what a fit spanning
 /// both reads: a curvature radius between r and 3 r and its normal turned by up to 30 degrees,
 /// so that it proposes an axis point anywhere between the strands.
-Scene cable(double r, double contact, std::size_t perStrand, std::mt19937_64& rng) {
+Scene cable(double r, double contact, std::size_t perStrand, std::mt19937_64& rng,
+            double blurHalfLength = 0) {
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Vec3> axes;
   for (int k = 0; k < 3; ++k) {
@@ -45,7 +46,8 @@ Scene cable(double r, double contact, std::size_t perStrand, std::mt19937_64& rn
       ++n;
       Vec3 readNormal = normal;
       double radius = r;
-      if (gap < contact) {
+      // Strand 0 may also read its curvature as badly as a contact over |x| < blurHalfLength.
+      if (gap < contact || (k == 0 && std::abs(x) < blurHalfLength)) {
         const double turn = (2 * u(rng) - 1) * kPi / 6;
         readNormal = Eigen::AngleAxisd(turn, Vec3::UnitX()) * normal;
         radius = r * (1 + 2 * u(rng));
@@ -163,6 +165,25 @@ TEST(TubeSplitting, ACableFittedAsOneTubeSplitsIntoItsStrands) {
   EXPECT_TRUE(splitIntoThinnerTubes(s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t,
                                     {}, options)
                   .empty());
+}
+
+TEST(TubeSplitting, AStrandCutAcrossByTheDensityLevelsIsJoinedAgain) {
+  // Strand 0 reads its curvature as badly as a contact over a stretch of 2 r: its proposals thin
+  // out there, and the density levels cut it in two pieces end to end, which are joined again.
+  std::mt19937_64 rng(6);
+  const double r = 0.05, t = 0.04;
+  const Scene s = cable(r, 0.6 * r, 6000, rng, r);
+  EXPECT_EQ(splitByProposedAxes(s.positions, s.normals, s.kappa1, all(s), t, 0.02, 30).size(), 4u);
+  const TubeFit whole = fitTube(s.positions, s.normals, s.normals, s.kappa1, all(s), t);
+  TubeSplitOptions options;
+  options.maxRadiusRatio = 0.75;
+  const std::vector<ThinTube> strands = splitIntoThinnerTubes(
+      s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t, {}, options);
+  ASSERT_EQ(strands.size(), 3u);
+  for (const ThinTube& strand : strands) {
+    EXPECT_NEAR(strand.tube.radius, r, 0.05 * r);
+    EXPECT_GT(strand.tube.length, 1.8);  // the whole strand, x in [-1, 1]
+  }
 }
 
 TEST(TubeSplitting, OptionsAreChecked) {

@@ -617,4 +617,18 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   return fit;
 }
 
+double shareBeside(const TubeFit& a, const TubeFit& b) {
+  if (a.axis.size() < 2 || b.axis.empty()) return 0;
+  const AxisLocator locator(a.axis);
+  const double reach = 3 * std::max(a.radius, b.radius);
+  std::size_t beside = 0;
+  for (const Vec3& v : b.axis) {
+    const AxisLocator::Projection q = locator.project(v);
+    const bool end =
+        (q.segment == 0 && q.along <= 0) || (q.segment + 2 == a.axis.size() && q.along >= 1);
+    beside += !end && q.distance <= reach;
+  }
+  return double(beside) / double(b.axis.size());
+}
+
 }  // namespace scalespace

@@ -137,6 +137,11 @@ class TubeSurface {
   AxisLocator locator_;
 };
 
+/// The share of b's axis vertices that lie beside a's axis: their nearest point on it is not one
+/// of its ends, within 3 radii (the larger tube's). Two strands side by side: about 1 both ways;
+/// two pieces of one tube end to end: about 0.
+double shareBeside(const TubeFit& a, const TubeFit& b);
+
 /// OptionError naming the field unless every option is finite and in range.
 void validateTubeFitOptions(const TubeFitOptions& options);
 

@@ -53,8 +53,13 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
   };
   for (const auto& [count, ab] : pairs) {
     const int a = find(ab.first), b = find(ab.second);
-    if (a == b || share(groups[std::size_t(a)], groups[std::size_t(b)])) continue;
+    if (a == b) continue;
     const TubeFit &ta = tubes[std::size_t(a)], &tb = tubes[std::size_t(b)];
+    // Parts of one split region side by side are the strands it was split into; end to end, two
+    // pieces of one strand that the split's density levels cut.
+    if (share(groups[std::size_t(a)], groups[std::size_t(b)]) &&
+        std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5)
+      continue;
     const double big = std::max(ta.radius, tb.radius);
     if (std::abs(ta.radius - tb.radius) > 0.25 * big) continue;
     std::vector<Index> both;

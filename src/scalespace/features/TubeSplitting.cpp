@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
@@ -13,6 +14,7 @@
 #include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/scales/ScaleSeries.hpp"
 
 namespace scalespace {
 
@@ -23,12 +25,10 @@ using CellKey = std::array<std::int64_t, 3>;
 /// The median curvature radius 1 / |kappa1| of the points curved enough to read one (0: none).
 double medianCurvatureRadius(const std::vector<float>& kappa1, const std::vector<Index>& points,
                              double t, double minCurvatureFactor) {
-  std::vector<float> radii;
+  std::vector<double> radii;
   for (const Index i : points)
     if (std::abs(kappa1[i]) * t >= minCurvatureFactor) radii.push_back(1 / std::abs(kappa1[i]));
-  if (radii.empty()) return 0;
-  std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(radii.size() / 2), radii.end());
-  return radii[radii.size() / 2];
+  return radii.empty() ? 0 : lowerMedian(std::move(radii));
 }
 
 /// The parts of `points` split by their axes, part by part while a part's curvature sees tubes
@@ -100,8 +100,7 @@ std::vector<std::vector<Index>> splitByProposedAxes(
     radii.push_back(1 / std::abs(k));
   }
   if (proposals.size() < 2 * std::max<std::size_t>(minPoints, 1)) return {};
-  std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(radii.size() / 2), radii.end());
-  const double h = options.cellFactor * radii[radii.size() / 2];
+  const double h = options.cellFactor * lowerMedian(std::move(radii));
   // Cells anchored at the proposals' lower corner: a grid fixed in space would cut a translated
   // region differently. Proposals spread over more than 10^9 cells (curvature radii far below the
   // region's size) cannot be counted: no split.
@@ -227,6 +226,26 @@ std::vector<ThinTube> splitIntoThinnerTubes(const std::vector<Vec3>& positions,
       covered += part.points.size();
       kept.push_back(std::move(part));
     }
+  // The density levels can cut one strand across where its proposals thin out: parts of the same
+  // radius (25%) end to end, not beside one another, whose union is still a tube are one part.
+  for (bool joined = true; joined;) {
+    joined = false;
+    for (std::size_t a = 0; a < kept.size() && !joined; ++a)
+      for (std::size_t b = a + 1; b < kept.size() && !joined; ++b) {
+        const TubeFit &ta = kept[a].tube, &tb = kept[b].tube;
+        if (std::abs(ta.radius - tb.radius) > 0.25 * std::max(ta.radius, tb.radius) ||
+            std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5)
+          continue;
+        std::vector<Index> both;
+        std::merge(kept[a].points.begin(), kept[a].points.end(), kept[b].points.begin(),
+                   kept[b].points.end(), std::back_inserter(both));
+        TubeFit fit = fitTube(positions, normals, scaleNormals, kappa1, both, t, tube);
+        if (!fit.isTube() || !(fit.radius < options.maxRadiusRatio * whole.radius)) continue;
+        kept[a] = {std::move(both), std::move(fit)};
+        kept.erase(kept.begin() + std::ptrdiff_t(b));
+        joined = true;
+      }
+  }
   if (kept.size() < 2 || 2 * covered < points.size()) return {};
   return kept;
 }
