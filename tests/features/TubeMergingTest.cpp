@@ -38,8 +38,9 @@ struct Merged {
   std::vector<std::vector<Index>> regions;
 };
 
-/// One region per part, a tube fitted to each, then the merge.
-Merged fitAndMerge(const Scene& s, int parts, double t) {
+/// One region per part, a tube fitted to each, then the merge (`groups`: mergeTouchingTubes'
+/// `apart`).
+Merged fitAndMerge(const Scene& s, int parts, double t, const std::vector<int>& groups = {}) {
   LineAnisotropyField field;
   field.scale = t;
   field.normal = s.normals;
@@ -53,7 +54,7 @@ Merged fitAndMerge(const Scene& s, int parts, double t) {
   for (const TubeFit& tube : m.tubes)
     EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
   const KnnGraph graph = buildKnnGraph(s.positions, 10);
-  mergeTouchingTubes(graph, s.positions, s.normals, field, t, {}, m.tubes, m.regions);
+  mergeTouchingTubes(graph, s.positions, s.normals, field, t, {}, m.tubes, m.regions, groups);
   return m;
 }
 
@@ -100,27 +101,12 @@ TEST(TubeMerging, PiecesOfOneSplitRegionEndToEndMerge) {
   // they are pieces of one strand and merge. (Side by side, strands, they stay apart even where a
   // curved axis zigzagging between them lets their union pass as one tube: seen on the noisy pipe
   // rack, bench_cylinders, not built here.)
-  auto run = [](const Scene& s, int parts, const std::vector<int>& groups) {
-    LineAnisotropyField field;
-    field.scale = 0.03;
-    field.normal = s.normals;
-    field.kappa1 = s.kappa1;
-    Merged m;
-    m.regions.resize(std::size_t(parts));
-    for (std::size_t i = 0; i < s.part.size(); ++i)
-      m.regions[std::size_t(s.part[i])].push_back(Index(i));
-    for (const auto& region : m.regions)
-      m.tubes.push_back(fitTube(s.positions, s.normals, field.normal, field.kappa1, region, 0.03));
-    const KnnGraph graph = buildKnnGraph(s.positions, 10);
-    mergeTouchingTubes(graph, s.positions, s.normals, field, 0.03, {}, m.tubes, m.regions, groups);
-    return m;
-  };
   std::mt19937_64 rng(5);
   Scene ends;  // three pieces of one pipe, end to end; the first two of one split
   addTube(ends, Vec3::Zero(), 0.1, -0.6, 0.0, 0, 4000, rng);
   addTube(ends, Vec3::Zero(), 0.1, 0.0, 0.6, 1, 4000, rng);
   addTube(ends, Vec3::Zero(), 0.1, 0.6, 1.2, 2, 4000, rng);
-  const Merged a = run(ends, 3, {7, 7, -1});
+  const Merged a = fitAndMerge(ends, 3, 0.03, {7, 7, -1});
   EXPECT_TRUE(a.tubes[0].isTube());
   EXPECT_EQ(a.regions[0].size(), 12000u);
   EXPECT_EQ(a.tubes[1].rejection, TubeRejection::Merged);

@@ -66,6 +66,14 @@ std::vector<Index> all(const Scene& s) {
   return points;
 }
 
+/// splitIntoThinnerTubes on the whole cloud fitted as one tube at scale t, the input normals
+/// taken as the scale's.
+std::vector<ThinTube> splitCable(const Scene& s, double t, const TubeSplitOptions& options) {
+  const TubeFit whole = fitTube(s.positions, s.normals, s.normals, s.kappa1, all(s), t);
+  return splitIntoThinnerTubes(s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t, {},
+                               options);
+}
+
 }  // namespace
 
 TEST(TubeSplitting, ACablesStrandsComeApartOnePartEach) {
@@ -149,8 +157,7 @@ TEST(TubeSplitting, ACableFittedAsOneTubeSplitsIntoItsStrands) {
   EXPECT_GT(whole.radius, 1.4 * r);
   TubeSplitOptions options;
   options.maxRadiusRatio = 0.75;
-  const std::vector<ThinTube> strands = splitIntoThinnerTubes(
-      s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t, {}, options);
+  const std::vector<ThinTube> strands = splitCable(s, t, options);
   ASSERT_EQ(strands.size(), 3u);
   for (const ThinTube& strand : strands) {
     EXPECT_TRUE(strand.tube.isTube());
@@ -158,13 +165,9 @@ TEST(TubeSplitting, ACableFittedAsOneTubeSplitsIntoItsStrands) {
     EXPECT_TRUE(strand.tube.straight);
   }
   // At the default 0.6 the tube is not thick enough to hold thinner ones.
-  EXPECT_TRUE(
-      splitIntoThinnerTubes(s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t, {})
-          .empty());
+  EXPECT_TRUE(splitCable(s, t, {}).empty());
   options.enabled = false;
-  EXPECT_TRUE(splitIntoThinnerTubes(s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t,
-                                    {}, options)
-                  .empty());
+  EXPECT_TRUE(splitCable(s, t, options).empty());
 }
 
 TEST(TubeSplitting, AStrandCutAcrossByTheDensityLevelsIsJoinedAgain) {
@@ -174,11 +177,9 @@ TEST(TubeSplitting, AStrandCutAcrossByTheDensityLevelsIsJoinedAgain) {
   const double r = 0.05, t = 0.04;
   const Scene s = cable(r, 0.6 * r, 6000, rng, r);
   EXPECT_EQ(splitByProposedAxes(s.positions, s.normals, s.kappa1, all(s), t, 0.02, 30).size(), 4u);
-  const TubeFit whole = fitTube(s.positions, s.normals, s.normals, s.kappa1, all(s), t);
   TubeSplitOptions options;
   options.maxRadiusRatio = 0.75;
-  const std::vector<ThinTube> strands = splitIntoThinnerTubes(
-      s.positions, s.normals, s.normals, s.kappa1, all(s), whole, t, {}, options);
+  const std::vector<ThinTube> strands = splitCable(s, t, options);
   ASSERT_EQ(strands.size(), 3u);
   for (const ThinTube& strand : strands) {
     EXPECT_NEAR(strand.tube.radius, r, 0.05 * r);

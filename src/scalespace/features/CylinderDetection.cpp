@@ -111,11 +111,9 @@ void splitRegionsByAxes(const std::vector<Vec3>& positions, const std::vector<Ve
   splitFrom.assign(count, -1);
   std::vector<std::vector<ThinTube>> parts(count);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const auto& range) {
-    for (std::size_t r = range.begin(); r != range.end(); ++r) {
-      if (!options.split.enabled) continue;
+    for (std::size_t r = range.begin(); r != range.end(); ++r)
       parts[r] = splitIntoThinnerTubes(positions, normals, field.normal, field.kappa1, regions[r],
                                        tubes[r], t, options.tube, options.split);
-    }
   });
   for (std::size_t r = 0; r < count; ++r) {
     if (parts[r].empty()) continue;

@@ -19,8 +19,8 @@ struct TubeSplitOptions {
   /// The proposals are counted in cells of cellFactor x the region's median curvature radius
   /// (1 / |kappa1|), and a cell's density is the count over it and its 26 neighbours: at 0.2 the
   /// density reads 0.6 radius across, and the axes of two touching strands, two radii apart, stay
-  /// apart. bench_cylinders (noisy full scan, estimated normals): 3 of 3 strands from 0.15 to
-  /// 0.25, 1 at 0.3, none at 0.4 (the contacts' proposals fill the space between the axes).
+  /// apart; coarser cells let the contacts' proposals fill the space between the axes
+  /// (docs/THESIS_NOTES.md, "Regions split by the axes their points propose").
   double cellFactor = 0.2;
   /// The density levels tried: minDensity, 2 minDensity, ... up to densitySteps x minDensity,
   /// in units of the density of the cell that holds the median proposal (cells by decreasing
