@@ -15,11 +15,15 @@
 //                  [--own-tree-sign] (SheetSign::OwnTree: the sheet normals' own tree; the
 //                  default is `features`' SheetSign::ByRays: both, the one the rays find facing
 //                  inward at fewer points kept)
+//                  [--reflect | --no-reflect] (NormalOrientationOptions::reflectAcrossBisector;
+//                  default: featureNormalOptions()')
 //                  (NormalOrientationOptions::acrossWeight and ::visibility of the estimated
 //                  normals)
 //                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
+//                  [--crease-reach X (0: off)] [--crease-half-width X] [--crease-flatness X]
+//                  (FeatureCurveOptions::creaseReach, creaseHalfWidth, creaseFlatness)
 //                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
 //                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
 //                  collisionFraction, beta, borderOffset, minCurvatureGap)
@@ -474,6 +478,8 @@ std::vector<int> featureCurveOfPoints(const std::vector<Vec3>& positions, const 
 double acrossWeight = NormalOrientationOptions{}.acrossWeight;  // --across-weight
 double sheetNormals = 0.05;  // --sheet-normals, as `scalespace features` (kFeatureSheetNormals)
 bool visibility = NormalOrientationOptions{}.visibility;  // --no-visibility
+// --reflect / --no-reflect (NormalOrientationOptions::reflectAcrossBisector)
+bool reflect = featureNormalOptions().orientation.reflectAcrossBisector;
 // As `features` (featureNormalOptions(): ByRays); --sign-from-pca: FromPlanes; --own-tree-sign:
 // OwnTree (before 2026-11-30).
 SheetSign sheetSign = featureNormalOptions().sheetSign;
@@ -486,6 +492,7 @@ void estimateSceneNormals(PointCloud& cloud) {
   OrientedNormalsOptions options = featureNormalOptions(sheetNormals);
   options.orientation.acrossWeight = acrossWeight;
   options.orientation.visibility = visibility;
+  options.orientation.reflectAcrossBisector = reflect;
   options.sheetSign = sheetSign;
   OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options);
   if (sheetSign == SheetSign::ByRays && printPerCurve)
@@ -1344,6 +1351,12 @@ int main(int argc, char** argv) {
       ourOptions.centrelineReach = std::atof(argv[++i]);
     } else if (a == "--band-half-width" && hasValue) {
       ourOptions.bandHalfWidth = std::atof(argv[++i]);
+    } else if (a == "--crease-reach" && hasValue) {
+      ourOptions.creaseReach = std::atof(argv[++i]);
+    } else if (a == "--crease-half-width" && hasValue) {
+      ourOptions.creaseHalfWidth = std::atof(argv[++i]);
+    } else if (a == "--crease-flatness" && hasValue) {
+      ourOptions.creaseFlatness = std::atof(argv[++i]);
     } else if (a == "--centreline-linearity" && hasValue) {
       ourOptions.centrelineLinearity = std::atof(argv[++i]);
     } else if (a == "--across-weight" && hasValue) {
@@ -1352,6 +1365,10 @@ int main(int argc, char** argv) {
       sheetNormals = std::atof(argv[++i]);
     } else if (a == "--no-visibility") {
       visibility = false;
+    } else if (a == "--reflect") {
+      reflect = true;
+    } else if (a == "--no-reflect") {
+      reflect = false;
     } else if (a == "--sign-from-pca") {
       sheetSign = SheetSign::FromPlanes;
     } else if (a == "--own-tree-sign") {

@@ -244,10 +244,14 @@ TEST(FeatureCurves, TheBandIsTrimmedToTheCentrelineOfTheVotes) {
   FeatureCurveOptions untrimmed;
   untrimmed.centrelineReach = 0;
   const FeatureCurveResult wide = detectFeatureCurves(cloud, untrimmed);
-  const FeatureCurveResult trimmed = detectFeatureCurves(cloud, FeatureCurveOptions{});
-  FeatureCurveOptions tighter;
+  FeatureCurveOptions centreline;  // the centreline everywhere, not the sides' planes
+  centreline.creaseReach = 0;
+  const FeatureCurveResult trimmed = detectFeatureCurves(cloud, centreline);
+  FeatureCurveOptions tighter = centreline;
   tighter.bandHalfWidth = 0.8;
   const FeatureCurveResult tight = detectFeatureCurves(cloud, tighter);
+  FeatureCurveOptions byPlanes;  // the default: the line where the sides' planes meet
+  const FeatureCurveResult planes = detectFeatureCurves(cloud, byPlanes);
   const double e = trimmed.spacing;
   // The share of the labelled points beyond `reach` of every edge, away from the corners (where
   // the vertices of three edges do not lie along a line and the points keep their labels).
@@ -272,6 +276,13 @@ TEST(FeatureCurves, TheBandIsTrimmedToTheCentrelineOfTheVotes) {
   EXPECT_LT(beyond(tight, 1.1 * e), 0.25 * beyond(wide, 1.1 * e)) << beyond(wide, 1.1 * e);
   EXPECT_LT(beyond(trimmed, 1.2 * e), 0.25 * beyond(wide, 1.2 * e)) << beyond(wide, 1.2 * e);
   EXPECT_LT(beyond(trimmed, 1.2 * e), beyond(tight, 1.1 * e)) << "a wider band keeps more";
+  // The cube's faces are flat: the line where they meet is the edge itself, and the band is the
+  // points within creaseHalfWidth (1) e of it.
+  EXPECT_EQ(beyond(planes, 1.0 * e + 1e-12), 0.0);
+  EXPECT_GT(beyond(trimmed, 1.0 * e), 0.0) << "the centreline lies inside the edge";
+  for (const Edge& edge : cubeEdges())
+    EXPECT_GT(labelsAlong(cloud.positions(), planes, edge, 0.9 * e, +1).fraction, 0.95)
+        << edge.a.transpose() << " -> " << edge.b.transpose();
   for (const Edge& edge : cubeEdges())
     EXPECT_GT(labelsAlong(cloud.positions(), trimmed, edge, 0.7 * e, +1).fraction, 0.95)
         << edge.a.transpose() << " -> " << edge.b.transpose();
@@ -466,6 +477,9 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   refused([](auto& o) { o.centrelineReach = -1; }, "FeatureCurveOptions::centrelineReach");
   refused([](auto& o) { o.bandHalfWidth = 0; }, "FeatureCurveOptions::bandHalfWidth");
   refused([](auto& o) { o.centrelineLinearity = 2; }, "FeatureCurveOptions::centrelineLinearity");
+  refused([](auto& o) { o.creaseReach = -1; }, "FeatureCurveOptions::creaseReach");
+  refused([](auto& o) { o.creaseHalfWidth = 0; }, "FeatureCurveOptions::creaseHalfWidth");
+  refused([](auto& o) { o.creaseFlatness = std::nan(""); }, "FeatureCurveOptions::creaseFlatness");
   refused([](auto& o) { o.edgeRejoinAngle = 95; }, "FeatureCurveOptions::edgeRejoinAngle");
   // One scale cannot give the default 3 voting scales: the message names both fields and values.
   refused([](auto& o) { o.scaleCount = 1; },

@@ -134,24 +134,33 @@ def test_estimate_normals_equals_the_cli(data, tmp_path):
     points = ss.read(str(data / "house.ply")).points
     ss.write(str(tmp_path / "bare.ply"), points)
     # the across-sheet cost, the default (Hoppe's cost and the rays), Hoppe's cost alone, sheets
-    # oriented by their own tree, by the PCA normals', and by whichever the rays prefer
-    for weight, visibility, sheet, sign in ((1, True, 0, ""), (0, True, 0, ""),
-                                            (0, False, 0, ""), (0, True, 0.05, ""),
-                                            (0, True, 0.05, "pca"), (0, True, 0.05, "rays")):
+    # oriented by their own tree, by the PCA normals', and by whichever the rays prefer; the
+    # reflected agreement, alone and as features orients its sheet normals
+    for weight, visibility, sheet, sign, reflect in ((1, True, 0, "", False),
+                                                     (0, True, 0, "", False),
+                                                     (0, False, 0, "", False),
+                                                     (0, True, 0.05, "", False),
+                                                     (0, True, 0.05, "pca", False),
+                                                     (0, True, 0.05, "rays", False),
+                                                     (0, False, 0, "", True),
+                                                     (0, True, 0.05, "rays", True)):
         flags = ["--visibility" if visibility else "--no-visibility"]
         flags += {"": [], "pca": ["--sign-from-pca"], "rays": ["--sign-by-rays"]}[sign]
+        flags += ["--reflect"] if reflect else []
         cli("normals", tmp_path / "bare.ply", "-o", tmp_path / "n.ply", "--across-weight", weight,
             *flags, "--sheet", sheet)
         expected = columns(tmp_path / "n.ply")
         normals, reliable = ss.estimate_normals(points, across_weight=weight,
                                                 visibility=visibility, sheet=sheet,
                                                 sign_from_pca=sign == "pca",
-                                                sign_by_rays=sign == "rays")
+                                                sign_by_rays=sign == "rays", reflect=reflect)
         for c, name in enumerate(("nx", "ny", "nz")):
             np.testing.assert_array_equal(normals[:, c].astype(np.float32), expected[name], name)
         np.testing.assert_array_equal(reliable, expected["normal_reliable"] != 0)
     with pytest.raises(ValueError, match="acrossWeight"):
         ss.estimate_normals(points, across_weight=-1)
+    with pytest.raises(ValueError, match="reflectAcrossBisector"):
+        ss.estimate_normals(points, across_weight=1, reflect=True)
     with pytest.raises(ss.OptionError, match="sheet") as e:
         ss.estimate_normals(points, sheet=-1)
     assert "Options::" not in str(e.value)
@@ -558,9 +567,11 @@ def test_render_lines_features(data):
     with pytest.raises(ss.OptionError, match="noise_curvature must be finite and >= 0"):
         ss.features(cloud.points, noise_curvature=-1)
     # Without normals, features estimates sheet normals (0.05, the sign the rays prefer) or, with
-    # sheet_normals=0, PCA ones, as estimate_normals does.
+    # sheet_normals=0, PCA ones, as estimate_normals does, their sign propagated by reflection.
     for sheet, result in ((0.05, features), (0, ss.features(cloud.points, sheet_normals=0))):
-        normals, _ = ss.estimate_normals(cloud.points, sheet=sheet, sign_by_rays=sheet > 0)
+        normals, _ = ss.estimate_normals(
+            cloud.points, sheet=sheet, sign_by_rays=sheet > 0, reflect=True
+        )
         np.testing.assert_array_equal(
             result["curve_id"], ss.features(cloud.points, normals)["curve_id"])
     with pytest.raises(ss.OptionError, match="sheet_normals must be finite and >= 0"):

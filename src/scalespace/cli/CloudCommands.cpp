@@ -181,6 +181,7 @@ struct NormalArgs {
   std::size_t maxK = NormalEstimationOptions{}.maxK;
   std::vector<std::string> orient{"mst"};
   double acrossWeight = NormalOrientationOptions{}.acrossWeight;
+  bool reflect = NormalOrientationOptions{}.reflectAcrossBisector;
   bool visibility = NormalOrientationOptions{}.visibility;
   double sheet = NormalEstimationOptions{}.sheetTolerance;
   bool signFromPlanes = false;
@@ -218,6 +219,11 @@ void addNormalOptions(CLI::App& cmd, NormalArgs& a) {
                  "so that its two sides are oriented apart (clean, dense scans of thin parts; it "
                  "hurts noisy or sparse ones); 0 = Hoppe's cost alone")
       ->capture_default_str();
+  cmd.add_flag("--reflect", a.reflect,
+               "mst: compare each normal with its neighbour's reflected across the plane that "
+               "bisects their offset, not with the neighbour's itself: the two sides of a crease "
+               "sharper than 90 degrees (a narrow V-groove) and of a thin part stay apart "
+               "(features does this)");
   cmd.add_flag("--visibility,!--no-visibility", a.visibility,
                "mst: turn over the pieces of the propagation tree that rays cast from the points "
                "show facing the inside of a closed surface (both sides of thin parts, creases); "
@@ -234,6 +240,7 @@ NormalOrientationOptions orientationFrom(const NormalArgs& args, const PointClou
   NormalOrientationOptions o;
   o.k = a.k;
   o.acrossWeight = a.acrossWeight;
+  o.reflectAcrossBisector = a.reflect;
   o.visibility = a.visibility;
   if (a.orient.size() == 1 && a.orient[0] == "mst") {
     o.method = OrientationMethod::MinimumSpanningTree;

@@ -279,6 +279,17 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--band-half-width", args->features.bandHalfWidth,
                   "the points kept lie within this x e of the centreline")
       ->capture_default_str();
+  cmd->add_option("--crease-reach", args->features.creaseReach,
+                  "where the points within this x e form two flat sides, the line where their "
+                  "planes meet replaces the centreline (0: never)")
+      ->capture_default_str();
+  cmd->add_option("--crease-half-width", args->features.creaseHalfWidth,
+                  "the points kept lie within this x e of that line")
+      ->capture_default_str();
+  cmd->add_option("--crease-flatness", args->features.creaseFlatness,
+                  "a side is flat when its points lie within this x e (RMS; or twice the noise) "
+                  "of its plane")
+      ->capture_default_str();
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e, after the joining (0 keeps all)")
       ->capture_default_str();
@@ -418,6 +429,9 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"centreline_reach", options.centrelineReach},
                                    {"band_half_width", options.bandHalfWidth},
                                    {"centreline_linearity", options.centrelineLinearity},
+                                   {"crease_reach", options.creaseReach},
+                                   {"crease_half_width", options.creaseHalfWidth},
+                                   {"crease_flatness", options.creaseFlatness},
                                    {"edge_reach", options.edgeReach},
                                    {"edge_rejoin_angle", options.edgeRejoinAngle},
                                    {"curved_seeds_first", options.lines.curvedSeedsFirst},

@@ -60,6 +60,22 @@ double edgeCost(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb,
   return 1.0 - c + acrossWeight * along.a * along.b;
 }
 
+/// NormalOrientationOptions::reflectAcrossBisector: n_a . R(n_b), R the reflection across the
+/// plane perpendicular to d = p_b - p_a (unit normals; the offsets along them shrunk towards 0 by
+/// `noise`, so that the term fades where they are within the noise). Bilinear in the two normals:
+/// turning either over turns its sign, as for n_a . n_b.
+double reflectedAgreement(const Vec3& pa, const Vec3& na, const Vec3& pb, const Vec3& nb,
+                          double noise) {
+  const Vec3 ua = na.normalized(), ub = nb.normalized(), d = pb - pa;
+  const double c = ua.dot(ub), lengthSq = d.squaredNorm();
+  if (!(lengthSq > 0)) return c;
+  const auto shrink = [noise](double x) {
+    return std::copysign(std::max(0.0, std::abs(x) - noise), x);
+  };
+  const double q = c - 2.0 * shrink(ua.dot(d)) * shrink(ub.dot(d)) / lengthSq;
+  return std::clamp(q, -1.0, 1.0);
+}
+
 /// The offset between two points runs along both normals (within 60 degrees), by more than
 /// `minOffset` along each: an edge between the two sides of a thin part rather than along one
 /// surface. Under noise, neighbours on one surface are offset along the normals by the noise
@@ -99,24 +115,41 @@ float offPlaneSpread(const std::vector<Vec3>& points, std::size_t i, const Vec3&
 /// thickness of any part the rays can see.
 constexpr double kNoiseOffsetFactor = 6.0;
 
-/// kNoiseOffsetFactor times the median of the points' off-plane spreads (negative: none).
-double noiseOffset(const std::vector<float>& spread) {
+/// Offsets along the normals below this many times the median off-plane spread are left out of
+/// reflectedAgreement(): about 3.3 sigma under Gaussian noise sigma; 0 on clean flat faces.
+constexpr double kReflectNoiseFactor = 3.0;
+
+/// `factor` times the median of the points' off-plane spreads (negative: none).
+double noiseOffset(const std::vector<float>& spread, double factor = kNoiseOffsetFactor) {
   std::vector<float> known;
   known.reserve(spread.size());
   for (float v : spread)
     if (v >= 0) known.push_back(v);
   if (known.empty()) return 0.0;
   std::nth_element(known.begin(), known.begin() + std::ptrdiff_t(known.size() / 2), known.end());
-  return kNoiseOffsetFactor * double(known[known.size() / 2]);
+  return factor * double(known[known.size() / 2]);
 }
 
-/// The tree cut where its sign decision is a guess: a crease (|cos| < creaseThreshold) or an edge
-/// across a thin part (acrossSheet with `minOffset` of the edge's child). `parent` and `treeOrder`
-/// are the tree (parents first); returns the number of pieces.
+/// The signed agreement of two oriented normals along a graph edge (in [-1, 1]): n_a . n_b
+/// (Hoppe) or reflectedAgreement() (NormalOrientationOptions::reflectAcrossBisector).
+struct EdgeAgreement {
+  const std::vector<Vec3>& points;
+  bool reflect = false;
+  double noise = 0;  // reflectedAgreement's
+  double operator()(const Vec3& na, Index a, const Vec3& nb, Index b) const {
+    if (reflect) return reflectedAgreement(points[a], na, points[b], nb, noise);
+    return std::clamp(na.dot(nb) / (na.norm() * nb.norm()), -1.0, 1.0);
+  }
+};
+
+/// The tree cut where its sign decision is a guess: a crease (|agreement| < creaseThreshold) or
+/// an edge across a thin part (acrossSheet with `minOffset` of the edge's child). `parent` and
+/// `treeOrder` are the tree (parents first); returns the number of pieces.
 template <class MinOffset>
 Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented,
               const std::vector<Index>& parent, const std::vector<Index>& treeOrder,
-              double creaseThreshold, const MinOffset& minOffset, std::vector<Index>& piece) {
+              const EdgeAgreement& agreement, double creaseThreshold, const MinOffset& minOffset,
+              std::vector<Index>& piece) {
   Index pieces = 0;
   for (const Index c : treeOrder) {
     const Index p = parent[c];
@@ -124,8 +157,7 @@ Index cutTree(const std::vector<Vec3>& points, const std::vector<Vec3>& oriented
       piece[c] = pieces++;
       continue;
     }
-    const double cosine =
-        std::abs(oriented[c].dot(oriented[p])) / (oriented[c].norm() * oriented[p].norm());
+    const double cosine = std::abs(agreement(oriented[c], c, oriented[p], p));
     const bool guess = cosine < creaseThreshold ||
                        acrossSheet(points[p], oriented[p], points[c], oriented[c], minOffset(c));
     piece[c] = guess ? pieces++ : piece[p];
@@ -237,7 +269,7 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                          const std::vector<std::uint8_t>& settled,
                          const std::vector<float>& kthDistance, const std::vector<Index>& parent,
                          const std::vector<Index>& treeOrder, const std::vector<float>& spread,
-                         std::vector<Index>& piece, Index pieces,
+                         const EdgeAgreement& agreement, std::vector<Index>& piece, Index pieces,
                          const NormalOrientationOptions& options, const ProgressCallback& progress,
                          std::vector<std::uint8_t>& flipped, NormalOrientationResult& result) {
   const std::size_t n = points.size();
@@ -309,7 +341,8 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   const double noise = anyClosed ? noiseOffset(spread) : 0.0;
   const auto noiseAt = [&](std::size_t i) { return isClosed(i) ? noise : 0.0; };
   if (anyClosed) {
-    pieces = cutTree(points, oriented, parent, treeOrder, options.creaseThreshold, noiseAt, piece);
+    pieces = cutTree(points, oriented, parent, treeOrder, agreement, options.creaseThreshold,
+                     noiseAt, piece);
     members = countMembers(piece, pieces, treeOrder);
     // Not on flat-faced clean clouds (median off-plane spread under a thousandth of the spacing;
     // curvature or noise lift it above): there the cuts are where the sides meet, and a piece
@@ -556,7 +589,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
                           if (!usable(oriented[i])) continue;
                           index.knnSearch(points[i], k + 1, nbrs);
                           if (!nbrs.empty()) kthDistance[i] = float(std::sqrt(nbrs.back().distSq));
-                          if (inGraph[i] && options.visibility)
+                          if (inGraph[i] && (options.visibility || options.reflectAcrossBisector))
                             spread[i] = offPlaneSpread(points, i, oriented[i], nbrs);
                           std::size_t slot = 0;
                           for (const Neighbor& nb : nbrs) {
@@ -578,9 +611,18 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
                       });
     tracker.finish();
   }
+  // The reflected agreement needs the cloud's noise (its median off-plane spread) first.
+  const EdgeAgreement agreement{
+      points, options.reflectAcrossBisector,
+      options.reflectAcrossBisector ? noiseOffset(spread, kReflectNoiseFactor) : 0.0};
   // Empty slots sort last with a cost above any real one.
   tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t e) {
-    if (edges[e].a == kNone) edges[e].cost = std::numeric_limits<float>::infinity();
+    Edge& edge = edges[e];
+    if (edge.a == kNone)
+      edge.cost = std::numeric_limits<float>::infinity();
+    else if (agreement.reflect)
+      edge.cost =
+          float(1.0 - std::abs(agreement(oriented[edge.a], edge.a, oriented[edge.b], edge.b)));
   });
   checkCancel(progress, 0.0, "orientation sort");
   tbb::parallel_sort(edges.begin(), edges.end());
@@ -651,13 +693,12 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
         const Index c = adjacent[a];
         if (visited[c]) continue;
         visited[c] = 1;
-        const double d = oriented[c].dot(oriented[p]);
+        const double d = agreement(oriented[c], c, oriented[p], p);
         if (d < 0.0) {
           oriented[c] = -oriented[c];
           flipped[c] = 1;
         }
-        const double cosine = std::abs(d) / (oriented[c].norm() * oriented[p].norm());
-        result.reliable[c] = cosine >= options.creaseThreshold ? 1 : 0;
+        result.reliable[c] = std::abs(d) >= options.creaseThreshold ? 1 : 0;
         parent[c] = p;
         queue.push_back(c);
       }
@@ -666,8 +707,8 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   }
   checkCancel(progress, 1.0, "orientation tree");
   const Index pieces = cutTree(
-      points, oriented, parent, treeOrder, options.creaseThreshold, [](Index) { return 0.0; },
-      piece);
+      points, oriented, parent, treeOrder, agreement, options.creaseThreshold,
+      [](Index) { return 0.0; }, piece);
 
   std::vector<std::uint8_t> settled(n, 0);  // the viewpoint decided (turnPiecesToFace)
   if (options.faceViewpoint)
@@ -676,7 +717,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
 
   if (options.visibility)
     correctByVisibility(points, oriented, index, inGraph, settled, kthDistance, parent, treeOrder,
-                        spread, piece, pieces, options, progress, flipped, result);
+                        spread, agreement, piece, pieces, options, progress, flipped, result);
 
   // 5. Points outside the graph follow their nearest graph neighbour; never reliable.
   for (std::size_t i = 0; i < n; ++i) {
@@ -724,6 +765,10 @@ NormalOrientationResult orientNormals(const std::vector<Vec3>& points, std::vect
     throw OptionError(
         "NormalOrientationOptions::acrossWeight must be finite and >= 0 (0: Hoppe's "
         "cost alone)");
+  if (options.acrossWeight > 0 && options.reflectAcrossBisector)
+    throw OptionError(
+        "NormalOrientationOptions::acrossWeight adds to Hoppe's cost; it cannot be combined with "
+        "reflectAcrossBisector, which orients the two sides of a thin part by itself");
   if (index.size() != points.size())
     throw OptionError("orientNormals: the index holds " + std::to_string(index.size()) +
                       " points but " + std::to_string(points.size()) + " were given");

@@ -62,6 +62,17 @@ struct NormalOrientationOptions {
   /// too (figures: bench/README.md, bench_features, "The normals' orientation on thin parts").
   /// 0: Hoppe's cost alone.
   double acrossWeight = 0.0;
+  /// MST (not in Hoppe 1992): compare n_a with n_b reflected across the plane that bisects the
+  /// edge a-b (perpendicular to d = p_b - p_a), q = n_a . n_b - 2 (n_a . d)(n_b . d) / |d|^2,
+  /// instead of n_a . n_b: the cost is 1 - |q| and the propagation keeps q > 0. A surface
+  /// symmetric about that plane carries its normal over exactly: two points of a sphere or of a
+  /// circle, the two sides of a crease of any angle at equal distances, the two sides of a thin
+  /// slab. Hoppe's sign assumes the normals turn by less than 90 degrees, so it turns one side of
+  /// a crease sharper than that (a narrow V-groove, a knife edge) inside out, and the tree does
+  /// not cut there (|cos| is large). Offsets along the normals within the noise (3 x the median
+  /// off-plane spread, noiseOffset()) are taken as 0: between close neighbours on a noisy surface
+  /// they say nothing. false: Hoppe's n_a . n_b.
+  bool reflectAcrossBisector = false;
   /// MST: correct the tree's guesses by visibility (file comment). Hoppe's propagation alone
   /// orients both sides of a thin part alike and guesses at creases; CAD parts sampled without
   /// normals lose half their normals to it (bench_features: blade, rotor).

@@ -15,6 +15,7 @@
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/features/CreaseLine.hpp"
 #include "scalespace/features/CurveEdges.hpp"
 #include "scalespace/scales/PointNoise.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
@@ -115,9 +116,24 @@ std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLine
 /// edge), so the union of the vote balls is a band wider than the vote radius; the many vertices of
 /// several scales within `reach` average to the crease. Where they do not lie along a line (largest
 /// eigenvalue under `linearity` of the trace: corners, blobs) the point keeps its label.
+/// Where the cloud points near it form two flat sides (`crease`, features/CreaseLine; its reach 0:
+/// never) the line where their planes meet replaces the centreline, with `creaseHalfWidth`.
+double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirection) {
+  const Vec3 offset = x - point;
+  return (offset - offset.dot(unitDirection) * unitDirection).norm();
+}
+
+struct CreaseBand {
+  const std::vector<Vec3>& positions;
+  const std::vector<Vec3>& normals;
+  const SpatialIndex& index;
+  CreaseLineOptions line;
+  double halfWidth = 0;
+};
+
 void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>& salient,
                       const std::vector<std::int8_t>& salientSign, const SpatialIndex& index,
-                      double reach, double halfWidth, double linearity,
+                      double reach, double halfWidth, double linearity, const CreaseBand& crease,
                       std::vector<std::uint8_t>& eligible, std::vector<std::int8_t>& sign) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, targets.size(), 1024), [&](const auto& r) {
     std::vector<Neighbor> found;
@@ -148,8 +164,19 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
       const double trace = eigen.eigenvalues().sum();
       if (!(trace > 0) || eigen.eigenvalues()(2) < linearity * trace) continue;
       const Vec3 direction = eigen.eigenvectors().col(2);
-      const Vec3 offset = targets[i] - mean;
-      if ((offset - offset.dot(direction) * direction).squaredNorm() > halfWidth * halfWidth) {
+      Vec3 through = mean, along = direction;
+      double width = halfWidth;
+      if (crease.line.reach > 0)
+        if (const auto line = fitCreaseLine(crease.positions, crease.normals, crease.index,
+                                            targets[i], direction, crease.line);
+            line && distanceToLine(mean, line->point, line->direction) <= crease.halfWidth) {
+          // The salient vertices lie along the edge found: not two faces of a thin part, whose
+          // planes meet far from it or not at all.
+          through = line->point;
+          along = line->direction;
+          width = crease.halfWidth;
+        }
+      if (distanceToLine(targets[i], through, along) > width) {
         eligible[i] = 0;
         sign[i] = 0;
       }
@@ -210,6 +237,7 @@ OrientedNormalsOptions featureNormalOptions(double sheetTolerance) {
   OrientedNormalsOptions options;
   options.estimation.sheetTolerance = sheetTolerance;
   options.sheetSign = SheetSign::ByRays;
+  options.orientation.reflectAcrossBisector = true;
   return options;
 }
 
@@ -255,6 +283,12 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::centrelineReach must be finite and >= 0 (0 = off)");
   require(std::isfinite(o.bandHalfWidth) && o.bandHalfWidth > 0,
           "FeatureCurveOptions::bandHalfWidth must be finite and > 0");
+  require(std::isfinite(o.creaseReach) && o.creaseReach >= 0,
+          "FeatureCurveOptions::creaseReach must be finite and >= 0 (0 = off)");
+  require(std::isfinite(o.creaseHalfWidth) && o.creaseHalfWidth > 0,
+          "FeatureCurveOptions::creaseHalfWidth must be finite and > 0");
+  require(std::isfinite(o.creaseFlatness) && o.creaseFlatness >= 0,
+          "FeatureCurveOptions::creaseFlatness must be finite and >= 0");
   require(std::isfinite(o.centrelineLinearity) && o.centrelineLinearity >= 0 &&
               o.centrelineLinearity <= 1,
           "FeatureCurveOptions::centrelineLinearity must be in [0, 1]");
@@ -434,10 +468,19 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
-  if (options.centrelineReach > 0 && !salient.empty())
-    trimToCentreline(targets, salient, salientSign, *makeSpatialIndex(salient),
-                     options.centrelineReach * e, options.bandHalfWidth * e,
-                     options.centrelineLinearity, eligible, result.convexity);
+  if (options.centrelineReach > 0 && !salient.empty()) {
+    const auto salientIndex = makeSpatialIndex(salient);
+    const auto cloudIndex = options.creaseReach > 0 ? makeSpatialIndex(cloud.positions()) : nullptr;
+    CreaseBand crease{
+        cloud.positions(), cloud.normals(), cloudIndex ? *cloudIndex : *salientIndex, {}, 0};
+    crease.line.reach = options.creaseReach * e;
+    crease.line.maxRms = std::max(options.creaseFlatness * e, 2 * result.noiseRms);
+    crease.line.maxGap = 0.25 * e;
+    crease.halfWidth = options.creaseHalfWidth * e;
+    trimToCentreline(targets, salient, salientSign, *salientIndex, options.centrelineReach * e,
+                     options.bandHalfWidth * e, options.centrelineLinearity, crease, eligible,
+                     result.convexity);
+  }
   std::vector<Index> seeds = seedsByIncreasingKey(n, [&](Index i) {
     return eligible[i] ? -std::abs(result.votes[i]) : std::numeric_limits<double>::quiet_NaN();
   });

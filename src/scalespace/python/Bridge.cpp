@@ -394,7 +394,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress, double acrossWeight,
                                             bool visibility, double sheetTolerance,
-                                            std::size_t maxK, SheetSign sheetSign) {
+                                            std::size_t maxK, SheetSign sheetSign, bool reflect) {
   // The checks and defaults of the CLI's estimateAndOrient (cli/CloudCommands.cpp).
   if (k < 3) throw OptionError("k must be >= 3");
   if (sheetSign == SheetSign::FromPlanes && !(sheetTolerance > 0))
@@ -408,6 +408,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
   options.orientation.k = k;
   options.orientation.acrossWeight = acrossWeight;
   options.orientation.visibility = visibility;
+  options.orientation.reflectAcrossBisector = reflect;
   options.sheetSign = sheetSign;
   return estimateAndOrient(cloud, options, orient, viewpoint, progress);
 }

@@ -149,7 +149,8 @@ std::vector<std::uint8_t> estimateAndOrient(
     double acrossWeight = NormalOrientationOptions{}.acrossWeight,
     bool visibility = NormalOrientationOptions{}.visibility,
     double sheetTolerance = NormalEstimationOptions{}.sheetTolerance,
-    std::size_t maxK = NormalEstimationOptions{}.maxK, SheetSign sheetSign = SheetSign::OwnTree);
+    std::size_t maxK = NormalEstimationOptions{}.maxK, SheetSign sheetSign = SheetSign::OwnTree,
+    bool reflect = NormalOrientationOptions{}.reflectAcrossBisector);
 
 /// Same with the estimation and orientation of `options` (e.g. cylinderNormalOptions()); `orient`
 /// and `viewpoint` as above replace its orientation method and viewpoint.

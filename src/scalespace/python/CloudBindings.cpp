@@ -93,8 +93,9 @@ void writeCloudPy(const std::string& path, const py::handle& points, const py::h
 
 py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& orient,
                     const py::handle& viewpoint, double acrossWeight, bool visibility, double sheet,
-                    bool signFromPca, bool signByRays, std::optional<std::size_t> maxK,
-                    std::optional<int> threads, py::object progress) {
+                    bool signFromPca, bool signByRays, bool reflect,
+                    std::optional<std::size_t> maxK, std::optional<int> threads,
+                    py::object progress) {
   if (signFromPca && signByRays) throw OptionError("give one of sign_from_pca and sign_by_rays");
   PooledCloud cloud = makeCloud(asPoints(points), py::none());
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
@@ -104,7 +105,8 @@ py::tuple normalsPy(const py::handle& points, std::size_t k, const std::string& 
                              sheet, maxK.value_or(std::max(k, NormalEstimationOptions{}.maxK)),
                              signByRays    ? SheetSign::ByRays
                              : signFromPca ? SheetSign::FromPlanes
-                                           : SheetSign::OwnTree);
+                                           : SheetSign::OwnTree,
+                             reflect);
   });
   py::array_t<bool> reliableArray(py::ssize_t(reliable.size()));
   for (std::size_t i = 0; i < reliable.size(); ++i) reliableArray.mutable_data()[i] = reliable[i];
@@ -285,8 +287,8 @@ void bindClouds(py::module_& m) {
         "viewpoint"_a = py::none(), "across_weight"_a = NormalOrientationOptions{}.acrossWeight,
         "visibility"_a = NormalOrientationOptions{}.visibility,
         "sheet"_a = NormalEstimationOptions{}.sheetTolerance, "sign_from_pca"_a = false,
-        "sign_by_rays"_a = false, "max_k"_a = py::none(), "threads"_a = py::none(),
-        "progress"_a = py::none(),
+        "sign_by_rays"_a = false, "reflect"_a = NormalOrientationOptions{}.reflectAcrossBisector,
+        "max_k"_a = py::none(), "threads"_a = py::none(), "progress"_a = py::none(),
         R"doc(Estimates (PCA over k neighbours) and orients normals, as `scalespace normals`.
 
 max_k: under noise comparable to the sampling, k doubles up to max_k (default 80) while the
@@ -307,6 +309,10 @@ where two surfaces touch (the strands of a cable) the sheet normals' own tree ca
 out (cylinders does this). sign_by_rays (with sheet): orient both ways (the sheet normals' own tree,
 the PCA signs) and keep the one the visibility rays find facing inward less often (features does
 this).
+reflect (mst): the propagation compares each normal with its neighbour's reflected across the
+plane bisecting their offset, not with the neighbour's itself: creases sharper than 90 degrees (a
+narrow V-groove) and thin parts keep their sides apart (NormalOrientationOptions::
+reflectAcrossBisector).
 Returns (normals (N, 3) float64, reliable (N,) bool: False where the orientation is a guess).)doc");
   m.def("curvature", &curvaturePy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "scale"_a = py::none(), "scale_k"_a = py::none(), "estimator"_a = "w3", "mls"_a = false,

@@ -132,10 +132,12 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     int minScales, double minCurvature, double noiseCurvature,
                     double salientThreshold, double salientCap, double minExtent,
                     double minPieceExtent, double joinGap, double centrelineReach,
-                    double bandHalfWidth, double edgeReach, double edgeRejoinAngle, bool allSalient,
-                    bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
-                    bool withLines, const py::handle& triangles, std::size_t meshSamples,
-                    double sheetNormals, std::optional<int> threads, py::object progress) {
+                    double bandHalfWidth, double creaseReach, double creaseHalfWidth,
+                    double creaseFlatness, double edgeReach, double edgeRejoinAngle,
+                    bool allSalient, bool salientPerScale, double beta, double gamma,
+                    bool curvedSeedsFirst, bool withLines, const py::handle& triangles,
+                    std::size_t meshSamples, double sheetNormals, std::optional<int> threads,
+                    py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -150,6 +152,9 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.joinGap = joinGap;
   options.centrelineReach = centrelineReach;
   options.bandHalfWidth = bandHalfWidth;
+  options.creaseReach = creaseReach;
+  options.creaseHalfWidth = creaseHalfWidth;
+  options.creaseFlatness = creaseFlatness;
   options.edgeReach = edgeReach;
   options.edgeRejoinAngle = edgeRejoinAngle;
   options.ridgeOnly = !allSalient;
@@ -265,6 +270,9 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "min_piece_extent"_a = FeatureCurveOptions{}.minPieceExtent, "join_gap"_a = 1.5,
         "centreline_reach"_a = FeatureCurveOptions{}.centrelineReach,
         "band_half_width"_a = FeatureCurveOptions{}.bandHalfWidth,
+        "crease_reach"_a = FeatureCurveOptions{}.creaseReach,
+        "crease_half_width"_a = FeatureCurveOptions{}.creaseHalfWidth,
+        "crease_flatness"_a = FeatureCurveOptions{}.creaseFlatness,
         "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
         "edge_rejoin_angle"_a = FeatureCurveOptions{}.edgeRejoinAngle, "all_salient"_a = false,
         "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
@@ -289,7 +297,9 @@ join_gap=0, salient_per_scale=True, centreline_reach=0, curved_seeds_first=False
 thesis' rules (with min_extent=0, min_piece_extent=0: every region kept; else regions spanning
 under min_piece_extent x e are dropped before the joining, curves under min_extent x e after
 it). centreline_reach, band_half_width: a curve keeps the points within
-band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e.
+band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e;
+where the points within crease_reach x e form two flat sides (RMS within crease_flatness x e or
+twice the noise) the line where their planes meet replaces it, with crease_half_width (0: never).
 triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
 is estimated as the plane through the point and two neighbours that the most neighbours lie within

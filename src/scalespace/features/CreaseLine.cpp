@@ -1,0 +1,108 @@
+#include "scalespace/features/CreaseLine.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace scalespace {
+
+namespace {
+
+struct SidePlane {
+  Vec3 centroid = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  // unit, oriented as the side's normals
+  bool flat = false;
+};
+
+/// Plane of one side's points by weighted least squares, the weights (1 - (d / reach)^2)^2 of
+/// their distance d to the query point, so that a curved face gives its tangent plane near the
+/// crease rather than a chord; oriented as their mean normal. Flat when the weighted RMS is within
+/// maxRms and nine in ten of the side's normals lie within 30 degrees of it.
+SidePlane fitSide(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                  const std::vector<Neighbor>& side, double reach, double maxRms) {
+  SidePlane plane;
+  Vec3 meanNormal = Vec3::Zero();
+  double total = 0;
+  std::vector<double> weight(side.size());
+  for (std::size_t k = 0; k < side.size(); ++k) {
+    const double u = 1 - side[k].distSq / (reach * reach);
+    weight[k] = u * u;
+    total += weight[k];
+    plane.centroid += weight[k] * positions[side[k].index];
+    meanNormal += normals[side[k].index];
+  }
+  if (!(total > 0)) return plane;
+  plane.centroid /= total;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < side.size(); ++k) {
+    const Vec3 d = positions[side[k].index] - plane.centroid;
+    covariance += weight[k] * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+  plane.normal = eigen.eigenvectors().col(0);
+  if (plane.normal.dot(meanNormal) < 0) plane.normal = -plane.normal;
+  const double rms = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) / total);
+  // Nine in ten of its normals within 30 degrees of the plane's: one face, not the two faces of a
+  // part thinner than the reach, whose points can fit one plane between them.
+  std::size_t along = 0;
+  for (const Neighbor& nb : side)
+    along += normals[nb.index].dot(plane.normal) >= std::cos(30.0 * M_PI / 180.0);
+  plane.flat = rms <= maxRms && 10 * along >= 9 * side.size();
+  return plane;
+}
+
+}  // namespace
+
+std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
+                                        const std::vector<Vec3>& normals, const SpatialIndex& index,
+                                        const Vec3& x, const Vec3& along,
+                                        const CreaseLineOptions& options) {
+  std::vector<Neighbor> found;
+  index.radiusSearch(x, options.reach, found);
+  if (found.size() < std::size_t(2 * options.minSidePoints)) return std::nullopt;
+  // In index order: the same sums whatever order the search returns.
+  std::sort(found.begin(), found.end(),
+            [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
+  Vec3 mean = Vec3::Zero();
+  for (const Neighbor& nb : found) mean += normals[nb.index];
+  const Vec3 across = along.cross(mean);
+  if (!(across.norm() > 1e-9 * std::max(1.0, mean.norm()))) return std::nullopt;
+  std::vector<Neighbor> sides[2];
+  for (const Neighbor& nb : found) sides[normals[nb.index].dot(across) >= 0 ? 1 : 0].push_back(nb);
+  if (sides[0].size() < std::size_t(options.minSidePoints) ||
+      sides[1].size() < std::size_t(options.minSidePoints))
+    return std::nullopt;
+  const SidePlane a = fitSide(positions, normals, sides[0], options.reach, options.maxRms);
+  const SidePlane b = fitSide(positions, normals, sides[1], options.reach, options.maxRms);
+  if (!a.flat || !b.flat) return std::nullopt;
+  const Vec3 direction = a.normal.cross(b.normal);
+  const double sine = direction.norm();
+  const double turn = std::atan2(sine, a.normal.dot(b.normal)) * 180.0 / M_PI;
+  if (turn < options.minTurnDegrees) return std::nullopt;
+  CreaseLine line;
+  line.direction = direction / sine;
+  line.turnDegrees = turn;
+  // The point of both planes nearest x: both plane equations and the foot of x along the line.
+  Eigen::Matrix3d system;
+  system.row(0) = a.normal.transpose();
+  system.row(1) = b.normal.transpose();
+  system.row(2) = line.direction.transpose();
+  const Vec3 rhs(a.normal.dot(a.centroid), b.normal.dot(b.centroid), line.direction.dot(x));
+  line.point = system.colPivHouseholderQr().solve(rhs);
+  if (!line.point.allFinite()) return std::nullopt;
+  if (options.maxGap > 0) {
+    bool met = false;
+    for (const Neighbor& nb : found) {
+      const Vec3 offset = positions[nb.index] - line.point;
+      if ((offset - offset.dot(line.direction) * line.direction).squaredNorm() <=
+          options.maxGap * options.maxGap) {
+        met = true;
+        break;
+      }
+    }
+    if (!met) return std::nullopt;
+  }
+  return line;
+}
+
+}  // namespace scalespace

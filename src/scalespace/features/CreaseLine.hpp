@@ -1,0 +1,47 @@
+#pragma once
+// The crease through a point as the line where the planes of its two sides meet (not in the
+// thesis): the cloud points near the point split by the side their normal leans to across the
+// crease, a plane fitted to each side, the two planes intersected. On a sharp crease this is the
+// edge itself, where the salient vertices of the APSS lie 0.2 to 0.4 e inside a convex edge
+// (outside a concave one): the APSS rounds the edge at every scale.
+#include <optional>
+#include <vector>
+
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/core/Types.hpp"
+
+namespace scalespace {
+
+struct CreaseLineOptions {
+  /// The sides are the points within `reach` of the point.
+  double reach = 0;
+  /// Each side's points lie within maxRms (RMS) of its plane: else the sides are curved (a fillet,
+  /// a corner's third face) and no line is returned.
+  double maxRms = 0;
+  /// The two planes turn by at least this many degrees (else it is no crease).
+  double minTurnDegrees = 20;
+  /// Each side holds at least this many points.
+  int minSidePoints = 6;
+  /// Some point lies within maxGap of the line: the two sides meet there. Where a narrow third
+  /// face lies between them (the rim of a part thinner than the reach) their planes meet beyond
+  /// it, half a spacing or more from any point (libcgal-demo's blade). 0: not checked.
+  double maxGap = 0;
+};
+
+struct CreaseLine {
+  Vec3 point = Vec3::Zero();      // on the line, the nearest to the query point
+  Vec3 direction = Vec3::Zero();  // unit
+  double turnDegrees = 0;         // between the two sides' normals
+};
+
+/// The crease near `x` running roughly along `along` (unit; e.g. the salient vertices' line):
+/// the points of `positions` (with oriented unit `normals`, searched in `index`) within
+/// options.reach of x are split by the sign of n . (along x m), m their mean normal, and a plane
+/// is fitted to each side (least squares). None when a side is too small or not flat, when the
+/// planes turn by less than minTurnDegrees or when their normals disagree with the side's.
+std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
+                                        const std::vector<Vec3>& normals, const SpatialIndex& index,
+                                        const Vec3& x, const Vec3& along,
+                                        const CreaseLineOptions& options);
+
+}  // namespace scalespace

@@ -1,0 +1,126 @@
+// The crease through a point as the line where the planes of its two sides meet
+// (features/CreaseLine): exact on a sharp edge of any turn, along the middle of a rounded edge,
+// none on a flat face or beyond the end of a thin part.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "scalespace/core/SpatialIndex.hpp"
+#include "scalespace/features/CreaseLine.hpp"
+
+using namespace scalespace;
+
+namespace {
+
+constexpr double kSpacing = 0.01;
+
+struct Sample {
+  std::vector<Vec3> positions, normals;
+  void add(const Vec3& p, const Vec3& n) {
+    positions.push_back(p);
+    normals.push_back(n.normalized());
+  }
+};
+
+// Two half-planes meeting along the x axis, turning by `turnDegrees` (a convex edge: the normals
+// point away from the solid), `count` random points on each within 0.1 of the axis.
+Sample sharpEdge(double turnDegrees, std::uint64_t seed, int count = 4000) {
+  const double half = (180 - turnDegrees) / 2 * M_PI / 180;  // half the opening
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> along(-0.1, 0.1), away(0.0, 0.1);
+  Sample s;
+  for (int i = 0; i < 2 * count; ++i) {
+    const double side = i % 2 ? 1.0 : -1.0, d = away(rng);
+    const Vec3 direction(0, side * std::sin(half), -std::cos(half));  // down the face
+    const Vec3 normal(0, side * std::cos(half), std::sin(half));
+    s.add(Vec3(along(rng), 0, 0) + d * direction, normal);
+  }
+  return s;
+}
+
+CreaseLineOptions options() {
+  CreaseLineOptions o;
+  o.reach = 2 * kSpacing;
+  o.maxRms = 0.1 * kSpacing;
+  o.maxGap = 0.25 * kSpacing;
+  return o;
+}
+
+double distanceToXAxis(const Vec3& p) { return std::hypot(p.y(), p.z()); }
+
+}  // namespace
+
+TEST(CreaseLine, ASharpEdgeOfAnyTurnIsFoundExactly) {
+  for (double turn : {30.0, 90.0, 150.0}) {
+    const Sample s = sharpEdge(turn, 11);
+    const auto index = makeSpatialIndex(s.positions);
+    // From points beside the edge, and with the salient vertices' direction 10 degrees off.
+    const Vec3 along = Vec3(1, std::tan(10 * M_PI / 180), 0).normalized();
+    for (std::size_t i = 0; i < 200; ++i) {
+      const Vec3& x = s.positions[i];
+      if (std::abs(x.x()) > 0.05 || distanceToXAxis(x) > 1.5 * kSpacing) continue;
+      const auto line = fitCreaseLine(s.positions, s.normals, *index, x, along, options());
+      ASSERT_TRUE(line) << turn << " " << i;
+      EXPECT_NEAR(std::abs(line->direction.x()), 1.0, 1e-9);
+      EXPECT_LT(distanceToXAxis(line->point), 1e-9);
+      EXPECT_NEAR(line->point.x(), x.x(), 1e-9) << "the point of the line nearest x";
+      EXPECT_NEAR(line->turnDegrees, turn, 1e-6);
+    }
+  }
+}
+
+TEST(CreaseLine, NoneOnAFlatFaceAndAFilletsMiddleOnAFillet) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-0.1, 0.1), angle(0, M_PI / 2);
+  Sample flat, fillet;
+  const double radius = 1.5 * kSpacing;  // a quarter cylinder, within the reach all through
+  for (int i = 0; i < 8000; ++i) {
+    flat.add(Vec3(u(rng), u(rng), 0), Vec3::UnitZ());
+    const double a = angle(rng);
+    fillet.add(Vec3(u(rng), radius * std::sin(a), radius * std::cos(a)),
+               Vec3(0, std::sin(a), std::cos(a)));
+  }
+  const Vec3 along = Vec3::UnitX();
+  const auto flatIndex = makeSpatialIndex(flat.positions);
+  EXPECT_FALSE(
+      fitCreaseLine(flat.positions, flat.normals, *flatIndex, Vec3::Zero(), along, options()));
+  // Its two halves are flat within the tolerance: their planes meet along the middle of the
+  // rounded edge, on the surface (the rounded edge's feature line at coarse scales).
+  const auto filletIndex = makeSpatialIndex(fillet.positions);
+  const Vec3 middle(0, radius * std::sin(M_PI / 4), radius * std::cos(M_PI / 4));
+  const auto line =
+      fitCreaseLine(fillet.positions, fillet.normals, *filletIndex, middle, along, options());
+  ASSERT_TRUE(line);
+  EXPECT_NEAR(std::abs(line->direction.x()), 1.0, 1e-4);
+  EXPECT_LT((line->point - middle).norm(), 0.1 * kSpacing);
+  CreaseLineOptions strict = options();
+  strict.maxRms = 0.01 * kSpacing;
+  EXPECT_FALSE(fitCreaseLine(fillet.positions, fillet.normals, *filletIndex, middle, along, strict))
+      << "curved beyond a strict flatness";
+}
+
+// A wedge half a spacing thick at its end, its faces tilted by 10 degrees each, its end (the rim)
+// not sampled, as a scan can leave it: within the reach of a point at the end lie both faces, and
+// their planes meet beyond the end, where no point lies.
+TEST(CreaseLine, NoneBeyondTheEndOfAThinPart) {
+  const double thickness = 0.5 * kSpacing, tilt = 10 * M_PI / 180;
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> along(-0.1, 0.1), depth(0.0, 0.1);
+  Sample s;
+  for (int i = 0; i < 12000; ++i) {
+    const double d = depth(rng), side = i % 2 ? 1.0 : -1.0;
+    // faces: z = +-(thickness / 2 + d tan(tilt)), y = -d (the end at y = 0)
+    s.add(Vec3(along(rng), -d, side * (0.5 * thickness + d * std::tan(tilt))),
+          Vec3(0, std::sin(tilt), side * std::cos(tilt)));
+  }
+  const auto index = makeSpatialIndex(s.positions);
+  const Vec3 x(0, 0, 0), direction = Vec3::UnitX();
+  EXPECT_FALSE(fitCreaseLine(s.positions, s.normals, *index, x, direction, options()));
+  CreaseLineOptions unchecked = options();
+  unchecked.maxGap = 0;
+  const auto beyond = fitCreaseLine(s.positions, s.normals, *index, x, direction, unchecked);
+  ASSERT_TRUE(beyond) << "without the gap check the faces' planes give a line";
+  EXPECT_GT(beyond->point.y(), kSpacing) << "beyond the end";
+}
