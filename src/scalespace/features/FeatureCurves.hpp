@@ -12,7 +12,9 @@
 //   4. regions grow on the target graph (k-NN graph or mesh edges) over the points whose votes
 //      exceed v = voteThreshold * V_max in magnitude, between points of the same sign;
 //   4b. (not in the thesis) points farther than bandHalfWidth * e from the centreline fitted to the
-//      salient vertices within centrelineReach * e leave the band before the regions grow;
+//      salient vertices within centrelineReach * e leave the band before the regions grow; where
+//      the cloud points within creaseReach * e form two flat sides, points farther than
+//      creaseHalfWidth * e from the line where their planes meet (features/CreaseLine);
 //   5. (not in the thesis) regions smaller than minCurveExtent * e across are dropped: specks of
 //      one to a few points where a line grazed a corner; then regions of the same sign within
 //      joinGap * e of each other are joined (the gaps where lines stop at corners).
