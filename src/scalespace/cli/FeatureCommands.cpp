@@ -303,7 +303,8 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--sheet-normals", args->sheetNormals,
                   "a cloud without normals: estimate each as the plane of the neighbours within "
                   "this x the 10th neighbour's distance (or 8 noise RMS) of one through the "
-                  "point and two neighbours, one side's at a crease (0: PCA)")
+                  "point and two neighbours, one side's at a crease (0: PCA); oriented as "
+                  "'normals --sign-by-rays --reflect' does")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");

@@ -304,9 +304,9 @@ triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_sa
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
 is estimated as the plane through the point and two neighbours that the most neighbours lie within
 sheet_normals times the 10th neighbour's distance (or 8 noise RMS) of, where the PCA plane does not
-hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...), and
-oriented (MST; each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the
-CLI does).)doc");
+hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...,
+sign_by_rays=True, reflect=True), and oriented (MST, the sign carried by the reflected agreement;
+each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the CLI does).)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
