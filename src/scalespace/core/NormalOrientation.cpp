@@ -600,8 +600,11 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
                               break;
                             }
                             if (slot == k) break;
-                            const double cost = edgeCost(points[i], oriented[i], points[j],
-                                                         oriented[j], options.acrossWeight);
+                            // The reflected cost needs the cloud's noise: set once it is known.
+                            const double cost = options.reflectAcrossBisector
+                                                    ? 0.0
+                                                    : edgeCost(points[i], oriented[i], points[j],
+                                                               oriented[j], options.acrossWeight);
                             edges[i * k + slot++] =
                                 Edge{float(cost), Index(std::min<std::size_t>(i, j)),
                                      Index(std::max<std::size_t>(i, j))};

@@ -53,6 +53,11 @@ SidePlane fitSide(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
 
 }  // namespace
 
+double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirection) {
+  const Vec3 offset = x - point;
+  return (offset - offset.dot(unitDirection) * unitDirection).norm();
+}
+
 std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
                                         const std::vector<Vec3>& normals, const SpatialIndex& index,
                                         const Vec3& x, const Vec3& along,
@@ -91,15 +96,9 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
   line.point = system.colPivHouseholderQr().solve(rhs);
   if (!line.point.allFinite()) return std::nullopt;
   if (options.maxGap > 0) {
-    bool met = false;
-    for (const Neighbor& nb : found) {
-      const Vec3 offset = positions[nb.index] - line.point;
-      if ((offset - offset.dot(line.direction) * line.direction).squaredNorm() <=
-          options.maxGap * options.maxGap) {
-        met = true;
-        break;
-      }
-    }
+    const bool met = std::any_of(found.begin(), found.end(), [&](const Neighbor& nb) {
+      return distanceToLine(positions[nb.index], line.point, line.direction) <= options.maxGap;
+    });
     if (!met) return std::nullopt;
   }
   return line;

@@ -34,6 +34,9 @@ struct CreaseLine {
   double turnDegrees = 0;         // between the two sides' normals
 };
 
+/// Distance from x to the line through `point` along `unitDirection`.
+double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirection);
+
 /// The crease near `x` running roughly along `along` (unit; e.g. the salient vertices' line):
 /// the points of `positions` (with oriented unit `normals`, searched in `index`) within
 /// options.reach of x are split by the sign of n . (along x m), m their mean normal, and a plane

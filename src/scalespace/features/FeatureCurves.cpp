@@ -118,11 +118,6 @@ std::vector<std::uint8_t> acrossLineMaxima(const std::vector<const CurvatureLine
 /// eigenvalue under `linearity` of the trace: corners, blobs) the point keeps its label.
 /// Where the cloud points near it form two flat sides (`crease`, features/CreaseLine; its reach 0:
 /// never) the line where their planes meet replaces the centreline, with `creaseHalfWidth`.
-double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirection) {
-  const Vec3 offset = x - point;
-  return (offset - offset.dot(unitDirection) * unitDirection).norm();
-}
-
 struct CreaseBand {
   const std::vector<Vec3>& positions;
   const std::vector<Vec3>& normals;
