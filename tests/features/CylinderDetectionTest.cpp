@@ -189,6 +189,59 @@ TEST(Cylinders, ATubeFitMovesWithTheCloud) {
   }
 }
 
+// One run of a strand of the pipe rack's twisted cable seen from +z (bench_cylinders --scan
+// one-sided): strand radius r = 0.05, its axis a helix of radius 1.2 r about the x axis, pitch 0.8,
+// over the half pitch where it passes on the near side; the other strands hide all but its outer
+// cap (farther than 1.6 x 1.2 r from the cable's axis), noise 0.1 r. The cap lies on the cable's
+// envelope too: the straight axis along the cable's fits it as well as the strand's curved axis,
+// at 1.8 r over a narrow arc. Only the curved axis has the radius the curvature reads, 1 / r.
+TEST(Cylinders, AStrandsRunSeenFromOneSideTakesTheAxisOfItsCurvatureRadius) {
+  const double r = 0.05, R = 1.2 * r, omega = 2 * kPi / 0.8;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<Vec3> p, n;
+  while (p.size() < 4000) {
+    const double x = 0.4 * u(rng), a = 2 * kPi * u(rng);
+    const Vec3 centre(x, R * std::cos(omega * x), R * std::sin(omega * x));
+    const Vec3 tangent =
+        Vec3(1, -R * omega * std::sin(omega * x), R * omega * std::cos(omega * x)).normalized();
+    const Vec3 e1 = tangent.cross(Vec3::UnitX()).normalized(), e2 = tangent.cross(e1);
+    const Vec3 normal = std::cos(a) * e1 + std::sin(a) * e2;
+    const Vec3 q = centre + r * normal;
+    if (normal.z() < 0.2 || std::hypot(q.y(), q.z()) < 1.6 * R) continue;  // hidden
+    p.push_back(q + 0.1 * r * Vec3(g(rng), g(rng), g(rng)));
+    n.push_back(normal);
+  }
+  std::vector<Index> points(p.size());
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Index(i);
+  const std::vector<float> kappa1(p.size(), float(1 / r));
+  const double t = 0.04;
+  TubeFitOptions options;
+  options.minArcDegrees = 105;  // TubeSplitOptions::partMinArcDegrees
+  const TubeFit free = fitTube(p, n, n, kappa1, points, t, options);
+  EXPECT_TRUE(free.straight);
+  EXPECT_GT(free.radius, 1.5 * r);
+  EXPECT_EQ(free.rejection, TubeRejection::NarrowArc);
+  options.maxRadiusDisagreement = 1.5;  // TubeSplitOptions::partRadiusDisagreement
+  const TubeFit read = fitTube(p, n, n, kappa1, points, t, options);
+  EXPECT_TRUE(read.isTube()) << tubeRejectionName(read.rejection);
+  EXPECT_FALSE(read.straight);
+  EXPECT_NEAR(read.radius, r, 0.05 * r);
+
+  // A half-pipe whose curvature reads its radius keeps its straight axis.
+  Tube half;
+  half.radius = r;
+  half.length = 0.4;
+  half.arc = kPi;
+  const PointCloud pipe = sampleTube(half, 4000);
+  const TubeFit straight =
+      fitTube(pipe.positions(), pipe.normals(), pipe.normals(), kappa1, points, t, options);
+  EXPECT_TRUE(straight.isTube()) << tubeRejectionName(straight.rejection);
+  EXPECT_TRUE(straight.straight);
+  EXPECT_NEAR(straight.radius, r, 0.01 * r);
+}
+
 TEST(Cylinders, PlanesAndBoxesAreNoCylinders) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -187,6 +189,41 @@ TEST(TubeSplitting, AStrandCutAcrossByTheDensityLevelsIsJoinedAgain) {
   }
 }
 
+TEST(TubeSplitting, AnAxisContinuesAnotherOnlyEndToEndOnItsLine) {
+  const auto tubeAlong = [](std::vector<Vec3> axis) {
+    TubeFit fit;
+    fit.axis = std::move(axis);
+    return fit;
+  };
+  const double r = 0.05;
+  const TubeFit a = tubeAlong({Vec3(-1, 0, 0), Vec3(-0.5, 0, 0), Vec3(0, 0, 0)});
+  // The next piece of the same strand, 2 r on, its axis bent by 5 degrees.
+  const Vec3 bent(std::cos(5 * kPi / 180), std::sin(5 * kPi / 180), 0);
+  const TubeFit b = tubeAlong({Vec3(2 * r, 0, 0), Vec3(2 * r, 0, 0) + 0.5 * bent});
+  EXPECT_TRUE(continuesAxis(a, b, 3 * r, r));
+  EXPECT_TRUE(continuesAxis(b, a, 3 * r, r));
+  // Either order of the vertices: an axis has no direction.
+  TubeFit reversed = b;
+  std::reverse(reversed.axis.begin(), reversed.axis.end());
+  EXPECT_TRUE(continuesAxis(a, reversed, 3 * r, r));
+  // Too far on.
+  EXPECT_FALSE(continuesAxis(a, tubeAlong({Vec3(4 * r, 0, 0), Vec3(1, 0, 0)}), 3 * r, r));
+  // The run of the next strand of a cable scanned from one side: it begins where a ends, beside
+  // it (two radii aside); a curved axis through both would bridge the two strands.
+  EXPECT_FALSE(continuesAxis(a, tubeAlong({Vec3(r, 2 * r, 0), Vec3(1, 2 * r, 0)}), 3 * r, r));
+  // A tube across a's end: b's end lies near a's line, a's end is off b's.
+  EXPECT_FALSE(continuesAxis(a, tubeAlong({Vec3(2 * r, -0.5, 0), Vec3(2 * r, -r, 0)}), 3 * r, r));
+  // The last segment of a noisy axis may point anywhere: a's tip 0.5 r aside of its line. The
+  // direction over its last 2 r still leads to b, 3 r on; the last segment alone does not.
+  std::vector<Vec3> noisy;
+  for (int k = 0; k <= 50; ++k) noisy.emplace_back(-1 + 0.02 * k, 0, 0);
+  noisy.back().y() = 0.5 * r;
+  const TubeFit c = tubeAlong(noisy), d = tubeAlong({Vec3(3 * r, 0, 0), Vec3(1, 0, 0)});
+  EXPECT_FALSE(continuesAxis(c, d, 4 * r, r));
+  EXPECT_TRUE(continuesAxis(c, d, 4 * r, r, 2 * r));
+  EXPECT_FALSE(continuesAxis(a, tubeAlong({Vec3(0, 0, 0)}), 3 * r, r));
+}
+
 TEST(TubeSplitting, OptionsAreChecked) {
   TubeSplitOptions o;
   EXPECT_NO_THROW(validateTubeSplitOptions(o));
@@ -207,5 +244,19 @@ TEST(TubeSplitting, OptionsAreChecked) {
   EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
   o = {};
   o.minShare = 0.6;
+  EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
+  o = {};
+  o.maxJoinGap = -1;
+  EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
+  o = {};
+  o.maxJoinOffset = std::nan("");
+  EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
+  o = {};
+  o.partRadiusDisagreement = 0.9;
+  EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
+  o.partRadiusDisagreement = std::numeric_limits<double>::infinity();
+  EXPECT_NO_THROW(validateTubeSplitOptions(o));
+  o = {};
+  o.partMinArcDegrees = 400;
   EXPECT_THROW(validateTubeSplitOptions(o), OptionError);
 }

@@ -528,6 +528,8 @@ void validateTubeFitOptions(const TubeFitOptions& options) {
         "TubeFitOptions::minSectorFill must be in [0, 1]");
   check(std::isfinite(options.straightRmsRatio) && options.straightRmsRatio >= 1,
         "TubeFitOptions::straightRmsRatio must be finite and >= 1");
+  check(options.maxRadiusDisagreement >= 1,
+        "TubeFitOptions::maxRadiusDisagreement must be >= 1 (infinity: off)");
 }
 
 TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
@@ -585,8 +587,18 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
         fit.straightRadius = alongChord.straightRadius;
       }
     }
-    // The straight axis unless the curved one describes the points clearly better (a bent pipe).
-    fit.straight = straight.rms <= std::max(options.straightRmsRatio * curved.rms,
+    // The straight axis unless the curved one describes the points clearly better (a bent pipe),
+    // or unless only the curved one has the radius the scale's curvature reads: a run of a
+    // twisted strand seen from one side also lies on the cable's envelope, a straight tube of
+    // twice its radius over a narrow arc, and fits it about as well.
+    const auto offBy = [](double a, double b) { return std::max(a / b, b / a); };
+    const double curvatureRadius = radii[radii.size() / 2];
+    const double straightOff = offBy(fit.straightRadius, curvatureRadius);
+    const bool straightReadsTheCurvature =
+        !(straightOff > options.maxRadiusDisagreement &&
+          offBy(curved.meanDistance, curvatureRadius) < straightOff);
+    fit.straight = straightReadsTheCurvature &&
+                   straight.rms <= std::max(options.straightRmsRatio * curved.rms,
                                             curved.rms + 0.02 * curved.meanDistance);
   }
   AxisEvaluation& chosen = fit.straight ? straight : curved;

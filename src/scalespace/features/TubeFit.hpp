@@ -11,6 +11,7 @@
 // line, refined by a geometric circle fit) is kept unless the curved one fits the points clearly
 // better. The radius profile is the mean distance to the axis per axis vertex.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -63,6 +64,11 @@ struct TubeFitOptions {
   /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
   /// the radius of it).
   double straightRmsRatio = 1.5;
+  /// ... and, when this is finite, only if the straight axis's radius is within this factor of
+  /// the points' median curvature radius (1 / |kappa1|) or closer to it than the curved axis's.
+  /// Off for a grown region, which may be a cable whose fits read its strands; features/
+  /// TubeSplitting sets it for the parts it splits a region into (TubeSplitOptions).
+  double maxRadiusDisagreement = std::numeric_limits<double>::infinity();
 };
 
 /// Why a region is no tube (None: it is one; Merged: it joined a touching tube,

@@ -33,18 +33,23 @@ double medianCurvatureRadius(const std::vector<float>& kappa1, const std::vector
 
 /// The parts of `points` split by their axes, part by part while a part's curvature sees tubes
 /// thinner than its own (the first density level that parts a cable may leave two strands
-/// together), with their tubes; empty when the points do not split.
+/// together), with their tubes (fitted with `partTube`); empty when the points do not split.
+/// `whole` is the points' tube as a grown region's (fitted with `tube`), which decides whether
+/// they are split.
 std::vector<ThinTube> splitTubes(const std::vector<Vec3>& positions,
                                  const std::vector<Vec3>& normals,
                                  const std::vector<Vec3>& scaleNormals,
                                  const std::vector<float>& kappa1, const std::vector<Index>& points,
                                  const TubeFit& whole, double t, const TubeFitOptions& tube,
-                                 const TubeSplitOptions& options, int depth) {
-  // Only a tube, or one turned down as rough: the strands grown into one region are either, while
-  // a region that is no tube for want of arc or of normal directions holds no tubes side by side.
-  if (!options.enabled || depth > 3 || !(whole.radius > 0) ||
-      !(whole.isTube() || whole.rejection == TubeRejection::Rough))
-    return {};
+                                 const TubeFitOptions& partTube, const TubeSplitOptions& options,
+                                 int depth) {
+  // Only a tube, or one turned down as rough or for a narrow arc: the strands grown into one
+  // region are any of these (a cable scanned from one side: its envelope over a narrow arc), while
+  // a flat, thin, faceted or too small one holds no tubes side by side. Its curvature must also
+  // see thinner tubes (below), and its parts must be tubes to be kept (splitIntoThinnerTubes).
+  const bool mayHoldTubes = whole.isTube() || whole.rejection == TubeRejection::Rough ||
+                            whole.rejection == TubeRejection::NarrowArc;
+  if (!options.enabled || depth > 3 || !(whole.radius > 0) || !mayHoldTubes) return {};
   // The scale's curvature must see tubes thinner than the region's: the strands' own radius at a
   // scale below it; the whole cable, at a scale above the strands, proposes its own axis.
   const double curvatureRadius = medianCurvatureRadius(kappa1, points, t, tube.minCurvatureFactor);
@@ -53,18 +58,56 @@ std::vector<ThinTube> splitTubes(const std::vector<Vec3>& positions,
   for (std::vector<Index>& part :
        splitByProposedAxes(positions, scaleNormals, kappa1, points, t, tube.minCurvatureFactor,
                            tube.minPoints, options)) {
-    TubeFit fit = fitTube(positions, normals, scaleNormals, kappa1, part, t, tube);
-    std::vector<ThinTube> finer = splitTubes(positions, normals, scaleNormals, kappa1, part, fit, t,
-                                             tube, options, depth + 1);
-    if (finer.empty())
+    // Whether a part splits again is judged on its tube as a region's, the straight axis free
+    // to span two strands' runs: the part's own tube, whose axis must read the curvature's
+    // radius, can zigzag between them at about the strands' radius.
+    const TubeFit asRegion = fitTube(positions, normals, scaleNormals, kappa1, part, t, tube);
+    std::vector<ThinTube> finer = splitTubes(positions, normals, scaleNormals, kappa1, part,
+                                             asRegion, t, tube, partTube, options, depth + 1);
+    if (finer.empty()) {
+      TubeFit fit = fitTube(positions, normals, scaleNormals, kappa1, part, t, partTube);
       out.push_back({std::move(part), std::move(fit)});
-    else
+    } else {
       for (ThinTube& f : finer) out.push_back(std::move(f));
+    }
   }
   return out;
 }
 
 }  // namespace
+
+bool continuesAxis(const TubeFit& a, const TubeFit& b, double maxGap, double maxOffset,
+                   double directionReach) {
+  if (a.axis.size() < 2 || b.axis.size() < 2) return false;
+  // An axis end and the unit direction in which it leaves its tube, over the last directionReach
+  // of the axis: the last segment of a noisy curved axis may point anywhere.
+  const auto end = [directionReach](const std::vector<Vec3>& axis, bool back) {
+    const std::size_t n = axis.size();
+    const Vec3& tip = back ? axis[n - 1] : axis[0];
+    Vec3 inner = back ? axis[n - 2] : axis[1];
+    double length = 0;
+    for (std::size_t k = 1; k < n && length < directionReach; ++k) {
+      const Vec3& previous = back ? axis[n - k] : axis[k - 1];
+      inner = back ? axis[n - 1 - k] : axis[k];
+      length += (inner - previous).norm();
+    }
+    return std::pair<Vec3, Vec3>(tip, (tip - inner).normalized());
+  };
+  // Whether p lies on the way the end leaves: within maxOffset of its line, widening by half the
+  // distance ahead, as a curved axis (a helical strand's) turns away from its end's tangent.
+  const auto ahead = [maxOffset](const std::pair<Vec3, Vec3>& from, const Vec3& p) {
+    const Vec3 d = p - from.first;
+    const double along = d.dot(from.second);
+    return (d - along * from.second).norm() <= maxOffset + 0.5 * std::max(along, 0.0);
+  };
+  for (const bool ab : {false, true})
+    for (const bool bb : {false, true}) {
+      const auto ea = end(a.axis, ab), eb = end(b.axis, bb);
+      if ((ea.first - eb.first).norm() <= maxGap && ahead(ea, eb.first) && ahead(eb, ea.first))
+        return true;
+    }
+  return false;
+}
 
 void validateTubeSplitOptions(const TubeSplitOptions& options) {
   if (!(std::isfinite(options.cellFactor) && options.cellFactor > 0))
@@ -82,6 +125,14 @@ void validateTubeSplitOptions(const TubeSplitOptions& options) {
         "TubeSplitOptions::cellFactor");
   if (!(options.maxRadiusRatio > 0 && options.maxRadiusRatio <= 1))
     throw OptionError("TubeSplitOptions::maxRadiusRatio must be in (0, 1]");
+  if (!(std::isfinite(options.maxJoinGap) && options.maxJoinGap >= 0))
+    throw OptionError("TubeSplitOptions::maxJoinGap must be finite and >= 0");
+  if (!(options.partMinArcDegrees >= 0 && options.partMinArcDegrees <= 360))
+    throw OptionError("TubeSplitOptions::partMinArcDegrees must be in [0, 360]");
+  if (!(options.partRadiusDisagreement >= 1))
+    throw OptionError("TubeSplitOptions::partRadiusDisagreement must be >= 1 (infinity: off)");
+  if (!(std::isfinite(options.maxJoinOffset) && options.maxJoinOffset >= 0))
+    throw OptionError("TubeSplitOptions::maxJoinOffset must be finite and >= 0");
 }
 
 std::vector<std::vector<Index>> splitByProposedAxes(
@@ -218,10 +269,13 @@ std::vector<ThinTube> splitIntoThinnerTubes(const std::vector<Vec3>& positions,
                                             const std::vector<Index>& points, const TubeFit& whole,
                                             double t, const TubeFitOptions& tube,
                                             const TubeSplitOptions& options) {
+  TubeFitOptions partTube = tube;
+  partTube.maxRadiusDisagreement = options.partRadiusDisagreement;
+  partTube.minArcDegrees = std::min(tube.minArcDegrees, options.partMinArcDegrees);
   std::vector<ThinTube> kept;
   std::size_t covered = 0;
-  for (ThinTube& part :
-       splitTubes(positions, normals, scaleNormals, kappa1, points, whole, t, tube, options, 0))
+  for (ThinTube& part : splitTubes(positions, normals, scaleNormals, kappa1, points, whole, t, tube,
+                                   partTube, options, 0))
     if (part.tube.isTube() && part.tube.radius < options.maxRadiusRatio * whole.radius) {
       covered += part.points.size();
       kept.push_back(std::move(part));
@@ -234,12 +288,15 @@ std::vector<ThinTube> splitIntoThinnerTubes(const std::vector<Vec3>& positions,
       for (std::size_t b = a + 1; b < kept.size() && !joined; ++b) {
         const TubeFit &ta = kept[a].tube, &tb = kept[b].tube;
         if (std::abs(ta.radius - tb.radius) > 0.25 * std::max(ta.radius, tb.radius) ||
-            std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5)
+            std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5 ||
+            !continuesAxis(ta, tb, options.maxJoinGap * std::max(ta.radius, tb.radius),
+                           options.maxJoinOffset * std::max(ta.radius, tb.radius),
+                           2 * std::max(ta.radius, tb.radius)))
           continue;
         std::vector<Index> both;
         std::merge(kept[a].points.begin(), kept[a].points.end(), kept[b].points.begin(),
                    kept[b].points.end(), std::back_inserter(both));
-        TubeFit fit = fitTube(positions, normals, scaleNormals, kappa1, both, t, tube);
+        TubeFit fit = fitTube(positions, normals, scaleNormals, kappa1, both, t, partTube);
         if (!fit.isTube() || !(fit.radius < options.maxRadiusRatio * whole.radius)) continue;
         kept[a] = {std::move(both), std::move(fit)};
         kept.erase(kept.begin() + std::ptrdiff_t(b));

@@ -39,6 +39,24 @@ struct TubeSplitOptions {
   /// the whole cable's), and it gives its points only to parts whose tubes are that thin
   /// (features/CylinderDetection).
   double maxRadiusRatio = 0.6;
+  /// Two parts of the same radius that lie end to end are joined into one (when their union is
+  /// still a tube) where one axis continues the other (continuesAxis): their nearest ends at most
+  /// maxJoinGap x that radius apart, each ahead of the other's end within maxJoinOffset x the
+  /// radius (+ half the distance ahead) of the line along which that axis leaves its tube. That
+  /// is one strand cut across where its proposals thin out (3.7 radii apart on the noisy pipe
+  /// rack); a scan from one side sees the strands of a cable in turn, each piece beginning where
+  /// another ends but two radii aside, and a curved axis would bridge them.
+  double maxJoinGap = 5;
+  double maxJoinOffset = 1;
+  /// The parts' tubes take the straight axis only where its radius is within this factor of the
+  /// part's median curvature radius, or closer to it than the curved axis's
+  /// (TubeFitOptions::maxRadiusDisagreement): a run of a twisted strand seen from one side lies
+  /// on the cable's envelope too, a straight tube of twice its radius over a narrow arc.
+  double partRadiusDisagreement = 1.5;
+  /// The parts' tubes need their normals to turn by this much around the axis
+  /// (TubeFitOptions::minArcDegrees, 135 for a grown region): the strands of a cable scanned from
+  /// one side hide one another's flanks, and each is seen over less than the half-pipe's 180.
+  double partMinArcDegrees = 105;
 };
 
 /// The parts of `points` (indices into positions and the scale fields of scale t) whose proposals
@@ -52,17 +70,28 @@ std::vector<std::vector<Index>> splitByProposedAxes(
     const std::vector<float>& kappa1, const std::vector<Index>& points, double t,
     double minCurvatureFactor, std::size_t minPoints, const TubeSplitOptions& options = {});
 
+/// Whether b's axis continues a's: their nearest ends at most maxGap apart, and each end ahead
+/// of the other, within maxOffset (+ half the distance ahead) of the line along which the other
+/// axis leaves its tube, measured over its last directionReach (false for an axis of fewer than
+/// two vertices). Two pieces of one strand pass; the runs of two strands that a scan from one
+/// side sees in turn, each beginning where another ends but beside it, do not.
+bool continuesAxis(const TubeFit& a, const TubeFit& b, double maxGap, double maxOffset,
+                   double directionReach = 0);
+
 struct ThinTube {
   std::vector<Index> points;  // sorted
   TubeFit tube;
 };
 
-/// The tubes a region (`points`, whose tube is `whole`) splits into: only a tube or a rough one
-/// (TubeRejection::Rough), and only where its points' median curvature radius is below
-/// maxRadiusRatio x whole.radius (one tube, whatever its noise, reads
+/// The tubes a region (`points`, whose tube is `whole`) splits into: only a tube, a rough one or
+/// one over a narrow arc (a cable seen from one side), and only where its points' median
+/// curvature radius is below maxRadiusRatio x whole.radius (one tube, whatever its noise, reads
 /// its own radius and is never split), by splitByProposedAxes, again on each part whose own
-/// curvature still sees thinner tubes (up to 3 times); kept when two or more parts are tubes
-/// thinner than maxRadiusRatio x whole.radius and hold half of the points, else empty.
+/// curvature still sees thinner tubes (up to 3 times: two strands' runs side by side); the final
+/// parts fitted with the part options (partRadiusDisagreement, partMinArcDegrees) and joined
+/// where one continues another (continuesAxis, over the last 2 radii of each axis); kept when two
+/// or more parts are tubes thinner than maxRadiusRatio x whole.radius and hold half of the
+/// points, else empty.
 /// `normals` are the input's, `scaleNormals` and kappa1 those of scale t.
 std::vector<ThinTube> splitIntoThinnerTubes(const std::vector<Vec3>& positions,
                                             const std::vector<Vec3>& normals,
