@@ -112,3 +112,31 @@ TEST(TubeMerging, PiecesOfOneSplitRegionEndToEndMerge) {
   EXPECT_EQ(a.tubes[1].rejection, TubeRejection::Merged);
   EXPECT_EQ(a.tubes[2].rejection, TubeRejection::Merged);
 }
+
+TEST(TubeMerging, PartsOfOneSplitMergeOnlyWhereTheyMayBeOneStrand) {
+  // A cable scanned from one side shows its strands in turn: the run of one strand ends where the
+  // next strand's begins, two radii aside. Of one split, such parts are two strands; two pieces of
+  // one pipe end to end are one (mayBeOneStrand, features/TubeSplitting).
+  std::mt19937_64 rng(7);
+  Scene runs, pieces;
+  addTube(runs, Vec3(0, -0.05, 0), 0.05, -0.4, 0.0, 0, 3000, rng);
+  addTube(runs, Vec3(0, 0.05, 0), 0.05, 0.0, 0.4, 1, 3000, rng);
+  addTube(pieces, Vec3::Zero(), 0.05, -0.4, 0.0, 0, 3000, rng);
+  addTube(pieces, Vec3::Zero(), 0.05, 0.0, 0.4, 1, 3000, rng);
+  const double t = 0.03;
+  const Merged apart = fitAndMerge(runs, 2, t, {3, 3});
+  EXPECT_FALSE(mayBeOneStrand(apart.tubes[0], apart.tubes[1]));
+  EXPECT_TRUE(apart.tubes[0].isTube());
+  EXPECT_TRUE(apart.tubes[1].isTube());
+  EXPECT_EQ(apart.regions[1].size(), 3000u);
+  const auto fitPart = [&](int part) {
+    std::vector<Index> region;
+    for (std::size_t i = 0; i < pieces.part.size(); ++i)
+      if (pieces.part[i] == part) region.push_back(Index(i));
+    return fitTube(pieces.positions, pieces.normals, pieces.normals, pieces.kappa1, region, t);
+  };
+  EXPECT_TRUE(mayBeOneStrand(fitPart(0), fitPart(1)));
+  const Merged one = fitAndMerge(pieces, 2, t, {3, 3});
+  EXPECT_EQ(one.tubes[1].rejection, TubeRejection::Merged);
+  EXPECT_EQ(one.regions[0].size(), 6000u);
+}

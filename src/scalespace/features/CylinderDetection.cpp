@@ -273,7 +273,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     splitRegionsByAxes(positions, cloud.normals(), field, t, options, tubes, seg.regions,
                        splitFrom);
     mergeTouchingTubes(graph, positions, cloud.normals(), field, t, options.tube, tubes,
-                       seg.regions, splitFrom);
+                       seg.regions, splitFrom, options.split);
     extendTubes(graph, positions, cloud.normals(), tubes, seg.regions, options.coverage);
     CylinderLevel level;
     level.scale = t;

@@ -20,7 +20,8 @@ std::vector<int> tubeOwners(std::size_t pointCount, const std::vector<TubeFit>& 
 void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
                         const std::vector<Vec3>& normals, const LineAnisotropyField& field,
                         double t, const TubeFitOptions& options, std::vector<TubeFit>& tubes,
-                        std::vector<std::vector<Index>>& regions, const std::vector<int>& apart) {
+                        std::vector<std::vector<Index>>& regions, const std::vector<int>& apart,
+                        const TubeSplitOptions& split) {
   const std::vector<int> owner = tubeOwners(positions.size(), tubes, regions);
   std::map<std::pair<int, int>, std::size_t> edges;
   for (std::size_t p = 0; p < positions.size(); ++p) {
@@ -55,10 +56,10 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
     const int a = find(ab.first), b = find(ab.second);
     if (a == b) continue;
     const TubeFit &ta = tubes[std::size_t(a)], &tb = tubes[std::size_t(b)];
-    // Parts of one split region side by side are the strands it was split into; end to end, two
-    // pieces of one strand that the split's density levels cut.
-    if (share(groups[std::size_t(a)], groups[std::size_t(b)]) &&
-        std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5)
+    // Parts of one split region side by side are the strands it was split into, and end to end
+    // but aside the runs of two strands a scan from one side sees in turn; where one continues
+    // the other, two pieces of one strand that the split's density levels cut.
+    if (share(groups[std::size_t(a)], groups[std::size_t(b)]) && !mayBeOneStrand(ta, tb, split))
       continue;
     const double big = std::max(ta.radius, tb.radius);
     if (std::abs(ta.radius - tb.radius) > 0.25 * big) continue;

@@ -8,6 +8,7 @@
 #include "scalespace/core/Types.hpp"
 #include "scalespace/features/LineAnisotropy.hpp"
 #include "scalespace/features/TubeFit.hpp"
+#include "scalespace/features/TubeSplitting.hpp"
 
 namespace scalespace {
 
@@ -22,15 +23,15 @@ std::vector<int> tubeOwners(std::size_t pointCount, const std::vector<TubeFit>& 
 /// number of edges between them, then by index, so the result is deterministic. The merged tube
 /// takes the lower index (its region the union, sorted); the other is left with an empty region
 /// and TubeRejection::Merged.
-/// `apart` (may be empty): per region, a group id; two tubes of one group >= 0 lying side by side
-/// (over half of the vertices of one axis beside the other, within 3 radii, not beyond its ends)
-/// are never merged: the parts of one region split by their axes (features/TubeSplitting), where a
-/// curved axis can zigzag between two strands and fit both as one tube. End to end they may be:
-/// two pieces of one strand.
+/// `apart` (may be empty): per region, a group id; two tubes of one group >= 0 are the parts of
+/// one region split by their axes (features/TubeSplitting) and merge only where they may be
+/// pieces of one strand (mayBeOneStrand with `split`): side by side, a curved axis can zigzag
+/// between two strands and fit both as one tube; end to end but aside, it bridges the runs of two
+/// strands that a scan from one side sees in turn.
 void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& positions,
                         const std::vector<Vec3>& normals, const LineAnisotropyField& field,
                         double t, const TubeFitOptions& options, std::vector<TubeFit>& tubes,
                         std::vector<std::vector<Index>>& regions,
-                        const std::vector<int>& apart = {});
+                        const std::vector<int>& apart = {}, const TubeSplitOptions& split = {});
 
 }  // namespace scalespace

@@ -109,6 +109,13 @@ bool continuesAxis(const TubeFit& a, const TubeFit& b, double maxGap, double max
   return false;
 }
 
+bool mayBeOneStrand(const TubeFit& a, const TubeFit& b, const TubeSplitOptions& options) {
+  const double big = std::max(a.radius, b.radius);
+  return std::abs(a.radius - b.radius) <= 0.25 * big &&
+         std::max(shareBeside(a, b), shareBeside(b, a)) <= 0.5 &&
+         continuesAxis(a, b, options.maxJoinGap * big, options.maxJoinOffset * big, 2 * big);
+}
+
 void validateTubeSplitOptions(const TubeSplitOptions& options) {
   if (!(std::isfinite(options.cellFactor) && options.cellFactor > 0))
     throw OptionError("TubeSplitOptions::cellFactor must be finite and > 0");
@@ -287,12 +294,7 @@ std::vector<ThinTube> splitIntoThinnerTubes(const std::vector<Vec3>& positions,
     for (std::size_t a = 0; a < kept.size() && !joined; ++a)
       for (std::size_t b = a + 1; b < kept.size() && !joined; ++b) {
         const TubeFit &ta = kept[a].tube, &tb = kept[b].tube;
-        if (std::abs(ta.radius - tb.radius) > 0.25 * std::max(ta.radius, tb.radius) ||
-            std::max(shareBeside(ta, tb), shareBeside(tb, ta)) > 0.5 ||
-            !continuesAxis(ta, tb, options.maxJoinGap * std::max(ta.radius, tb.radius),
-                           options.maxJoinOffset * std::max(ta.radius, tb.radius),
-                           2 * std::max(ta.radius, tb.radius)))
-          continue;
+        if (!mayBeOneStrand(ta, tb, options)) continue;
         std::vector<Index> both;
         std::merge(kept[a].points.begin(), kept[a].points.end(), kept[b].points.begin(),
                    kept[b].points.end(), std::back_inserter(both));

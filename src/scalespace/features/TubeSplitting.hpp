@@ -78,6 +78,13 @@ std::vector<std::vector<Index>> splitByProposedAxes(
 bool continuesAxis(const TubeFit& a, const TubeFit& b, double maxGap, double maxOffset,
                    double directionReach = 0);
 
+/// Whether two parts of one split region may be pieces of one strand, to be joined: radii within
+/// 25% of the larger, neither beside the other (shareBeside, at most half of an axis), and one
+/// axis continuing the other (continuesAxis: within options.maxJoinGap and maxJoinOffset x the
+/// larger radius, the ends' directions over 2 radii). splitIntoThinnerTubes joins its parts by
+/// it, and features/TubeMerging merges the touching tubes of one split by it.
+bool mayBeOneStrand(const TubeFit& a, const TubeFit& b, const TubeSplitOptions& options = {});
+
 struct ThinTube {
   std::vector<Index> points;  // sorted
   TubeFit tube;
