@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/PointCloud.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
@@ -133,7 +134,7 @@ Run runFits(Surface& s, EstimatorKind kind, double t, int threads) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t n = 1000000, peerPoints = 20000;
   bool onlyW3 = false, sweep = true;
@@ -190,4 +191,8 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_curvature_speed", [&] { return run(argc, argv); });
 }

@@ -47,6 +47,7 @@
 #include <tuple>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/OrientedNormals.hpp"
@@ -337,7 +338,7 @@ void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   std::size_t points = 1000000;
   bool peers = true, cleanOnly = false, noisyOnly = false, estimate = false, pcaNormals = false;
   std::size_t normalK = 0;  // NormalEstimationOptions' defaults
@@ -347,9 +348,9 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--points" && i + 1 < argc)
-      points = std::stoul(argv[++i]);
+      points = scalespace::bench::countArgument(argv, ++i);
     else if (a == "--seed" && i + 1 < argc)
-      seed = std::stoull(argv[++i]);
+      seed = scalespace::bench::countArgument(argv, ++i);
     else if (a == "--no-peers")
       peers = false;
     else if (a == "--clean-only")
@@ -359,19 +360,19 @@ int main(int argc, char** argv) {
     else if (a == "--no-split")
       ours.split.enabled = false;
     else if (a == "--split-cell" && i + 1 < argc)
-      ours.split.cellFactor = std::stod(argv[++i]);
+      ours.split.cellFactor = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--split-density" && i + 1 < argc)
-      ours.split.minDensity = std::stod(argv[++i]);
+      ours.split.minDensity = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--split-link" && i + 1 < argc)
-      ours.split.linkRadius = std::stod(argv[++i]);
+      ours.split.linkRadius = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--split-steps" && i + 1 < argc)
-      ours.split.densitySteps = std::stoi(argv[++i]);
+      ours.split.densitySteps = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--scan" && i + 1 < argc)
       only = argv[++i];
     else if (a == "--scales" && i + 1 < argc)
-      ours.scaleCount = std::stoi(argv[++i]);
+      ours.scaleCount = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--tmin" && i + 1 < argc)
-      ours.tMin = std::stod(argv[++i]);
+      ours.tMin = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--curved-seeds-first")
       ours.lines.curvedSeedsFirst = true;
     else if (a == "--one-curvature-sign")
@@ -381,11 +382,11 @@ int main(int argc, char** argv) {
     else if (a == "--pca-normals")
       pcaNormals = true;
     else if (a == "--min-arc" && i + 1 < argc)
-      ours.tube.minArcDegrees = std::stod(argv[++i]);
+      ours.tube.minArcDegrees = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--max-gap" && i + 1 < argc)
-      ours.maxGapLevels = std::stoi(argv[++i]);
+      ours.maxGapLevels = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--normal-k" && i + 1 < argc)
-      normalK = std::stoul(argv[++i]);
+      normalK = scalespace::bench::countArgument(argv, ++i);
     else {
       std::fprintf(
           stderr,
@@ -443,4 +444,8 @@ int main(int argc, char** argv) {
     std::printf("\n");
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_cylinders", [&] { return run(argc, argv); });
 }

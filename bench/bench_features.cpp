@@ -99,6 +99,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/core/KnnGraph.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
@@ -1290,7 +1291,7 @@ std::vector<std::string> splitList(const std::string& list) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 100000;
   std::string dir = "/tmp/real/cgal/data/meshes";
@@ -1423,4 +1424,8 @@ int main(int argc, char** argv) {
     printMeans(rows);
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_features", [&] { return run(argc, argv); });
 }

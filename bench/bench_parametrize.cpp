@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/param/ConformalRelaxation.hpp"
 #include "scalespace/param/MeshlessDistortion.hpp"
@@ -170,7 +171,7 @@ std::vector<std::string> split(const std::string& text) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   std::size_t points = 100000;
   std::vector<ParamShape> shapes = allParamShapes();
   std::vector<double> noises{0, 1e-3};
@@ -182,31 +183,32 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--points" && i + 1 < argc) {
-      points = std::stoul(argv[++i]);
+      points = scalespace::bench::countArgument(argv, ++i);
     } else if (a == "--shapes" && i + 1 < argc) {
       shapes.clear();
       for (const std::string& s : split(argv[++i])) shapes.push_back(parseParamShape(s));
     } else if (a == "--noise" && i + 1 < argc) {
       noises.clear();
-      for (const std::string& s : split(argv[++i])) noises.push_back(std::stod(s));
+      for (const std::string& s : split(argv[++i]))
+        noises.push_back(scalespace::bench::parseNumber("--noise", s));
     } else if (a == "--scales" && i + 1 < argc) {
-      scales = std::stoi(argv[++i]);
+      scales = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--resolution" && i + 1 < argc) {
-      resolution = std::stoi(argv[++i]);
+      resolution = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--threads" && i + 1 < argc) {
-      threads = std::stoi(argv[++i]);
+      threads = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--relax-iterations" && i + 1 < argc) {
-      relaxIterations = std::stoi(argv[++i]);
+      relaxIterations = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--relax-max-solve" && i + 1 < argc) {
-      relaxMaxSolve = std::stoul(argv[++i]);
+      relaxMaxSolve = scalespace::bench::countArgument(argv, ++i);
     } else if (a == "--no-peers") {
       peers = false;
     } else if (a == "--relax-large-spheres") {
       largeSpheres = true;
     } else if (a == "--rigidity" && i + 1 < argc) {
-      rigidity = std::stod(argv[++i]);
+      rigidity = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--sphere-rigidity" && i + 1 < argc) {
-      sphereRigidity = std::stod(argv[++i]);
+      sphereRigidity = scalespace::bench::numberArgument(argv, ++i);
     } else {
       std::fprintf(stderr,
                    "usage: bench_parametrize [--points N] [--shapes a,b] [--noise 0,0.001] "
@@ -291,4 +293,8 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_parametrize", [&] { return run(argc, argv); });
 }

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "RansacPeer.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
@@ -200,7 +201,7 @@ void runOurs(const PointCloud& cloud, const std::vector<int>& gt, int faceCount,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 100000;
   int scales = 50, positional = 0;
@@ -273,4 +274,8 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_planes", [&] { return run(argc, argv); });
 }

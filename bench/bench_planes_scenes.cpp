@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "RansacPeer.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SceneGenerator.hpp"
@@ -496,7 +497,7 @@ void runPeer(const PointCloud& cloud, const Truth& truth, const char* scene, dou
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 300000;
   int scales = 50, minPersistence = 5;
@@ -576,4 +577,8 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_planes_scenes", [&] { return run(argc, argv); });
 }

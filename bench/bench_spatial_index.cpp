@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/KdTreeIndex.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
@@ -245,7 +246,7 @@ void benchSurface(const std::string& name, const std::vector<Vec3>& input, std::
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 1000000, queries = 0;
   bool normals = true;
@@ -270,4 +271,8 @@ int main(int argc, char** argv) {
   benchSurface("sphere", sphere(points), queries, normals);
   benchSurface("scan-like", scanLike(points), queries, normals);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("bench_spatial_index", [&] { return run(argc, argv); });
 }

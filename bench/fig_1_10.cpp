@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/Parallel.hpp"
 #include "scalespace/scales/PoissonDiskSampler.hpp"
@@ -282,7 +283,7 @@ void fig10Bench(const PointCloud& cloud, ScaleSpaceOptions options, const fs::pa
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t n = 1000000, fig10Points = 100000;
   int scales = 50, threads = 0, mlsSteps = -1;
@@ -292,21 +293,21 @@ int main(int argc, char** argv) {
   for (int a = 1; a + 1 < argc; a += 2) {
     const std::string k = argv[a], v = argv[a + 1];
     if (k == "--points")
-      n = std::stoul(v);
+      n = scalespace::bench::parseCount(k, v);
     else if (k == "--scales")
-      scales = std::stoi(v);
+      scales = scalespace::bench::parseInteger(k, v);
     else if (k == "--out")
       out = v;
     else if (k == "--mode")
       mode = v;
     else if (k == "--threads")
-      threads = std::stoi(v);
+      threads = scalespace::bench::parseInteger(k, v);
     else if (k == "--mls-steps")
-      mlsSteps = std::stoi(v);
+      mlsSteps = scalespace::bench::parseInteger(k, v);
     else if (k == "--fig10-points")
-      fig10Points = std::stoul(v);
+      fig10Points = scalespace::bench::parseCount(k, v);
     else if (k == "--tmax")
-      tMax = std::stod(v);
+      tMax = scalespace::bench::parseNumber(k, v);
     else if (k == "--robust")
       robust = v == "1";
     else {
@@ -332,4 +333,8 @@ int main(int argc, char** argv) {
   if (mode == "all" || mode == "fig10")
     fig10Bench(scanLikeCloud(fig10Points, 2), options, out, fig10Points / 100);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("fig_1_10", [&] { return run(argc, argv); });
 }

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "BenchMain.hpp"
 #include "scalespace/core/AnalyticSurface.hpp"
 #include "scalespace/core/MemoryReuse.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
@@ -135,7 +136,7 @@ void speed() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   scalespace::retainFreedMemory();  // as the CLI does (core/MemoryReuse.hpp)
   std::size_t points = 800000;
   bool runSpeed = true, runTable = true;
@@ -257,4 +258,8 @@ int main(int argc, char** argv) {
   }
   std::printf("\n");
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return scalespace::bench::guardedMain("table_1_1", [&] { return run(argc, argv); });
 }
