@@ -1303,67 +1303,67 @@ static int run(int argc, char** argv) {
     const std::string a = argv[i];
     const bool hasValue = i + 1 < argc;
     if (a == "--points" && hasValue) {
-      points = std::size_t(std::atoll(argv[++i]));
+      points = scalespace::bench::countArgument(argv, ++i);
     } else if (a == "--data" && hasValue) {
       dir = argv[++i];
     } else if (a == "--models" && hasValue) {
       models = splitList(argv[++i]);
     } else if (a == "--angle" && hasValue) {
-      angle = std::atof(argv[++i]);
+      angle = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--clean-only") {
       noisy = false;
     } else if (a == "--noise-only") {
       clean = false;
     } else if (a == "--salient" && hasValue) {
-      ourOptions.salientThreshold = std::atof(argv[++i]);
+      ourOptions.salientThreshold = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--vote-threshold" && hasValue) {
-      ourOptions.voteThreshold = std::atof(argv[++i]);
+      ourOptions.voteThreshold = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--min-curvature" && hasValue) {
-      ourOptions.minSalientCurvature = std::atof(argv[++i]);
+      ourOptions.minSalientCurvature = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--bound-cap" && hasValue) {
-      ourOptions.salientBoundCap = std::atof(argv[++i]);
+      ourOptions.salientBoundCap = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--all-salient") {
       ourOptions.ridgeOnly = false;
     } else if (a == "--noise-curvature" && hasValue) {
-      ourOptions.noiseSalientFactor = std::atof(argv[++i]);
+      ourOptions.noiseSalientFactor = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--min-scales" && hasValue) {
-      ourOptions.minVotingScales = std::atoi(argv[++i]);
+      ourOptions.minVotingScales = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--vote-radius" && hasValue) {
-      ourOptions.voteRadiusFactor = std::atof(argv[++i]);
+      ourOptions.voteRadiusFactor = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--random-seed-order") {
       ourOptions.lines.curvedSeedsFirst = false;
     } else if (a == "--max-turn" && hasValue) {
-      ourOptions.lines.maxTurnDegrees = std::atof(argv[++i]);
+      ourOptions.lines.maxTurnDegrees = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--collision" && hasValue) {
-      ourOptions.lines.collisionFraction = std::atof(argv[++i]);
+      ourOptions.lines.collisionFraction = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--beta" && hasValue) {
-      ourOptions.lines.beta = std::atof(argv[++i]);
+      ourOptions.lines.beta = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--border-offset" && hasValue) {
-      ourOptions.lines.borderOffset = std::atof(argv[++i]);
+      ourOptions.lines.borderOffset = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--curvature-gap" && hasValue) {
-      ourOptions.lines.minCurvatureGap = std::atof(argv[++i]);
+      ourOptions.lines.minCurvatureGap = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--min-piece-extent" && hasValue) {
-      ourOptions.minPieceExtent = std::atof(argv[++i]);
+      ourOptions.minPieceExtent = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--min-extent" && hasValue) {
-      ourOptions.minCurveExtent = std::atof(argv[++i]);
+      ourOptions.minCurveExtent = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--join-gap" && hasValue) {
-      ourOptions.joinGap = std::atof(argv[++i]);
+      ourOptions.joinGap = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--centreline-reach" && hasValue) {
-      ourOptions.centrelineReach = std::atof(argv[++i]);
+      ourOptions.centrelineReach = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--band-half-width" && hasValue) {
-      ourOptions.bandHalfWidth = std::atof(argv[++i]);
+      ourOptions.bandHalfWidth = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--crease-reach" && hasValue) {
-      ourOptions.creaseReach = std::atof(argv[++i]);
+      ourOptions.creaseReach = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--crease-half-width" && hasValue) {
-      ourOptions.creaseHalfWidth = std::atof(argv[++i]);
+      ourOptions.creaseHalfWidth = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--crease-flatness" && hasValue) {
-      ourOptions.creaseFlatness = std::atof(argv[++i]);
+      ourOptions.creaseFlatness = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--centreline-linearity" && hasValue) {
-      ourOptions.centrelineLinearity = std::atof(argv[++i]);
+      ourOptions.centrelineLinearity = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--across-weight" && hasValue) {
-      acrossWeight = std::atof(argv[++i]);
+      acrossWeight = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--sheet-normals" && hasValue) {
-      sheetNormals = std::atof(argv[++i]);
+      sheetNormals = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--no-visibility") {
       visibility = false;
     } else if (a == "--reflect") {

@@ -213,37 +213,37 @@ static int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--max-step" && i + 1 < argc) {
-      detection.growing.maxStep = std::atof(argv[++i]);
+      detection.growing.maxStep = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--max-rms" && i + 1 < argc) {
-      detection.planarity.maxRelativeRms = std::atof(argv[++i]);
+      detection.planarity.maxRelativeRms = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-rms" && i + 1 < argc) {
-      detection.merging.maxRelativeRms = std::atof(argv[++i]);
+      detection.merging.maxRelativeRms = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--no-refine-unlabelled") {
       detection.refinement.takeUnlabelled = false;
     } else if (a == "--fill-max-angle" && i + 1 < argc) {
-      detection.refinement.fillMaxAngleDegrees = std::atof(argv[++i]);
+      detection.refinement.fillMaxAngleDegrees = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-distance" && i + 1 < argc) {
-      detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
+      detection.refinement.maxRelativeDistance = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-gain" && i + 1 < argc) {
-      detection.refinement.minRelativeGain = std::atof(argv[++i]);
+      detection.refinement.minRelativeGain = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-offset" && i + 1 < argc) {
-      detection.refinement.minRelativeOffset = std::atof(argv[++i]);
+      detection.refinement.minRelativeOffset = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-width" && i + 1 < argc) {
-      detection.merging.minRelativeWidth = std::atof(argv[++i]);
+      detection.merging.minRelativeWidth = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--scene" && i + 1 < argc) {
       onlyScene = argv[++i];
     } else if (a == "--noise" && i + 1 < argc) {
-      onlyNoise = std::atof(argv[++i]);
+      onlyNoise = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--robust-tolerance" && i + 1 < argc) {
-      robustTolerance = std::atof(argv[++i]);
+      robustTolerance = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--robust-iterations" && i + 1 < argc) {
-      robustIterations = std::atoi(argv[++i]);
+      robustIterations = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--no-peers") {
       peers = false;
     } else if (positional == 0 && !a.empty() && a[0] != '-') {
-      points = std::size_t(std::atoll(argv[i])), ++positional;
+      points = scalespace::bench::parseCount("POINTS", argv[i]), ++positional;
     } else if (positional == 1 && !a.empty() && a[0] != '-') {
-      scales = std::atoi(argv[i]), ++positional;
+      scales = scalespace::bench::parseInteger("SCALES", argv[i]), ++positional;
     } else {
       std::fprintf(stderr, "bench_planes: unknown argument '%s'\n", argv[i]);
       return 2;

@@ -510,39 +510,39 @@ static int run(int argc, char** argv) {
     const std::string a = argv[i];
     const bool hasValue = i + 1 < argc;
     if (a == "--points" && hasValue) {
-      points = std::size_t(std::atoll(argv[++i]));
+      points = scalespace::bench::countArgument(argv, ++i);
     } else if (a == "--scales" && hasValue) {
-      scales = std::atoi(argv[++i]);
+      scales = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--scene" && hasValue) {
       onlyScene = argv[++i];
     } else if (a == "--noise" && hasValue) {
-      onlyNoise = std::atof(argv[++i]);
+      onlyNoise = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--min-persistence" && hasValue) {
-      minPersistence = std::atoi(argv[++i]);
+      minPersistence = scalespace::bench::integerArgument(argv, ++i);
     } else if (a == "--max-step" && hasValue) {
-      detection.growing.maxStep = std::atof(argv[++i]);
+      detection.growing.maxStep = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-rms" && hasValue) {
-      detection.merging.maxRelativeRms = std::atof(argv[++i]);
+      detection.merging.maxRelativeRms = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--no-refine-unlabelled") {
       detection.refinement.takeUnlabelled = false;
     } else if (a == "--fill-max-angle" && hasValue) {
-      detection.refinement.fillMaxAngleDegrees = std::atof(argv[++i]);
+      detection.refinement.fillMaxAngleDegrees = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-distance" && hasValue) {
-      detection.refinement.maxRelativeDistance = std::atof(argv[++i]);
+      detection.refinement.maxRelativeDistance = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--planar-noise" && hasValue) {
-      detection.planarity.noiseFactor = std::atof(argv[++i]);
+      detection.planarity.noiseFactor = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-gain" && hasValue) {
-      detection.refinement.minRelativeGain = std::atof(argv[++i]);
+      detection.refinement.minRelativeGain = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--refine-offset" && hasValue) {
-      detection.refinement.minRelativeOffset = std::atof(argv[++i]);
+      detection.refinement.minRelativeOffset = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-width" && hasValue) {
-      detection.merging.minRelativeWidth = std::atof(argv[++i]);
+      detection.merging.minRelativeWidth = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-parallel" && hasValue) {
-      detection.merging.parallelDegrees = std::atof(argv[++i]);
+      detection.merging.parallelDegrees = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--merge-deviation" && hasValue) {
-      detection.merging.maxRelativeDeviation = std::atof(argv[++i]);
+      detection.merging.maxRelativeDeviation = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--max-rms" && hasValue) {
-      detection.planarity.maxRelativeRms = std::atof(argv[++i]);
+      detection.planarity.maxRelativeRms = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--no-robust") {
       robust = false;
     } else if (a == "--no-ransac") {

@@ -256,7 +256,7 @@ static int run(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--queries") && i + 1 < argc)
       queries = std::strtoull(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      gRepeat = std::max(1, std::atoi(argv[++i]));
+      gRepeat = std::max(1, scalespace::bench::integerArgument(argv, ++i));
     else if (!std::strcmp(argv[i], "--no-normals"))
       normals = false;
     else {
