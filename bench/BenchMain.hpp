@@ -54,15 +54,12 @@ template <class Body>
 int guardedMain(const char* name, Body&& body) {
   try {
     return body();
-  } catch (const std::invalid_argument& error) {
-    std::fprintf(stderr, "%s: error: %s\n", name, error.what());
-    return 2;
-  } catch (const OptionError& error) {
-    std::fprintf(stderr, "%s: error: %s\n", name, error.what());
-    return 2;
   } catch (const std::exception& error) {
+    // A bad value or option (ours or the library's) is the caller's mistake: exit 2, as CLI11.
+    const bool usage = dynamic_cast<const std::invalid_argument*>(&error) != nullptr ||
+                       dynamic_cast<const OptionError*>(&error) != nullptr;
     std::fprintf(stderr, "%s: error: %s\n", name, error.what());
-    return 1;
+    return usage ? 2 : 1;
   }
 }
 

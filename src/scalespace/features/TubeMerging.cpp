@@ -59,10 +59,10 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
     // Parts of one split region side by side are the strands it was split into, and end to end
     // but aside the runs of two strands a scan from one side sees in turn; where one continues
     // the other, two pieces of one strand that the split's density levels cut.
-    if (share(groups[std::size_t(a)], groups[std::size_t(b)]) && !mayBeOneStrand(ta, tb, split))
-      continue;
     const double big = std::max(ta.radius, tb.radius);
-    if (std::abs(ta.radius - tb.radius) > 0.25 * big) continue;
+    const bool oneSplit = share(groups[std::size_t(a)], groups[std::size_t(b)]);
+    if (oneSplit ? !mayBeOneStrand(ta, tb, split) : std::abs(ta.radius - tb.radius) > 0.25 * big)
+      continue;
     std::vector<Index> both;
     both.reserve(regions[std::size_t(a)].size() + regions[std::size_t(b)].size());
     std::merge(regions[std::size_t(a)].begin(), regions[std::size_t(a)].end(),
