@@ -480,6 +480,35 @@ def test_cylinders_one_curvature_sign_equals_the_cli(tmp_path):
                             split_by_axes=False)) < 2
 
 
+def test_cylinders_trim_junctions_equals_the_cli(tmp_path):
+    # A cylinder (r 0.04) standing on a plane, no normals: at one scale the wall's region grows
+    # out onto the plane over the rounded foot and its tube, reading r 0.0465, is the reported
+    # one; trimmed to the points curving one way (trim_junctions, the default) it is the wall.
+    rng = np.random.default_rng(1)
+    r, h, d, side = 0.04, 0.1, 0.002, 0.25
+    nc = int(2 * np.pi * r * h / d**2)
+    theta, z = rng.uniform(0, 2 * np.pi, nc), rng.uniform(0, h, nc)
+    wall = np.stack([r * np.cos(theta), r * np.sin(theta), z], axis=1)
+    n = int(side * side / d**2)
+    plane = np.stack([rng.uniform(-side / 2, side / 2, n), rng.uniform(-side / 2, side / 2, n),
+                      np.zeros(n)], axis=1)
+    plane = plane[np.hypot(plane[:, 0], plane[:, 1]) > r]
+    points = np.concatenate([wall, plane])
+    points += rng.normal(0, 0.0005, points.shape)
+
+    def reported_radius(c):
+        best = max(c.components, key=lambda k: (k["persistence"], k["point_count"]))
+        return best["radius"]
+
+    trimmed = ss.cylinders(points)
+    assert abs(reported_radius(trimmed) - r) < 0.01 * r
+    assert reported_radius(ss.cylinders(points, trim_junctions=False)) > 1.1 * r
+    ss.write(str(tmp_path / "stand.ply"), points)
+    cli("cylinders", tmp_path / "stand.ply", "-o", tmp_path / "c", "--no-junction-trim")
+    untrimmed = json.loads((tmp_path / "c" / "components.json").read_text())["components"]
+    assert max(untrimmed, key=lambda k: (k["persistence"], k["point_count"]))["radius"] > 1.1 * r
+
+
 def test_cylinders_bad_options_and_cancel(pipes):
     _, cloud, cylinders, _ = pipes
     p = cloud.points[::20]

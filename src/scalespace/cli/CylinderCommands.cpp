@@ -167,6 +167,10 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_flag("!--no-axis-split", args->cylinders.split.enabled,
                 "do not split a region whose points' curvature reads tubes thinner than its own "
                 "by the axes they propose (the strands of a noisy cable grown into one region)");
+  cmd->add_flag("!--no-junction-trim", args->cylinders.trim.enabled,
+                "do not trim a region turned down as no tube to its points curving one way and "
+                "fit it again (a cylinder standing on a plane, grown out onto the plane over the "
+                "junction)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");

@@ -127,6 +127,34 @@ void splitRegionsByAxes(const std::vector<Vec3>& positions, const std::vector<Ve
   }
 }
 
+/// Each region turned down as flat, rough, narrow-arc or faceted, and not split, that trims to a
+/// tube (features/TubeTrimming) keeps only the trimmed points, with that tube; the rest are left
+/// free (extendTubes may give them back to it where they lie on it).
+void trimRejectedRegions(const KnnGraph& graph, const std::vector<Vec3>& positions,
+                         const std::vector<Vec3>& normals, const LineAnisotropyField& field,
+                         double t, const CylinderOptions& options, std::vector<TubeFit>& tubes,
+                         std::vector<std::vector<Index>>& regions) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, regions.size(), 1), [&](const auto& range) {
+    for (std::size_t r = range.begin(); r != range.end(); ++r) {
+      const TubeRejection why = tubes[r].rejection;
+      if (why != TubeRejection::None && why != TubeRejection::Flat && why != TubeRejection::Rough &&
+          why != TubeRejection::NarrowArc && why != TubeRejection::Faceted)
+        continue;
+      std::vector<Index> core = trimToOneCurvatureSign(
+          graph, field.kappa1, regions[r], t, options.tube.minCurvatureFactor,
+          options.tube.minPoints, options.trim,
+          why == TubeRejection::None ? options.trim.tubeMinAgainstShare : 0);
+      if (core.empty()) continue;
+      TubeFit fit = fitTube(positions, normals, field.normal, field.kappa1, core, t, options.tube);
+      if (!fit.isTube() || !(fit.radius >= options.trim.minRadiusScales * t)) continue;
+      if (tubes[r].isTube() && !(fit.rms * tubes[r].radius <= 0.5 * tubes[r].rms * fit.radius))
+        continue;
+      regions[r] = std::move(core);
+      tubes[r] = std::move(fit);
+    }
+  });
+}
+
 std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
                                   const CylinderOptions& options) {
   if (!options.scales.empty()) return options.scales;
@@ -208,6 +236,7 @@ void validateCylinderOptions(const CylinderOptions& options) {
   validateLineFilterOptions(options.filter);
   validateTubeFitOptions(options.tube);
   validateTubeSplitOptions(options.split);
+  validateTubeTrimOptions(options.trim);
   require(std::isfinite(options.coverage.rmsFactor) && options.coverage.rmsFactor >= 0,
           "TubeCoverageOptions::rmsFactor must be finite and >= 0");
   require(std::isfinite(options.coverage.radiusFraction) && options.coverage.radiusFraction >= 0,
@@ -272,6 +301,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     std::vector<int> splitFrom;
     splitRegionsByAxes(positions, cloud.normals(), field, t, options, tubes, seg.regions,
                        splitFrom);
+    trimRejectedRegions(graph, positions, cloud.normals(), field, t, options, tubes, seg.regions);
     mergeTouchingTubes(graph, positions, cloud.normals(), field, t, options.tube, tubes,
                        seg.regions, splitFrom, options.split);
     extendTubes(graph, positions, cloud.normals(), tubes, seg.regions, options.coverage);

@@ -11,7 +11,9 @@
 //      (optionally, not in the thesis, only over points curving as the seed does:
 //      oneCurvatureSign);
 //   4. a tube fitted to each region (features/TubeFit), the regions that are no tube dropped;
-//   5. (not in the thesis) a region whose points' curvature reads tubes thinner than its own is
+//   5. (not in the thesis) a region turned down that ran over a concave junction onto the surface
+//      a tube stands on is trimmed back to the points curving one way (features/TubeTrimming);
+//      a region whose points' curvature reads tubes thinner than its own is
 //      split by the axes they propose into those tubes (features/TubeSplitting: a noisy cable's
 //      strands grown into one region), touching tubes whose union is still a tube merge (the
 //      parts of one split region excepted), and each tube takes the free points lying on it next
@@ -28,6 +30,7 @@
 #include "scalespace/features/LineRegularity.hpp"
 #include "scalespace/features/TubeFit.hpp"
 #include "scalespace/features/TubeSplitting.hpp"
+#include "scalespace/features/TubeTrimming.hpp"
 
 namespace scalespace {
 
@@ -72,6 +75,10 @@ struct CylinderOptions {
   /// (Not in the thesis.) A rough region is split by the axes its points propose: the strands of
   /// a noisy cable that Eq. 3.10 grew into one region across their contacts.
   TubeSplitOptions split;
+  /// (Not in the thesis.) A region turned down as flat, rough, narrow-arc or faceted, and not
+  /// split, is trimmed to its points curving one way (features/TubeTrimming) and fitted again: a
+  /// cylinder standing on a plane, grown out onto the plane over their junction.
+  TubeTrimOptions trim;
   TubeCoverageOptions coverage;
   double minJaccard = 0.5;  // Sec. 2.3.2
   /// A component bridges up to this many levels where its tube was not found (core/RegionGraph):
