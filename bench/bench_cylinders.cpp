@@ -23,6 +23,7 @@
 //                   grown) [--split-cell F] [--split-density F] [--split-steps N]
 //                   [--split-link F] (TubeSplitOptions::cellFactor, minDensity, densitySteps,
 //                   linkRadius)
+//                   [--no-junction-trim] (ours: TubeTrimOptions::enabled off)
 //
 // Scores, per scene and method:
 //   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
@@ -359,6 +360,8 @@ static int run(int argc, char** argv) {
       noisyOnly = true;
     else if (a == "--no-split")
       ours.split.enabled = false;
+    else if (a == "--no-junction-trim")
+      ours.trim.enabled = false;
     else if (a == "--split-cell" && i + 1 < argc)
       ours.split.cellFactor = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--split-density" && i + 1 < argc)
@@ -394,7 +397,8 @@ static int run(int argc, char** argv) {
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
           "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS] "
-          "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F]\n");
+          "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F] "
+          "[--no-junction-trim]\n");
       return 2;
     }
   }
