@@ -141,6 +141,32 @@ TEST(Cylinders, AHalfPipeScanIsATube) {
   EXPECT_NEAR(c->tube.arcDegrees, 180, 30);
 }
 
+// Seen over 100 degrees only (a pole or a mug in one scan), a tube's arc is under the 135 one
+// scale needs, at every scale; found with the same radius at three scales it is a tube
+// (NarrowTubeOptions), seen at one scale only it is not.
+TEST(Cylinders, ANarrowArcIsATubeWhereItsRadiusHoldsAcrossScales) {
+  Tube tube;
+  tube.arc = 100 * kPi / 180;
+  const PointCloud cloud = sampleTube(tube, 6000);
+  CylinderOptions options = atScales({0.2, 0.3, 0.45});
+  const CylinderDetection d = detectCylinders(cloud, options);
+  const CylinderComponent* c = mostPersistent(d);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->persistence, 2);
+  EXPECT_NEAR(c->tube.radius, 1.0, 0.02);
+  EXPECT_LT(angleDegrees(c->tube.direction, tube.axis), 1.0);
+  EXPECT_LT(c->tube.arcDegrees, 135);
+  for (const CylinderLevel& level : d.levels)
+    for (const std::uint8_t narrow : level.narrow) EXPECT_EQ(narrow, 1);
+  options.narrow.enabled = false;
+  EXPECT_TRUE(detectCylinders(cloud, options).components.empty());
+  options.narrow.enabled = true;
+  options.narrow.minPersistence = 3;
+  EXPECT_TRUE(detectCylinders(cloud, options).components.empty());
+  options = atScales({0.3});
+  EXPECT_TRUE(detectCylinders(cloud, options).components.empty());
+}
+
 TEST(Cylinders, ATorusSectionIsOneBentTube) {
   const PointCloud cloud = sampleTorusSection(1.0, 0.25, 20000);
   const CylinderDetection d = detectCylinders(cloud, atScales({0.08, 0.12, 0.18}));
@@ -620,6 +646,12 @@ TEST(Cylinders, OptionsAreChecked) {
           "TubeFitOptions::maxRelativeRms");
   rejects([](CylinderOptions& o) { o.lines.beta = 0; }, "CurvatureLineOptions::beta");
   rejects([](CylinderOptions& o) { o.trim.keepFraction = 2; }, "TubeTrimOptions::keepFraction");
+  rejects([](CylinderOptions& o) { o.narrow.minArcDegrees = -1; },
+          "NarrowTubeOptions::minArcDegrees");
+  rejects([](CylinderOptions& o) { o.narrow.minPersistence = -1; },
+          "NarrowTubeOptions::minPersistence");
+  rejects([](CylinderOptions& o) { o.narrow.maxRadiusSpread = NAN; },
+          "NarrowTubeOptions::maxRadiusSpread");
   rejects([](CylinderOptions& o) { o.trim.minRadiusScales = -1; },
           "TubeTrimOptions::minRadiusScales");
   PointCloud bare;

@@ -509,6 +509,26 @@ def test_cylinders_trim_junctions_equals_the_cli(tmp_path):
     assert max(untrimmed, key=lambda k: (k["persistence"], k["point_count"]))["radius"] > 1.1 * r
 
 
+def test_cylinders_narrow_tubes_equal_the_cli(tmp_path):
+    # A unit tube seen over 100 degrees: under the 135 one scale needs, but found with the same
+    # radius at three scales (narrow_tubes, the default), as the CLI finds it.
+    rng = np.random.default_rng(2)
+    theta = rng.uniform(0, np.radians(100), 6000)
+    normals = np.stack([np.zeros_like(theta), np.cos(theta), np.sin(theta)], axis=1)
+    points = normals + np.stack([rng.uniform(0, 6, 6000), np.zeros(6000), np.zeros(6000)], axis=1)
+    found = ss.cylinders(points, normals, scales=[0.2, 0.3, 0.45])
+    assert len(found) == 1
+    assert found.components[0]["persistence"] == 2
+    assert abs(found.components[0]["radius"] - 1) < 0.02
+    assert len(ss.cylinders(points, normals, scales=[0.2, 0.3, 0.45], narrow_tubes=False)) == 0
+    ss.write(str(tmp_path / "arc.ply"), points, normals)
+    for flags, count in (((), 1), (("--no-narrow-tubes",), 0)):
+        out = tmp_path / ("c%d" % count)
+        cli("cylinders", tmp_path / "arc.ply", "-o", out, "--scales", 3, "--tmin", 0.2, "--tmax",
+            0.45, *flags)
+        assert len(json.loads((out / "components.json").read_text())["components"]) == count
+
+
 def test_cylinders_bad_options_and_cancel(pipes):
     _, cloud, cylinders, _ = pipes
     p = cloud.points[::20]

@@ -171,6 +171,10 @@ void addCylindersCommand(CLI::App& app) {
                 "do not trim a region turned down as no tube to its points curving one way and "
                 "fit it again (a cylinder standing on a plane, grown out onto the plane over the "
                 "junction)");
+  cmd->add_flag("!--no-narrow-tubes", args->cylinders.narrow.enabled,
+                "do not keep regions turned down for their arc alone (seen over 75 degrees or "
+                "more) that are found with the same radius at 3 or more scales (a cylinder seen "
+                "from one side)");
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");

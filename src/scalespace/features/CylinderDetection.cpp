@@ -155,6 +155,52 @@ void trimRejectedRegions(const KnnGraph& graph, const std::vector<Vec3>& positio
   });
 }
 
+/// Drops the narrow-arc tubes (CylinderLevel::narrow) of the components made of them alone that
+/// live under options.minPersistence steps or whose radii spread over options.maxRadiusSpread,
+/// from `levels` and `regionLevels` alike; whether any was dropped (the graph is then stale).
+bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOptions& options,
+                                std::vector<CylinderLevel>& levels,
+                                std::vector<RegionLevel>& regionLevels) {
+  std::vector<std::vector<std::uint8_t>> drop(levels.size());
+  for (std::size_t j = 0; j < levels.size(); ++j) drop[j].assign(levels[j].tubes.size(), 0);
+  bool any = false;
+  for (const GraphComponent& c : graph.components) {
+    bool allNarrow = true;
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0;
+    for (std::size_t k = 0; k < c.regionAt.size(); ++k) {
+      if (c.regionAt[k] < 0) continue;
+      const CylinderLevel& level = levels[std::size_t(c.birthLevel) + k];
+      allNarrow = allNarrow && level.narrow[std::size_t(c.regionAt[k])];
+      const double radius = level.tubes[std::size_t(c.regionAt[k])].radius;
+      smallest = std::min(smallest, radius);
+      largest = std::max(largest, radius);
+    }
+    if (!allNarrow || (c.persistence() >= options.minPersistence &&
+                       largest <= (1 + options.maxRadiusSpread) * smallest))
+      continue;
+    for (std::size_t k = 0; k < c.regionAt.size(); ++k)
+      if (c.regionAt[k] >= 0) drop[std::size_t(c.birthLevel) + k][std::size_t(c.regionAt[k])] = 1;
+    any = true;
+  }
+  if (!any) return false;
+  for (std::size_t j = 0; j < levels.size(); ++j) {
+    std::size_t kept = 0;
+    for (std::size_t r = 0; r < drop[j].size(); ++r) {
+      if (drop[j][r]) continue;
+      if (kept != r) {  // a self-move would empty them
+        levels[j].tubes[kept] = std::move(levels[j].tubes[r]);
+        levels[j].narrow[kept] = levels[j].narrow[r];
+        regionLevels[j].regions[kept] = std::move(regionLevels[j].regions[r]);
+      }
+      ++kept;
+    }
+    levels[j].tubes.resize(kept);
+    levels[j].narrow.resize(kept);
+    regionLevels[j].regions.resize(kept);
+  }
+  return true;
+}
+
 std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
                                   const CylinderOptions& options) {
   if (!options.scales.empty()) return options.scales;
@@ -237,6 +283,11 @@ void validateCylinderOptions(const CylinderOptions& options) {
   validateTubeFitOptions(options.tube);
   validateTubeSplitOptions(options.split);
   validateTubeTrimOptions(options.trim);
+  require(options.narrow.minArcDegrees >= 0 && options.narrow.minArcDegrees <= 360,
+          "NarrowTubeOptions::minArcDegrees must be in [0, 360]");
+  require(options.narrow.minPersistence >= 0, "NarrowTubeOptions::minPersistence must be >= 0");
+  require(std::isfinite(options.narrow.maxRadiusSpread) && options.narrow.maxRadiusSpread >= 0,
+          "NarrowTubeOptions::maxRadiusSpread must be finite and >= 0");
   require(std::isfinite(options.coverage.rmsFactor) && options.coverage.rmsFactor >= 0,
           "TubeCoverageOptions::rmsFactor must be finite and >= 0");
   require(std::isfinite(options.coverage.radiusFraction) && options.coverage.radiusFraction >= 0,
@@ -315,11 +366,27 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
       if (!tube.isTube()) ++level.rejections[std::size_t(tube.rejection)];
     RegionLevel regionLevel;
     regionLevel.t = t;
-    for (std::size_t r = 0; r < tubes.size(); ++r)
-      if (tubes[r].isTube()) {
+    TubeFitOptions narrowArc = options.tube;
+    narrowArc.minArcDegrees = std::min(narrowArc.minArcDegrees, options.narrow.minArcDegrees);
+    // The tubes took free points next to them (extendTubes): a narrow-arc region keeps the rest.
+    const std::vector<int> owner = tubeOwners(n, tubes, seg.regions);
+    for (std::size_t r = 0; r < tubes.size(); ++r) {
+      bool narrow = options.narrow.enabled && tubes[r].rejection == TubeRejection::NarrowArc &&
+                    judgeTube(tubes[r], t, narrowArc) == TubeRejection::None;
+      if (narrow) {
+        std::vector<Index>& points = seg.regions[r];
+        points.erase(
+            std::remove_if(points.begin(), points.end(), [&](Index i) { return owner[i] >= 0; }),
+            points.end());
+        narrow = points.size() >= options.tube.minPoints;
+      }
+      if (tubes[r].isTube() || narrow) {
+        if (narrow) tubes[r].rejection = TubeRejection::None;
         regionLevel.regions.push_back(std::move(seg.regions[r]));
         level.tubes.push_back(std::move(tubes[r]));
+        level.narrow.push_back(narrow);
       }
+    }
     level.anisotropy = field.sigma;
     level.seconds = secondsSince(levelStart);
     result.levels.push_back(std::move(level));
@@ -335,8 +402,11 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     const double b = result.levels[std::size_t(k)].tubes[std::size_t(s)].radius;
     return std::abs(a - b) <= 0.1 * std::max(a, b);
   };
-  result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard, nullptr,
+  result.graph = buildRegionGraph(regionLevels, n, options.minJaccard, nullptr,
                                   options.maxGapLevels, sameTube);
+  if (dropUnconfirmedNarrowTubes(result.graph, options.narrow, result.levels, regionLevels))
+    result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard, nullptr,
+                                    options.maxGapLevels, sameTube);
   for (std::size_t c = 0; c < result.graph.components.size(); ++c) {
     const GraphComponent& g = result.graph.components[c];
     CylinderComponent component;

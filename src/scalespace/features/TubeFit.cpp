@@ -612,21 +612,20 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 
-  if (fit.length < fit.radius)  // a ring shorter than its radius: too little to call a tube
-    fit.rejection = TubeRejection::TooSmall;
-  else if (fit.arcDegrees < options.minArcDegrees)
-    fit.rejection = TubeRejection::NarrowArc;
-  else if (!(fit.radius >= options.minRadiusFactor * t))
-    fit.rejection = TubeRejection::Thin;
-  else if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t)))
-    fit.rejection = TubeRejection::Rough;
-  else if (fit.normalDirections <
-               std::min(options.minNormalDirections, 0.5 * double(points.size())) ||
-           fit.sectorFill < options.minSectorFill)
-    fit.rejection = TubeRejection::Faceted;
-  else
-    fit.rejection = TubeRejection::None;
+  fit.rejection = judgeTube(fit, t, options);
   return fit;
+}
+
+TubeRejection judgeTube(const TubeFit& fit, double t, const TubeFitOptions& options) {
+  if (fit.length < fit.radius)  // a ring shorter than its radius: too little to call a tube
+    return TubeRejection::TooSmall;
+  if (fit.arcDegrees < options.minArcDegrees) return TubeRejection::NarrowArc;
+  if (!(fit.radius >= options.minRadiusFactor * t)) return TubeRejection::Thin;
+  if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t))) return TubeRejection::Rough;
+  if (fit.normalDirections < std::min(options.minNormalDirections, 0.5 * double(fit.pointCount)) ||
+      fit.sectorFill < options.minSectorFill)
+    return TubeRejection::Faceted;
+  return TubeRejection::None;
 }
 
 double shareBeside(const TubeFit& a, const TubeFit& b) {

@@ -105,6 +105,11 @@ struct TubeFit {
   std::size_t pointCount = 0;
 };
 
+/// The tests of a fitted tube (fitTube's last step), in order: TooSmall, NarrowArc, Thin, Rough,
+/// Faceted, else None; on its measures (length, arc, radius, RMS, normal directions, sector
+/// fill, point count) at scale t.
+TubeRejection judgeTube(const TubeFit& fit, double t, const TubeFitOptions& options);
+
 /// Fits the tube of `points` (indices into positions / normals / the scale fields). `normals` are
 /// the input's oriented normals; `scaleNormals` and `kappa1` those of scale t
 /// (LineAnisotropyField).

@@ -149,8 +149,8 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
                                        int scaleCount, double tmin, double tmax, double epsilon,
                                        double minAnisotropy, double minArc, double minSectorFill,
                                        double maxRms, bool oneCurvatureSign, bool splitByAxes,
-                                       bool trimJunctions, int maxGap, std::optional<int> threads,
-                                       py::object progress) {
+                                       bool trimJunctions, bool narrowTubes, int maxGap,
+                                       std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -165,6 +165,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.oneCurvatureSign = oneCurvatureSign;
   options.split.enabled = splitByAxes;
   options.trim.enabled = trimJunctions;
+  options.narrow.enabled = narrowTubes;
   options.maxGapLevels = maxGap;
   validateCylinderOptions(options);
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
@@ -234,6 +235,7 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
         "split_by_axes"_a = TubeSplitOptions{}.enabled,
         "trim_junctions"_a = TubeTrimOptions{}.enabled,
+        "narrow_tubes"_a = NarrowTubeOptions{}.enabled,
         "max_gap"_a = CylinderOptions{}.maxGapLevels, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
@@ -251,7 +253,9 @@ normals; off: Eq. 3.10 alone). split_by_axes: a region whose points' curvature r
 thinner than its own is split by the axes they propose (x - n / kappa1) into those tubes: the
 strands of a noisy cable grown into one region across their contacts. trim_junctions: a region
 turned down as no tube is trimmed to its points curving one way and fitted again (a cylinder
-standing on a plane, grown out onto the plane over the junction). max_gap: a component bridges up to this many levels where its
+standing on a plane, grown out onto the plane over the junction). narrow_tubes: a region turned
+down for its arc alone (75 degrees or more) is kept where it is found with the same radius at 3
+or more scales (a cylinder seen from one side). max_gap: a component bridges up to this many levels where its
 tube was not found (0: consecutive levels only, as the thesis). Without
 normals they are estimated (sheet planes, 10 neighbours) and oriented (MST of the PCA normals), as
 the CLI does. Returns a Cylinders.)doc");
