@@ -119,7 +119,8 @@ void validateCylinderOptions(const CylinderOptions& options);
 struct CylinderLevel {
   double scale = 0;
   std::size_t lines = 0, regularLines = 0, regions = 0;  // regions: grown, and split parts
-  /// How many regions each test of the tube fit turned down, indexed by TubeRejection.
+  /// How many regions each test of the tube fit turned down, indexed by TubeRejection (the
+  /// narrow-arc regions kept as narrow tubes included).
   std::vector<std::size_t> rejections;
   /// The tubes of this level, same order as the graph's regions at this level.
   std::vector<TubeFit> tubes;
