@@ -530,6 +530,10 @@ TEST(Cylinders, ACylinderStandingOnAPlaneIsTrimmedOffThePlane) {
   // The most plane points the most persistent component holds at any level, and its tube.
   const auto worst = [&](const CylinderOptions& options, TubeFit& tube) {
     const CylinderDetection d = detectCylinders(cloud, options);
+    // Every tube reports the points it holds (trimmed, merged, extended or narrow alike).
+    for (std::size_t j = 0; j < d.levels.size(); ++j)
+      for (std::size_t k = 0; k < d.levels[j].tubes.size(); ++k)
+        EXPECT_EQ(d.levels[j].tubes[k].pointCount, d.graph.levels[j].regions[k].size());
     const CylinderComponent* c = mostPersistent(d);
     if (!c) return std::size_t(-1);
     tube = c->tube;

@@ -379,6 +379,7 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
             std::remove_if(points.begin(), points.end(), [&](Index i) { return owner[i] >= 0; }),
             points.end());
         narrow = points.size() >= options.tube.minPoints;
+        tubes[r].pointCount = points.size();
       }
       if (tubes[r].isTube() || narrow) {
         if (narrow) tubes[r].rejection = TubeRejection::None;
