@@ -168,9 +168,9 @@ void addCylindersCommand(CLI::App& app) {
                 "do not split a region whose points' curvature reads tubes thinner than its own "
                 "by the axes they propose (the strands of a noisy cable grown into one region)");
   cmd->add_flag("!--no-junction-trim", args->cylinders.trim.enabled,
-                "do not trim a region turned down as no tube to its points curving one way and "
-                "fit it again (a cylinder standing on a plane, grown out onto the plane over the "
-                "junction)");
+                "do not trim a region turned down as no tube, or a tube partly curving against "
+                "itself, to its points curving one way and fit it again (a cylinder standing on a "
+                "plane, grown out onto the plane over the junction)");
   cmd->add_flag("!--no-narrow-tubes", args->cylinders.narrow.enabled,
                 "do not keep regions turned down for their arc alone (seen over 75 degrees or "
                 "more) that are found with the same radius at 3 or more scales (a cylinder seen "

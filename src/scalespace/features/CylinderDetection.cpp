@@ -128,8 +128,10 @@ void splitRegionsByAxes(const std::vector<Vec3>& positions, const std::vector<Ve
 }
 
 /// Each region turned down as flat, rough, narrow-arc or faceted, and not split, that trims to a
-/// tube (features/TubeTrimming) keeps only the trimmed points, with that tube; the rest are left
-/// free (extendTubes may give them back to it where they lie on it).
+/// tube (features/TubeTrimming) keeps only the trimmed points, with that tube; so does each tube
+/// of which TubeTrimOptions::tubeMinAgainstShare of the points curve against it, where the
+/// trimmed points' tube fits twice as well. The rest are left free (extendTubes may give them
+/// back to it where they lie on it).
 void trimRejectedRegions(const KnnGraph& graph, const std::vector<Vec3>& positions,
                          const std::vector<Vec3>& normals, const LineAnisotropyField& field,
                          double t, const CylinderOptions& options, std::vector<TubeFit>& tubes,
@@ -375,11 +377,17 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
                     judgeTube(tubes[r], t, narrowArc) == TubeRejection::None;
       if (narrow) {
         std::vector<Index>& points = seg.regions[r];
+        const std::size_t before = points.size();
         points.erase(
             std::remove_if(points.begin(), points.end(), [&](Index i) { return owner[i] >= 0; }),
             points.end());
-        narrow = points.size() >= options.tube.minPoints;
-        tubes[r].pointCount = points.size();
+        if (points.size() != before) {  // its tube is that of the points it keeps
+          tubes[r] = points.size() >= options.tube.minPoints
+                         ? fitTube(positions, cloud.normals(), field.normal, field.kappa1, points,
+                                   t, narrowArc)
+                         : TubeFit{};
+          narrow = tubes[r].isTube();
+        }
       }
       if (tubes[r].isTube() || narrow) {
         if (narrow) tubes[r].rejection = TubeRejection::None;

@@ -91,8 +91,9 @@ struct CylinderOptions {
   /// a noisy cable that Eq. 3.10 grew into one region across their contacts.
   TubeSplitOptions split;
   /// (Not in the thesis.) A region turned down as flat, rough, narrow-arc or faceted, and not
-  /// split, is trimmed to its points curving one way (features/TubeTrimming) and fitted again: a
-  /// cylinder standing on a plane, grown out onto the plane over their junction.
+  /// split, or a tube partly curving against itself, is trimmed to its points curving one way
+  /// (features/TubeTrimming) and fitted again: a cylinder standing on a plane, grown out onto the
+  /// plane over their junction.
   TubeTrimOptions trim;
   NarrowTubeOptions narrow;
   TubeCoverageOptions coverage;

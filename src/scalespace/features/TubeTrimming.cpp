@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/Error.hpp"
 #include "scalespace/scales/ScaleSeries.hpp"
 
@@ -23,6 +24,11 @@ std::vector<Index> trimToOneCurvatureSign(const KnnGraph& graph, const std::vect
                                           double minCurvatureFactor, std::size_t minPoints,
                                           const TubeTrimOptions& options, double minAgainstShare) {
   if (!options.enabled || points.size() < std::max<std::size_t>(minPoints, 1)) return {};
+  if (!std::is_sorted(points.begin(), points.end()) || points.back() >= graph.size() ||
+      points.back() >= kappa1.size())
+    throw OptionError(
+        "trimToOneCurvatureSign: the points must be sorted indices into the graph "
+        "and kappa1");
   std::vector<double> convex, concave;  // |kappa1| t of each sign, beyond minCurvatureFactor
   for (const Index i : points) {
     const double k = double(kappa1[i]) * t;
@@ -44,42 +50,34 @@ std::vector<Index> trimToOneCurvatureSign(const KnnGraph& graph, const std::vect
   if (double(against) < minAgainstShare * double(points.size())) return {};
   if (kept.size() < std::max<std::size_t>(minPoints, 1)) return {};
 
-  // The largest connected part of the kept points (breadth-first over the graph's edges between
-  // them; the first found on ties, so the result does not depend on anything but the input).
-  // Which kept point a graph vertex is: a table over the whole cloud, one per thread, cleared
-  // after use (a binary search per edge took a tenth of `cylinders`).
+  // The largest part of the kept points connected by the graph's edges between them, either way
+  // (the k-NN graph is directed); the one holding the lowest index on ties, so the result does
+  // not depend on anything but the input. Which kept point a graph vertex is: a table over the
+  // whole cloud, one per thread, cleared before anything can throw again (a binary search per
+  // edge took a tenth of `cylinders`).
+  DisjointSets sets(kept.size());
+  std::vector<std::size_t> sizes(kept.size(), 0);
   thread_local std::vector<std::uint32_t> slotOf;  // kept index + 1, 0: not kept
-  if (slotOf.size() < graph.size()) slotOf.assign(graph.size(), 0);
+  if (slotOf.size() < graph.size()) slotOf.resize(graph.size(), 0);
   for (std::size_t s = 0; s < kept.size(); ++s) slotOf[kept[s]] = std::uint32_t(s + 1);
-  std::vector<int> part(kept.size(), -1);
-  int best = -1;
-  std::size_t bestSize = 0;
-  std::vector<std::size_t> frontier;
-  for (std::size_t s = 0; s < kept.size(); ++s) {
-    if (part[s] >= 0) continue;
-    const int id = int(s);
-    part[s] = id;
-    std::size_t size = 1;
-    frontier.assign(1, s);
-    while (!frontier.empty()) {
-      const Index p = kept[frontier.back()];
-      frontier.pop_back();
-      for (std::size_t e = graph.offsets[p]; e < graph.offsets[p + 1]; ++e) {
-        const std::uint32_t q = slotOf[graph.neighbors[e]];
-        if (q == 0 || part[q - 1] >= 0) continue;
-        part[q - 1] = id;
-        ++size;
-        frontier.push_back(q - 1);
-      }
-    }
-    if (size > bestSize) best = id, bestSize = size;
-  }
+  for (std::size_t s = 0; s < kept.size(); ++s)
+    for (std::size_t e = graph.offsets[kept[s]]; e < graph.offsets[kept[s] + 1]; ++e)
+      if (const std::uint32_t q = slotOf[graph.neighbors[e]]) sets.unite(Index(s), Index(q - 1));
   for (const Index i : kept) slotOf[i] = 0;
+  std::vector<Index> rootOf(kept.size());
+  for (std::size_t s = 0; s < kept.size(); ++s) ++sizes[rootOf[s] = sets.find(Index(s))];
+  const std::size_t bestSize = *std::max_element(sizes.begin(), sizes.end());
+  Index best = 0;
+  for (std::size_t s = 0; s < kept.size(); ++s)
+    if (sizes[rootOf[s]] == bestSize) {
+      best = rootOf[s];
+      break;
+    }
   if (bestSize < std::max<std::size_t>(minPoints, 1) || bestSize == points.size()) return {};
   std::vector<Index> core;
   core.reserve(bestSize);
   for (std::size_t s = 0; s < kept.size(); ++s)
-    if (part[s] == best) core.push_back(kept[s]);
+    if (rootOf[s] == best) core.push_back(kept[s]);
   return core;
 }
 

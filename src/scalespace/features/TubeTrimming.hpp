@@ -8,7 +8,8 @@
 // A tube curves one way all round while the junction curves the other way, and strongly: there
 // kappa1 t read -1.4 against the wall's +0.35 (CylinderOptions::oneCurvatureSign cuts the
 // growth there, but needs consistently oriented normals everywhere, and on real scans cut tubes).
-// Only the regions turned down are trimmed, so no tube found without it changes.
+// The regions turned down are trimmed, and the tubes of which enough points curve against them,
+// where their trimmed points fit twice as well (TubeTrimOptions::tubeMinAgainstShare).
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"

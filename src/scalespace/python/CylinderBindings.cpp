@@ -252,7 +252,8 @@ does, which stops it at the groove between a noisy cable's strands (needs consis
 normals; off: Eq. 3.10 alone). split_by_axes: a region whose points' curvature reads tubes
 thinner than its own is split by the axes they propose (x - n / kappa1) into those tubes: the
 strands of a noisy cable grown into one region across their contacts. trim_junctions: a region
-turned down as no tube is trimmed to its points curving one way and fitted again (a cylinder
+turned down as no tube, or a tube partly curving against itself, is trimmed to its points
+curving one way and fitted again (a cylinder
 standing on a plane, grown out onto the plane over the junction). narrow_tubes: a region turned
 down for its arc alone (75 degrees or more) is kept where it is found with the same radius at 3
 or more scales (a cylinder seen from one side). max_gap: a component bridges up to this many levels where its
