@@ -1414,6 +1414,7 @@ static int run(int argc, char** argv) {
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
           estimateSceneNormals(cloud);
+          if (meshNormals) cloud.setNormals(m.meshNormals);
           if (printPerCurve) printOrientation(m, cloud, "noisy");
           runMethods(m, cloud, peers, rows);
         }

@@ -135,6 +135,9 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("c.ply") + " --max-gap -1 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--max-gap"), std::string::npos) << r.err;
+  r = run("cylinders " + path("c.ply") + " --nested-link-tolerance 1 -q -o " + path("o"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--nested-link-tolerance"), std::string::npos) << r.err;
   r = run("cylinders " + path("c.ply") + " --tmin 1 --tmax 0.5 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--tmax"), std::string::npos) << r.err;

@@ -73,7 +73,9 @@ TEST(RegionGraph, BridgesGapsWhenAsked) {
   levels[4].regions = {{6, 7}, {0, 1, 2, 3}};
   // Without bridges: {0..3} at 0-1, {6,7} at 0, {5} at 2, {0..3,5} at 3-4, {6,7} at 4.
   EXPECT_EQ(buildRegionGraph(levels, 8).components.size(), 5u);
-  const RegionGraph g = buildRegionGraph(levels, 8, 0.5, nullptr, 2);
+  RegionLinkOptions bridging;
+  bridging.maxGap = 2;
+  const RegionGraph g = buildRegionGraph(levels, 8, bridging);
   ASSERT_EQ(g.components.size(), 4u);
   const GraphComponent& tube = g.components[0];
   EXPECT_EQ(tube.birthLevel, 0);
@@ -86,11 +88,15 @@ TEST(RegionGraph, BridgesGapsWhenAsked) {
   EXPECT_EQ(g.components[1].persistence(), 0);
   EXPECT_EQ(g.componentLabels(2), (std::vector<int>{-1, -1, -1, -1, -1, 2, -1, -1}));
   EXPECT_EQ(g.components[3].birthLevel, 4);
-  EXPECT_EQ(buildRegionGraph(levels, 8, 0.5, nullptr, 3).components.size(), 3u);
+  bridging.maxGap = 3;
+  EXPECT_EQ(buildRegionGraph(levels, 8, bridging).components.size(), 3u);
   // The caller's test refuses a bridge (the tubes of both ends differ): no bridge is made.
-  const BridgeTest never = [](int, int, int, int) { return false; };
-  EXPECT_EQ(buildRegionGraph(levels, 8, 0.5, nullptr, 3, never).components.size(), 5u);
-  EXPECT_THROW(buildRegionGraph(levels, 8, 0.5, nullptr, -1), OptionError);
+  bridging.bridgeAllowed = [](const std::vector<RegionLevel>&, int, int, int, int) {
+    return false;
+  };
+  EXPECT_EQ(buildRegionGraph(levels, 8, bridging).components.size(), 5u);
+  bridging.maxGap = -1;
+  EXPECT_THROW(buildRegionGraph(levels, 8, bridging), OptionError);
 }
 
 // Regions of different kinds are never linked, whatever their Jaccard index: the chain splits.
@@ -102,12 +108,15 @@ TEST(RegionGraph, KindsKeepChainsApart) {
   levels[2].regions = {{0, 1, 2, 3, 4, 5}};
   EXPECT_EQ(buildRegionGraph(levels, 6).components.size(), 1u);
   const std::vector<std::vector<std::uint8_t>> kinds{{1}, {1}, {0}};
-  const RegionGraph g = buildRegionGraph(levels, 6, 0.5, &kinds);
+  RegionLinkOptions byKind;
+  byKind.kinds = &kinds;
+  const RegionGraph g = buildRegionGraph(levels, 6, byKind);
   ASSERT_EQ(g.components.size(), 2u);
   EXPECT_EQ(g.components[0].deathLevel, 1);
   EXPECT_EQ(g.components[1].birthLevel, 2);
   const std::vector<std::vector<std::uint8_t>> wrongSize{{1}, {1}};
-  EXPECT_THROW(buildRegionGraph(levels, 6, 0.5, &wrongSize), OptionError);
+  byKind.kinds = &wrongSize;
+  EXPECT_THROW(buildRegionGraph(levels, 6, byKind), OptionError);
 }
 
 // A preferred component wins over a more persistent one; among preferred ones (or with no
@@ -124,4 +133,52 @@ TEST(RegionGraph, PreferredComponentsWinThePersistenceLabels) {
   EXPECT_EQ(labelsByPersistence(m, persistence, 2, &preferred), (std::vector<int>{1, 2, 2}));
   const std::vector<std::uint8_t> short_{1};
   EXPECT_THROW(labelsByPersistence(m, persistence, 0, &short_), OptionError);
+}
+
+// Not in the thesis (RegionLinkOptions::nestedAllowed): a region holding more than half of a
+// smaller one's points links to it where J does not when the caller's test agrees, the largest
+// overlap first, between consecutive levels and across a gap.
+TEST(RegionGraph, NestedRegionsLinkWhenTheCallerAgrees) {
+  std::vector<RegionLevel> levels(4);
+  for (int j = 0; j < 4; ++j) levels[std::size_t(j)].t = 0.1 * (j + 1);
+  levels[0].regions = {{0, 1, 2}, {3, 4, 5, 6}};  // two pieces of level 1's first region
+  levels[1].regions = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, {20, 21, 22}};  // J 3/10 and 4/10
+  levels[2].regions = {{30}};                              // the second chain is missing here
+  levels[3].regions = {{20, 21, 22, 23, 24, 25, 26, 27}};  // J with {20, 21, 22}: 3/8
+  EXPECT_EQ(buildRegionGraph(levels, 31).components.size(), 6u);
+
+  RegionLinkOptions nested;
+  nested.maxGap = 1;
+  nested.nestedAllowed = [](const std::vector<RegionLevel>&, int, int, int, int) { return true; };
+  RegionGraph g = buildRegionGraph(levels, 31, nested);
+  ASSERT_EQ(g.components.size(), 4u);
+  EXPECT_EQ(g.successor[0], (std::vector<int>{-1, 0}));  // 4 shared points beat 3
+  EXPECT_EQ(g.components[1].persistence(), 1);
+  EXPECT_EQ(g.bridge[1][1], (std::pair<int, int>{3, 0}));
+  EXPECT_EQ(g.components[2].regionAt, (std::vector<int>{1, -1, 0}));
+  EXPECT_EQ(g.components[2].persistence(), 1);
+
+  // The test sees the levels: refusing the piece of 4 points lets the piece of 3 link.
+  nested.nestedAllowed = [](const std::vector<RegionLevel>& l, int j, int r, int, int) {
+    return l[std::size_t(j)].regions[std::size_t(r)].size() != 4;
+  };
+  g = buildRegionGraph(levels, 31, nested);
+  EXPECT_EQ(g.successor[0], (std::vector<int>{0, -1}));
+  // Without gaps allowed, no nested bridge either.
+  nested.maxGap = 0;
+  EXPECT_EQ(buildRegionGraph(levels, 31, nested).components.size(), 5u);
+  // A piece under a quarter of the larger region does not link, unless the ratio allows it.
+  levels[0].regions = {{0, 1}};
+  EXPECT_EQ(buildRegionGraph(levels, 31, nested).successor[0], (std::vector<int>{-1}));
+  nested.nestedMinSizeRatio = 0.2;
+  EXPECT_EQ(buildRegionGraph(levels, 31, nested).successor[0], (std::vector<int>{0}));
+  nested.nestedMinSizeRatio = 0;
+  EXPECT_THROW(buildRegionGraph(levels, 31, nested), OptionError);
+  nested.nestedMinSizeRatio = 0.25;
+  // An overlap of half the smaller region is not more than half: no link.
+  levels[0].regions = {{0, 1, 20, 21}};
+  levels[1].regions = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, {30, 31}};
+  levels[2].regions.clear();
+  levels[3].regions.clear();
+  EXPECT_EQ(buildRegionGraph(levels, 32, nested).successor[0], (std::vector<int>{-1}));
 }

@@ -167,6 +167,51 @@ TEST(Cylinders, ANarrowArcIsATubeWhereItsRadiusHoldsAcrossScales) {
   EXPECT_TRUE(detectCylinders(cloud, options).components.empty());
 }
 
+// A tube whose two seams along the axis are rough: the fine scale finds its two halves as two
+// tubes, the coarse scale the whole. J of a half with the whole is under 0.5, but each half lies
+// on the whole's tube (CylinderOptions::nestedLinkTolerance): the larger half and the whole are
+// one component.
+TEST(Cylinders, ATubeFoundInHalvesAndThenWholeIsOneComponent) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<Vec3> p(20000), n(20000);
+  std::vector<int> half(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double theta = u(rng) * 2 * kPi;
+    n[i] = Vec3(std::cos(theta), std::sin(theta), 0);
+    p[i] = n[i] + Vec3(0, 0, 6 * u(rng));
+    if (std::abs(std::sin(theta)) < std::sin(0.2)) p[i] += 0.1 * Vec3(g(rng), g(rng), g(rng));
+    half[i] = std::sin(theta) > 0;
+  }
+  PointCloud cloud;
+  cloud.setAbsolutePositions(p);
+  cloud.setNormals(std::move(n));
+  CylinderOptions options = atScales({0.1, 0.9});
+  const CylinderDetection d = detectCylinders(cloud, options);
+  ASSERT_EQ(d.levels[0].tubes.size(), 2u);
+  ASSERT_EQ(d.levels[1].tubes.size(), 1u);
+  ASSERT_EQ(d.components.size(), 2u);
+  const CylinderComponent* c = mostPersistent(d);
+  EXPECT_EQ(c->persistence, 1);
+  EXPECT_NEAR(c->tube.radius, 1.0, 0.01);
+  // Its fine region is one half, its coarse one the whole.
+  const RegionGraph& graph = d.graph;
+  const auto& fine =
+      graph.levels[0].regions[std::size_t(graph.components[std::size_t(c->id)].regionAt[0])];
+  std::size_t upper = 0;
+  for (Index i : fine) upper += std::size_t(half[i]);
+  EXPECT_TRUE(upper < fine.size() / 10 || upper > fine.size() * 9 / 10) << upper;
+  EXPECT_GT(graph.levels[1].regions[0].size(), p.size() * 9 / 10);
+  EXPECT_LT(jaccardIndex(fine, graph.levels[1].regions[0]), 0.5);
+  // A tolerance under the halves' median distance to the whole's surface (about 0.1% of the
+  // radius here), or none, keeps the three tubes apart.
+  options.nestedLinkTolerance = 1e-5;
+  EXPECT_EQ(detectCylinders(cloud, options).components.size(), 3u);
+  options.nestedLinkTolerance = 0;
+  EXPECT_EQ(detectCylinders(cloud, options).components.size(), 3u);
+}
+
 TEST(Cylinders, ATorusSectionIsOneBentTube) {
   const PointCloud cloud = sampleTorusSection(1.0, 0.25, 20000);
   const CylinderDetection d = detectCylinders(cloud, atScales({0.08, 0.12, 0.18}));
@@ -190,6 +235,23 @@ TEST(Cylinders, ATorusSectionIsOneBentTube) {
 // translated region fell into other cells and got another axis (and, in `scalespace cylinders`,
 // tubes accepted or rejected as the cloud moved: 9 vs 11 components on the pipe rack shifted by
 // 1 or 1000).
+TEST(TubeFit, MedianRelativeResidualOfPointsOnAnotherTube) {
+  TubeFit tube;
+  tube.axis = {Vec3(0, 0, 0), Vec3(0, 0, 6)};
+  tube.radii = {2, 2};
+  tube.radius = 2;
+  std::vector<Vec3> positions;
+  for (int k = 0; k < 9; ++k)  // 5 on the surface, 4 at 1.5 times the radius
+    positions.push_back((k < 5 ? 2.0 : 3.0) * Vec3(std::cos(k), std::sin(k), 0) + Vec3(0, 0, k));
+  std::vector<Index> all(9);
+  for (Index i = 0; i < 9; ++i) all[i] = i;
+  EXPECT_NEAR(medianRelativeResidual(positions, all, tube), 0.0, 1e-12);
+  EXPECT_NEAR(medianRelativeResidual(positions, {5, 6, 7}, tube), 0.5, 1e-12);
+  EXPECT_EQ(medianRelativeResidual(positions, {}, tube), 0.0);
+  tube.axis.resize(1);
+  EXPECT_TRUE(std::isinf(medianRelativeResidual(positions, all, tube)));
+}
+
 TEST(Cylinders, ATubeFitMovesWithTheCloud) {
   const PointCloud torus = sampleTorusSection(1.0, 0.25, 20000);
   std::vector<Index> points(torus.size());
@@ -658,6 +720,8 @@ TEST(Cylinders, OptionsAreChecked) {
           "NarrowTubeOptions::maxRadiusSpread");
   rejects([](CylinderOptions& o) { o.trim.minRadiusScales = -1; },
           "TubeTrimOptions::minRadiusScales");
+  rejects([](CylinderOptions& o) { o.nestedLinkTolerance = 1; },
+          "CylinderOptions::nestedLinkTolerance");
   PointCloud bare;
   bare.setAbsolutePositions(cloud.positions());
   EXPECT_THROW(detectCylinders(bare, atScales({0.3})), OptionError);

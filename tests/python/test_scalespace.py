@@ -529,6 +529,28 @@ def test_cylinders_narrow_tubes_equal_the_cli(tmp_path):
         assert len(json.loads((out / "components.json").read_text())["components"]) == count
 
 
+def test_cylinders_nested_links_equal_the_cli(tmp_path):
+    # A unit tube whose two seams along the axis are rough: two half tubes at t = 0.1, the whole
+    # at 0.9. A half and the whole fail J > 0.5, but the half lies on the whole's tube
+    # (nested_link_tolerance, the default): one component over both scales, as the CLI finds it.
+    rng = np.random.default_rng(1)
+    theta = rng.uniform(0, 2 * np.pi, 20000)
+    normals = np.stack([np.cos(theta), np.sin(theta), np.zeros_like(theta)], axis=1)
+    points = normals + np.stack([np.zeros_like(theta)] * 2 + [rng.uniform(0, 6, 20000)], axis=1)
+    seam = np.abs(np.sin(theta)) < np.sin(0.2)
+    points[seam] += rng.normal(0, 0.1, (seam.sum(), 3))
+    found = ss.cylinders(points, normals, scales=[0.1, 0.9])
+    assert sorted(c["persistence"] for c in found.components) == [0, 1]
+    apart = ss.cylinders(points, normals, scales=[0.1, 0.9], nested_link_tolerance=0)
+    assert sorted(c["persistence"] for c in apart.components) == [0, 0, 0]
+    ss.write(str(tmp_path / "seams.ply"), points, normals)
+    for flags, count in (((), 2), (("--nested-link-tolerance", 0), 3)):
+        out = tmp_path / ("c%d" % count)
+        cli("cylinders", tmp_path / "seams.ply", "-o", out, "--scales", 2, "--tmin", 0.1, "--tmax",
+            0.9, *flags)
+        assert len(json.loads((out / "components.json").read_text())["components"]) == count
+
+
 def test_cylinders_bad_options_and_cancel(pipes):
     _, cloud, cylinders, _ = pipes
     p = cloud.points[::20]
@@ -537,6 +559,7 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"max_rms": 0}, "max_rms"), ({"tmin": -1}, "tmin"),
                          ({"min_sector_fill": 2}, "min_sector_fill"),
                          ({"max_gap": -1}, "max_gap"),
+                         ({"nested_link_tolerance": 1}, "nested_link_tolerance"),
                          ({"scales": [0.2, 0.1]}, "scales")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.cylinders(p, **kwargs)

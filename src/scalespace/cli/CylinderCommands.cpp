@@ -161,6 +161,12 @@ void addCylindersCommand(CLI::App& app) {
                   "a component bridges up to this many scales where its tube was not found (0: "
                   "consecutive scales only, as the thesis)")
       ->capture_default_str();
+  cmd->add_option("--nested-link-tolerance", args->cylinders.nestedLinkTolerance,
+                  "tubes of two scales that fail the Jaccard rule but one of which holds over half "
+                  "of the other's points are one component when the smaller one's points lie on "
+                  "the larger one's tube within this share of its radius (median; 0: off): a "
+                  "scale that finds a piece of a tube the next finds whole")
+      ->capture_default_str();
   cmd->add_flag("--one-curvature-sign", args->cylinders.oneCurvatureSign,
                 "a region only grows over points curving the way its seed does, which stops it at "
                 "the groove between a noisy cable's strands; needs consistently oriented normals");
@@ -263,6 +269,7 @@ void addCylindersCommand(CLI::App& app) {
           {"min_sector_fill", o.tube.minSectorFill},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
+          {"nested_link_tolerance", o.nestedLinkTolerance},
           {"curved_seeds_first", o.lines.curvedSeedsFirst},
           {"threads", args->threads}}},
         {"levels", levels},

@@ -78,6 +78,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
     {"TubeFitOptions::minSectorFill", "--min-sector-fill"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
+    {"CylinderOptions::nestedLinkTolerance", "--nested-link-tolerance"},
     {"TubeFitOptions::maxRelativeRms", "--max-rms"},
     {"FlatteningOptions::scaleCount", "--scales"},
     {"FlatteningOptions::K", "--k"},

@@ -105,16 +105,37 @@ std::vector<int> RegionGraph::componentLabels(int level) const {
 }
 
 namespace {
-// For each region r of level `from` with wanted[r], the region of level `to` (of the same kind)
-// with Jaccard index > minJaccard, or -1. Regions of a level are disjoint, so J > 0.5 holds for
-// at most one: the answer does not depend on the order of the search.
-std::vector<int> linkLevels(const RegionGraph& graph, std::size_t from, std::size_t to,
-                            double minJaccard, const std::vector<std::vector<std::uint8_t>>* kinds,
-                            const std::vector<char>& wanted, const std::vector<char>& open) {
+struct NestedCandidate {
+  std::size_t common = 0;
+  int region = 0, laterRegion = 0;
+};
+
+struct LevelLinks {
+  std::vector<int> byJaccard;  // per region of level `from`: the region with J > minJaccard, or -1
+  std::vector<NestedCandidate> nested;  // options.nestedAllowed's, largest overlaps first
+};
+
+// Whether regions of sizes a and b sharing `common` points may link as nested ones.
+bool nestedSizes(std::size_t a, std::size_t b, std::size_t common,
+                 const RegionLinkOptions& options) {
+  const double smaller = double(std::min(a, b)), larger = double(std::max(a, b));
+  return double(common) > options.minJaccard * smaller &&
+         smaller >= options.nestedMinSizeRatio * larger;
+}
+
+// For each region r of level `from` with wanted[r], the open region of level `to` (of the same
+// kind) with Jaccard index > minJaccard: regions of a level are disjoint, so J > 0.5 holds for at
+// most one and the answer does not depend on the order of the search. With nestedAllowed, the
+// other open regions holding more than minJaccard of the smaller one's points that it accepts.
+LevelLinks linkLevels(const RegionGraph& graph, std::size_t from, std::size_t to,
+                      const RegionLinkOptions& options, const std::vector<char>& wanted,
+                      const std::vector<char>& open) {
   const std::vector<int> toLabels = regionLabels(graph.levels[to], graph.pointCount);
   const auto& here = graph.levels[from].regions;
   const auto& there = graph.levels[to].regions;
-  std::vector<int> link(here.size(), -1);
+  LevelLinks links;
+  links.byJaccard.assign(here.size(), -1);
+  std::vector<std::vector<NestedCandidate>> nested(here.size());
   tbb::parallel_for(std::size_t(0), here.size(), [&](std::size_t r) {
     if (!wanted[r]) return;
     std::unordered_map<int, std::size_t> overlap;
@@ -122,22 +143,37 @@ std::vector<int> linkLevels(const RegionGraph& graph, std::size_t from, std::siz
       if (toLabels[i] >= 0) ++overlap[toLabels[i]];
     for (const auto& [s, common] : overlap) {
       if (!open[std::size_t(s)]) continue;
-      if (kinds && (*kinds)[from][r] != (*kinds)[to][std::size_t(s)]) continue;
-      const std::size_t unionSize = here[r].size() + there[std::size_t(s)].size() - common;
-      if (double(common) > minJaccard * double(unionSize)) link[r] = s;  // Eq. 2.1
+      if (options.kinds && (*options.kinds)[from][r] != (*options.kinds)[to][std::size_t(s)])
+        continue;
+      const std::size_t size = there[std::size_t(s)].size();
+      if (double(common) > options.minJaccard * double(here[r].size() + size - common)) {
+        links.byJaccard[r] = s;  // Eq. 2.1
+      } else if (options.nestedAllowed && nestedSizes(here[r].size(), size, common, options) &&
+                 options.nestedAllowed(graph.levels, int(from), int(r), int(to), s)) {
+        nested[r].push_back({common, int(r), s});
+      }
     }
   });
-  return link;
+  for (const auto& candidates : nested)
+    links.nested.insert(links.nested.end(), candidates.begin(), candidates.end());
+  std::sort(links.nested.begin(), links.nested.end(),
+            [](const NestedCandidate& a, const NestedCandidate& b) {
+              if (a.common != b.common) return a.common > b.common;
+              return a.region != b.region ? a.region < b.region : a.laterRegion < b.laterRegion;
+            });
+  return links;
 }
 }  // namespace
 
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
-                             double minJaccard, const std::vector<std::vector<std::uint8_t>>* kinds,
-                             int maxGap, const BridgeTest& bridgeAllowed) {
-  if (!(minJaccard >= 0.5 && minJaccard < 1))
+                             const RegionLinkOptions& options) {
+  if (!(options.minJaccard >= 0.5 && options.minJaccard < 1))
     throw OptionError("the Jaccard threshold must be in [0.5, 1): below 0.5 links are ambiguous");
-  if (maxGap < 0) throw OptionError("region graph: the largest bridged gap must be >= 0 levels");
-  if (kinds) {
+  if (options.maxGap < 0)
+    throw OptionError("region graph: the largest bridged gap must be >= 0 levels");
+  if (!(options.nestedMinSizeRatio > 0 && options.nestedMinSizeRatio <= 1))
+    throw OptionError("region graph: the nested regions' size ratio must be in (0, 1]");
+  if (const auto* kinds = options.kinds) {
     bool sized = kinds->size() == levels.size();
     for (std::size_t j = 0; sized && j < levels.size(); ++j)
       sized = (*kinds)[j].size() == levels[j].regions.size();
@@ -160,19 +196,28 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
   }
   // Edges between consecutive levels: the candidates of region r at level j are the regions of
   // level j+1 holding its points; J > 0.5 holds for at most one of them (and, symmetrically, for
-  // at most one region of level j per region of level j+1).
+  // at most one region of level j per region of level j+1). Nested links take what J left free.
   for (std::size_t j = 0; j + 1 < m; ++j) {
-    graph.successor[j] = linkLevels(graph, j, j + 1, minJaccard, kinds,
-                                    std::vector<char>(graph.levels[j].regions.size(), 1),
-                                    std::vector<char>(graph.levels[j + 1].regions.size(), 1));
+    const LevelLinks links =
+        linkLevels(graph, j, j + 1, options, std::vector<char>(graph.levels[j].regions.size(), 1),
+                   std::vector<char>(graph.levels[j + 1].regions.size(), 1));
+    graph.successor[j] = links.byJaccard;
     for (std::size_t r = 0; r < graph.successor[j].size(); ++r)
       if (graph.successor[j][r] >= 0)
         predecessor[j + 1][std::size_t(graph.successor[j][r])] = int(r);
+    for (const NestedCandidate& c : links.nested) {
+      int& successor = graph.successor[j][std::size_t(c.region)];
+      int& before = predecessor[j + 1][std::size_t(c.laterRegion)];
+      if (successor >= 0 || before >= 0) continue;
+      successor = c.laterRegion;
+      before = c.region;
+    }
   }
   // Bridges: chain ends to chain starts 1..maxGap levels further, shorter gaps first. Two ends of
   // one level cannot both pass J > 0.5 with one start; an end of an earlier level that would,
-  // finds the start taken (one bridge per start, the first in this order).
-  for (int gap = 1; gap <= maxGap; ++gap)
+  // finds the start taken (one bridge per start, the first in this order). Nested bridges take
+  // what J left free at each gap and level.
+  for (int gap = 1; gap <= options.maxGap; ++gap)
     for (std::size_t j = 0; j + std::size_t(gap) + 1 < m; ++j) {
       const std::size_t k = j + std::size_t(gap) + 1;
       std::vector<char> ends(graph.levels[j].regions.size()),
@@ -181,14 +226,23 @@ RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointC
         ends[r] = graph.successor[j][r] < 0 && graph.bridge[j][r].first < 0;
       for (std::size_t s = 0; s < starts.size(); ++s) starts[s] = predecessor[k][s] < 0;
       if (std::find(ends.begin(), ends.end(), 1) == ends.end()) continue;
-      const std::vector<int> link = linkLevels(graph, j, k, minJaccard, kinds, ends, starts);
-      for (std::size_t r = 0; r < link.size(); ++r) {
-        const int s = link[r];
+      const LevelLinks links = linkLevels(graph, j, k, options, ends, starts);
+      const auto bridge = [&](int r, int s) {
+        graph.bridge[j][std::size_t(r)] = {int(k), s};
+        predecessor[k][std::size_t(s)] = r;
+      };
+      for (std::size_t r = 0; r < links.byJaccard.size(); ++r) {
+        const int s = links.byJaccard[r];
         if (s < 0 || predecessor[k][std::size_t(s)] >= 0) continue;
-        if (bridgeAllowed && !bridgeAllowed(int(j), int(r), int(k), s)) continue;
-        graph.bridge[j][r] = {int(k), s};
-        predecessor[k][std::size_t(s)] = int(r);
+        if (options.bridgeAllowed &&
+            !options.bridgeAllowed(graph.levels, int(j), int(r), int(k), s))
+          continue;
+        bridge(int(r), s);
       }
+      for (const NestedCandidate& c : links.nested)
+        if (graph.bridge[j][std::size_t(c.region)].first < 0 &&
+            predecessor[k][std::size_t(c.laterRegion)] < 0)
+          bridge(c.region, c.laterRegion);
     }
   // Chains start at the nodes without predecessor; levels and region indices increase, so the
   // component order (birth level, then region index) is deterministic.

@@ -87,17 +87,36 @@ int nearestScaleIndex(const std::vector<double>& scales, double t);
 /// Jaccard index |A n B| / |A u B| of two increasing index lists (Eq. 2.1).
 double jaccardIndex(const std::vector<Index>& a, const std::vector<Index>& b);
 
-/// Links consecutive levels (J > minJaccard, 0.5 in Sec. 2.3.2) and extracts the chains. With
-/// `kinds` (kinds[j][r] per region), only regions of the same kind are linked: a chain never
-/// mixes them (planes/RegionPlanarity.hpp: planar and non-planar regions). With maxGap > 0, a
-/// chain's last region also links to the first region of a chain starting up to maxGap + 1
-/// levels later (J > minJaccard; shorter gaps first, then lower levels and region indices), if
-/// `bridgeAllowed(level, region, laterLevel, laterRegion)` (when given) agrees: the primitives
-/// fitted to both must be one (the same tube radius), since nothing between them vouches for it.
-using BridgeTest = std::function<bool(int, int, int, int)>;
+/// Whether two regions of the graph being built hold one primitive: (levels, level, region,
+/// later level, later region). Called from several threads at once: it must only read.
+using LinkTest = std::function<bool(const std::vector<RegionLevel>&, int, int, int, int)>;
+
+struct RegionLinkOptions {
+  double minJaccard = 0.5;  // Eq. 2.1; in [0.5, 1)
+  /// kinds[j][r] per region: only regions of the same kind are linked, a chain never mixes them
+  /// (planes/RegionPlanarity.hpp: planar and non-planar regions).
+  const std::vector<std::vector<std::uint8_t>>* kinds = nullptr;
+  /// A chain's last region also links to the first region of a chain starting up to maxGap + 1
+  /// levels later (J > minJaccard; shorter gaps first, then lower levels and region indices), if
+  /// bridgeAllowed (when given) agrees: the primitives fitted to both must be one (the same tube
+  /// radius), since nothing between them vouches for it.
+  int maxGap = 0;
+  LinkTest bridgeAllowed;
+  /// (Not in the thesis.) Two regions that did not link by J, one holding more than minJaccard of
+  /// the other's points (|A n B| > minJaccard min(|A|, |B|)) and the smaller at least
+  /// nestedMinSizeRatio times as many points as the larger, link when nestedAllowed (when given)
+  /// agrees, between consecutive levels and across gaps alike: a scale that finds a large piece of
+  /// the primitive the next one finds whole. Such links are made after the J links of the same
+  /// levels, the largest overlaps first (then lower region indices), one successor and one
+  /// predecessor per region as ever.
+  LinkTest nestedAllowed;
+  double nestedMinSizeRatio = 0.25;  // in (0, 1]
+};
+
+/// Links consecutive levels (J > minJaccard, 0.5 in Sec. 2.3.2), then bridges and nested links as
+/// `options` asks, and extracts the chains. Throws OptionError on options out of range, kinds not
+/// one per region, or regions of a level that overlap or hold points out of range.
 RegionGraph buildRegionGraph(std::vector<RegionLevel> levels, std::size_t pointCount,
-                             double minJaccard = 0.5,
-                             const std::vector<std::vector<std::uint8_t>>* kinds = nullptr,
-                             int maxGap = 0, const BridgeTest& bridgeAllowed = {});
+                             const RegionLinkOptions& options = {});
 
 }  // namespace scalespace

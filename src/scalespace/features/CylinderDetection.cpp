@@ -281,6 +281,8 @@ void validateCylinderOptions(const CylinderOptions& options) {
   require(options.minJaccard >= 0.5 && options.minJaccard < 1,
           "CylinderOptions::minJaccard must be in [0.5, 1)");
   require(options.maxGapLevels >= 0, "CylinderOptions::maxGapLevels must be >= 0");
+  require(options.nestedLinkTolerance >= 0 && options.nestedLinkTolerance < 1,
+          "CylinderOptions::nestedLinkTolerance must be in [0, 1) (0: off)");
   validateLineFilterOptions(options.filter);
   validateTubeFitOptions(options.tube);
   validateTubeSplitOptions(options.split);
@@ -406,16 +408,30 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
   // Across a gap the two tubes must agree in radius (10%): a region that swallowed both walls of
   // a thick pipe at one scale (radius between them) shares most of its points with the outer
   // wall's tube of a later scale.
-  const auto sameTube = [&](int j, int r, int k, int s) {
+  RegionLinkOptions linking;
+  linking.minJaccard = options.minJaccard;
+  linking.maxGap = options.maxGapLevels;
+  linking.bridgeAllowed = [&](const std::vector<RegionLevel>&, int j, int r, int k, int s) {
     const double a = result.levels[std::size_t(j)].tubes[std::size_t(r)].radius;
     const double b = result.levels[std::size_t(k)].tubes[std::size_t(s)].radius;
     return std::abs(a - b) <= 0.1 * std::max(a, b);
   };
-  result.graph = buildRegionGraph(regionLevels, n, options.minJaccard, nullptr,
-                                  options.maxGapLevels, sameTube);
-  if (dropUnconfirmedNarrowTubes(result.graph, options.narrow, result.levels, regionLevels))
-    result.graph = buildRegionGraph(std::move(regionLevels), n, options.minJaccard, nullptr,
-                                    options.maxGapLevels, sameTube);
+  if (options.nestedLinkTolerance > 0)
+    linking.nestedAllowed = [&](const std::vector<RegionLevel>& regions, int j, int r, int k,
+                                int s) {
+      const std::vector<Index>& a = regions[std::size_t(j)].regions[std::size_t(r)];
+      const std::vector<Index>& b = regions[std::size_t(k)].regions[std::size_t(s)];
+      const bool aOnB = a.size() <= b.size();
+      const TubeFit& tube = aOnB ? result.levels[std::size_t(k)].tubes[std::size_t(s)]
+                                 : result.levels[std::size_t(j)].tubes[std::size_t(r)];
+      return medianRelativeResidual(positions, aOnB ? a : b, tube) <= options.nestedLinkTolerance;
+    };
+  result.graph = buildRegionGraph(std::move(regionLevels), n, linking);
+  if (dropUnconfirmedNarrowTubes(result.graph, options.narrow, result.levels,
+                                 result.graph.levels)) {
+    std::vector<RegionLevel> kept = std::move(result.graph.levels);
+    result.graph = buildRegionGraph(std::move(kept), n, linking);
+  }
   for (std::size_t c = 0; c < result.graph.components.size(); ++c) {
     const GraphComponent& g = result.graph.components[c];
     CylinderComponent component;

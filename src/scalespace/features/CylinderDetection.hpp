@@ -103,6 +103,16 @@ struct CylinderOptions {
   /// region at two middle scales and part again above them; without the bridge each wall was two
   /// components, the same tube reported twice. 0: the thesis' consecutive links only.
   int maxGapLevels = 2;
+  /// (Not in the thesis; 0: off.) Two tubes of linked levels (consecutive, or across a gap as
+  /// above) whose regions do not pass the Jaccard rule but one of which holds more than minJaccard
+  /// of the other's points also link when the smaller region's points lie on the larger one's
+  /// tube: the median of their distances to its surface within this share of its radius
+  /// (core/RegionGraph, RegionLinkOptions::nestedAllowed). A scale finds a piece of a tube that the
+  /// next finds whole, or a narrow arc whose fitted radius is loose while its points are not (the
+  /// mug of python3-pcl's mug scene: a wall of radius 0.040 read 0.055 over a 75-degree arc at
+  /// one scale, whole at the next but one). A strand's points on the whole cable's tube lie about
+  /// a quarter of its radius off.
+  double nestedLinkTolerance = 0.1;
 };
 
 /// The normals `cylinders` estimates for a cloud without any (CLI, Python): sheet normals

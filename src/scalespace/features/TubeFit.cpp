@@ -486,6 +486,22 @@ double TubeSurface::residual(const Vec3& p, Vec3* radial) const {
   return q.distance - ((1 - q.along) * tube_.radii[s] + q.along * tube_.radii[s + 1]);
 }
 
+double medianRelativeResidual(const std::vector<Vec3>& positions, const std::vector<Index>& points,
+                              const TubeFit& tube) {
+  if (points.empty()) return 0;
+  if (tube.axis.size() < 2 || !(tube.radius > 0)) return std::numeric_limits<double>::infinity();
+  const TubeSurface surface(tube);
+  constexpr std::size_t kMaxPoints = 4096;
+  const std::size_t stride = (points.size() + kMaxPoints - 1) / kMaxPoints;
+  std::vector<double> residuals;
+  residuals.reserve(points.size() / stride + 1);
+  for (std::size_t k = 0; k < points.size(); k += stride)
+    residuals.push_back(std::abs(surface.residual(positions[points[k]])));
+  const auto middle = residuals.begin() + std::ptrdiff_t(residuals.size() / 2);
+  std::nth_element(residuals.begin(), middle, residuals.end());
+  return *middle / tube.radius;
+}
+
 const char* tubeRejectionName(TubeRejection rejection) {
   switch (rejection) {
     case TubeRejection::None:

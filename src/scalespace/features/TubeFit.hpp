@@ -148,6 +148,13 @@ class TubeSurface {
   AxisLocator locator_;
 };
 
+/// The median over `points` (indices into positions) of |TubeSurface::residual| over the tube's
+/// mean radius: how well points fitted elsewhere lie on `tube` (0 for no points, infinity for a
+/// tube without an axis or radius). Every point
+/// counts up to 4096, then an even stride of them.
+double medianRelativeResidual(const std::vector<Vec3>& positions, const std::vector<Index>& points,
+                              const TubeFit& tube);
+
 /// The share of b's axis vertices that lie beside a's axis: their nearest point on it is not one
 /// of its ends, within 3 radii (the larger tube's). Two strands side by side: about 1 both ways;
 /// two pieces of one tube end to end: about 0.

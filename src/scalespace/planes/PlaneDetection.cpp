@@ -83,7 +83,10 @@ PlaneDetection buildPlaneDetection(const std::vector<Vec3>& positions,
   const auto planar = regionPlanarity(positions, levels, result.noiseRms, options.planarity);
   for (const auto& level : planar)
     result.nonPlanarRegions += std::size_t(std::count(level.begin(), level.end(), 0));
-  result.graph = buildRegionGraph(std::move(levels), positions.size(), options.minJaccard, &planar);
+  RegionLinkOptions linking;
+  linking.minJaccard = options.minJaccard;
+  linking.kinds = &planar;
+  result.graph = buildRegionGraph(std::move(levels), positions.size(), linking);
   result.timings.graph = secondsSince(start);
   start = std::chrono::steady_clock::now();
   ComponentOptions componentOptions;

@@ -97,6 +97,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"TubeFitOptions::minArcDegrees", "min_arc"},
     {"TubeFitOptions::minSectorFill", "min_sector_fill"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
+    {"CylinderOptions::nestedLinkTolerance", "nested_link_tolerance"},
     {"TubeFitOptions::maxRelativeRms", "max_rms"},
     {"the thread count (threads option)", "threads"},
     {"findSimilar: no component", "similar: no component"},

@@ -143,14 +143,12 @@ class Cylinders {
   Vec3 origin_;
 };
 
-std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handle& normals,
-                                       const py::handle& viewpoint,
-                                       const std::optional<std::vector<double>>& scales,
-                                       int scaleCount, double tmin, double tmax, double epsilon,
-                                       double minAnisotropy, double minArc, double minSectorFill,
-                                       double maxRms, bool oneCurvatureSign, bool splitByAxes,
-                                       bool trimJunctions, bool narrowTubes, int maxGap,
-                                       std::optional<int> threads, py::object progress) {
+std::unique_ptr<Cylinders> cylindersPy(
+    const py::handle& points, const py::handle& normals, const py::handle& viewpoint,
+    const std::optional<std::vector<double>>& scales, int scaleCount, double tmin, double tmax,
+    double epsilon, double minAnisotropy, double minArc, double minSectorFill, double maxRms,
+    bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap,
+    double nestedLinkTolerance, std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -167,6 +165,7 @@ std::unique_ptr<Cylinders> cylindersPy(const py::handle& points, const py::handl
   options.trim.enabled = trimJunctions;
   options.narrow.enabled = narrowTubes;
   options.maxGapLevels = maxGap;
+  options.nestedLinkTolerance = nestedLinkTolerance;
   validateCylinderOptions(options);
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud = makeCloud(asPoints(points), normals);
@@ -236,7 +235,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "split_by_axes"_a = TubeSplitOptions{}.enabled,
         "trim_junctions"_a = TubeTrimOptions{}.enabled,
         "narrow_tubes"_a = NarrowTubeOptions{}.enabled,
-        "max_gap"_a = CylinderOptions{}.maxGapLevels, "threads"_a = py::none(),
+        "max_gap"_a = CylinderOptions{}.maxGapLevels,
+        "nested_link_tolerance"_a = CylinderOptions{}.nestedLinkTolerance, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
@@ -246,20 +246,23 @@ scales themselves (increasing), else scale_count log-spaced ones in [tmin, tmax]
 median distance to the 10th neighbour, a tenth of the diagonal). epsilon: the region growing
 tolerance of Eq. 3.10; min_anisotropy: the least sigma of a region's points; min_arc: degrees
 the points' normals must turn around the axis; min_sector_fill: the share of the 10-degree
-sectors of that arc the normals must fill (a box edge rounded into a tube fills about half); max_rms: a tube's RMS distance to its surface
-over its radius. one_curvature_sign: a region only grows over points curving the way its seed
-does, which stops it at the groove between a noisy cable's strands (needs consistently oriented
-normals; off: Eq. 3.10 alone). split_by_axes: a region whose points' curvature reads tubes
-thinner than its own is split by the axes they propose (x - n / kappa1) into those tubes: the
-strands of a noisy cable grown into one region across their contacts. trim_junctions: a region
-turned down as no tube, or a tube partly curving against itself, is trimmed to its points
-curving one way and fitted again (a cylinder
+sectors of that arc the normals must fill (a box edge rounded into a tube fills about half);
+max_rms: a tube's RMS distance to its surface over its radius. one_curvature_sign: a region
+only grows over points curving the way its seed does, which stops it at the groove between a
+noisy cable's strands (needs consistently oriented normals; off: Eq. 3.10 alone).
+split_by_axes: a region whose points' curvature reads tubes thinner than its own is split by the
+axes they propose (x - n / kappa1) into those tubes: the strands of a noisy cable grown into one
+region across their contacts. trim_junctions: a region turned down as no tube, or a tube partly
+curving against itself, is trimmed to its points curving one way and fitted again (a cylinder
 standing on a plane, grown out onto the plane over the junction). narrow_tubes: a region turned
 down for its arc alone (75 degrees or more) is kept where it is found with the same radius at 3
-or more scales (a cylinder seen from one side). max_gap: a component bridges up to this many levels where its
-tube was not found (0: consecutive levels only, as the thesis). Without
-normals they are estimated (sheet planes, 10 neighbours) and oriented (MST of the PCA normals), as
-the CLI does. Returns a Cylinders.)doc");
+or more scales (a cylinder seen from one side). max_gap: a component bridges up to this many
+levels where its tube was not found (0: consecutive levels only, as the thesis).
+nested_link_tolerance: tubes of two levels that fail the Jaccard rule, one holding over half of
+the other's points, are one component when the smaller one's points lie on the larger one's tube
+within this share of its radius (median; 0: off). Without normals they are estimated (sheet
+planes, 10 neighbours) and oriented (MST of the PCA normals), as the CLI does. Returns a
+Cylinders.)doc");
 }
 
 }  // namespace scalespace::python
