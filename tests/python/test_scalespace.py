@@ -753,26 +753,36 @@ def test_ctrl_c_cancels_a_long_call_and_leaves_no_output(tmp_path):
     assert list(tmp_path.iterdir()) == []  # nor any temporary folder
 
 
-def test_two_threads_overlap_in_time():
+def test_a_call_lets_other_threads_run():
+    # The C++ work runs without the GIL: a pure-Python loop in another thread keeps counting
+    # while a call runs. With the GIL held it would count only in the interpreter's switch
+    # intervals (5 ms) around the call, a twentieth of what it counts in 0.1 s of this thread's
+    # sleep; the call lasts about 0.5 s. (Two calls' progress reports interleaving in time was
+    # the earlier check: under ctest -j2 one thread could get no core for the whole of the other's
+    # call.) Up to three tries, should a busy machine starve the loop.
     p = sphere_points(150000)
-    calls = {0: [], 1: []}
-    # Both calls start together: under load (ctest -j2) a thread could otherwise start after the
-    # other's call had ended, which says nothing about the GIL.
-    start = threading.Barrier(2)
+    count = [0]
+    done = threading.Event()
 
-    def run(k):
-        start.wait()
-        ss.curvature(p, p, scale_k=30, threads=1,
-                     progress=lambda f, s: calls[k].append(time.monotonic()))
-    threads = [threading.Thread(target=run, args=(k,)) for k in (0, 1)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    a, b = calls[0], calls[1]
-    assert len(a) > 2 and len(b) > 2
-    # With the GIL held the second call would start only after the first ended.
-    assert a[0] < b[-1] and b[0] < a[-1]
+    def spin():
+        while not done.is_set():
+            count[0] += 1
+    spinner = threading.Thread(target=spin)
+    spinner.start()
+    try:
+        for _ in range(3):
+            before = count[0]
+            time.sleep(0.1)
+            asleep = count[0] - before
+            before = count[0]
+            ss.curvature(p, p, scale_k=30, threads=1)
+            during = count[0] - before
+            if during > asleep / 2:
+                break
+    finally:
+        done.set()
+        spinner.join()
+    assert during > asleep / 2, (during, asleep)
 
 
 # ------------------------------------------------------- the input buffers kept between calls
