@@ -138,6 +138,12 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   r = run("cylinders " + path("c.ply") + " --nested-link-tolerance 1 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--nested-link-tolerance"), std::string::npos) << r.err;
+  for (const char* flag : {"--narrow-min-arc", "--narrow-min-persistence", "--narrow-radius-spread",
+                           "--trim-keep-fraction", "--trim-min-radius", "--trim-against-share"}) {
+    r = run("cylinders " + path("c.ply") + " " + flag + " -1 -q -o " + path("o"));
+    EXPECT_EQ(r.code, 2) << flag;
+    EXPECT_NE(r.err.find(flag), std::string::npos) << r.err;
+  }
   r = run("cylinders " + path("c.ply") + " --tmin 1 --tmax 0.5 -q -o " + path("o"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--tmax"), std::string::npos) << r.err;

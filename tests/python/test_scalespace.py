@@ -521,9 +521,14 @@ def test_cylinders_narrow_tubes_equal_the_cli(tmp_path):
     assert found.components[0]["persistence"] == 2
     assert abs(found.components[0]["radius"] - 1) < 0.02
     assert len(ss.cylinders(points, normals, scales=[0.2, 0.3, 0.45], narrow_tubes=False)) == 0
+    # Its normals turn by 100 degrees, and it lives 2 steps.
+    for kwargs in ({"narrow_min_arc": 110}, {"narrow_min_persistence": 3}):
+        assert len(ss.cylinders(points, normals, scales=[0.2, 0.3, 0.45], **kwargs)) == 0
     ss.write(str(tmp_path / "arc.ply"), points, normals)
-    for flags, count in (((), 1), (("--no-narrow-tubes",), 0)):
-        out = tmp_path / ("c%d" % count)
+    for k, (flags, count) in enumerate((((), 1), (("--no-narrow-tubes",), 0),
+                                        (("--narrow-min-arc", 110), 0),
+                                        (("--narrow-min-persistence", 3), 0))):
+        out = tmp_path / ("c%d" % k)
         cli("cylinders", tmp_path / "arc.ply", "-o", out, "--scales", 3, "--tmin", 0.2, "--tmax",
             0.45, *flags)
         assert len(json.loads((out / "components.json").read_text())["components"]) == count
@@ -560,6 +565,12 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"min_sector_fill": 2}, "min_sector_fill"),
                          ({"max_gap": -1}, "max_gap"),
                          ({"nested_link_tolerance": 1}, "nested_link_tolerance"),
+                         ({"narrow_min_arc": -1}, "narrow_min_arc"),
+                         ({"narrow_min_persistence": -1}, "narrow_min_persistence"),
+                         ({"narrow_radius_spread": -1}, "narrow_radius_spread"),
+                         ({"trim_keep_fraction": 2}, "trim_keep_fraction"),
+                         ({"trim_min_radius": -1}, "trim_min_radius"),
+                         ({"trim_against_share": 2}, "trim_against_share"),
                          ({"scales": [0.2, 0.1]}, "scales")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.cylinders(p, **kwargs)

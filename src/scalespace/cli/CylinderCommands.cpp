@@ -181,6 +181,29 @@ void addCylindersCommand(CLI::App& app) {
                 "do not keep regions turned down for their arc alone (seen over 75 degrees or "
                 "more) that are found with the same radius at 3 or more scales (a cylinder seen "
                 "from one side)");
+  cmd->add_option("--trim-keep-fraction", args->cylinders.trim.keepFraction,
+                  "the trimming keeps the points curving the way most of a region's do by at "
+                  "least this share of their median |kappa1| t")
+      ->capture_default_str();
+  cmd->add_option("--trim-min-radius", args->cylinders.trim.minRadiusScales,
+                  "a trimmed region replaces its region only as a tube of radius at least this "
+                  "many times the scale t (a box edge trimmed of its faces is a tube of the scale)")
+      ->capture_default_str();
+  cmd->add_option("--trim-against-share", args->cylinders.trim.tubeMinAgainstShare,
+                  "a tube is trimmed too when at least this share of its points curve against it")
+      ->capture_default_str();
+  cmd->add_option("--narrow-min-arc", args->cylinders.narrow.minArcDegrees,
+                  "degrees the normals of a region turned down for its arc alone must still turn "
+                  "for it to be kept as a narrow tube")
+      ->capture_default_str();
+  cmd->add_option("--narrow-min-persistence", args->cylinders.narrow.minPersistence,
+                  "a component of narrow tubes alone is kept when it lives at least this many "
+                  "scale steps (with radii as --narrow-radius-spread)")
+      ->capture_default_str();
+  cmd->add_option("--narrow-radius-spread", args->cylinders.narrow.maxRadiusSpread,
+                  "the radii of a component of narrow tubes alone must lie within this share of "
+                  "one another (the radius of a tube the scale makes grows with t)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
@@ -270,6 +293,15 @@ void addCylindersCommand(CLI::App& app) {
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
           {"nested_link_tolerance", o.nestedLinkTolerance},
+          {"axis_split", o.split.enabled},
+          {"junction_trim", o.trim.enabled},
+          {"trim_keep_fraction", o.trim.keepFraction},
+          {"trim_min_radius", o.trim.minRadiusScales},
+          {"trim_against_share", o.trim.tubeMinAgainstShare},
+          {"narrow_tubes", o.narrow.enabled},
+          {"narrow_min_arc", o.narrow.minArcDegrees},
+          {"narrow_min_persistence", o.narrow.minPersistence},
+          {"narrow_radius_spread", o.narrow.maxRadiusSpread},
           {"curved_seeds_first", o.lines.curvedSeedsFirst},
           {"threads", args->threads}}},
         {"levels", levels},

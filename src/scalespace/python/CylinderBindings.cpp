@@ -148,7 +148,9 @@ std::unique_ptr<Cylinders> cylindersPy(
     const std::optional<std::vector<double>>& scales, int scaleCount, double tmin, double tmax,
     double epsilon, double minAnisotropy, double minArc, double minSectorFill, double maxRms,
     bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap,
-    double nestedLinkTolerance, std::optional<int> threads, py::object progress) {
+    double nestedLinkTolerance, double trimKeepFraction, double trimMinRadius,
+    double trimAgainstShare, double narrowMinArc, int narrowMinPersistence,
+    double narrowRadiusSpread, std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -166,6 +168,12 @@ std::unique_ptr<Cylinders> cylindersPy(
   options.narrow.enabled = narrowTubes;
   options.maxGapLevels = maxGap;
   options.nestedLinkTolerance = nestedLinkTolerance;
+  options.trim.keepFraction = trimKeepFraction;
+  options.trim.minRadiusScales = trimMinRadius;
+  options.trim.tubeMinAgainstShare = trimAgainstShare;
+  options.narrow.minArcDegrees = narrowMinArc;
+  options.narrow.minPersistence = narrowMinPersistence;
+  options.narrow.maxRadiusSpread = narrowRadiusSpread;
   validateCylinderOptions(options);
   const std::optional<Vec3> view = asOptionalVec3(viewpoint, "viewpoint");
   PooledCloud cloud = makeCloud(asPoints(points), normals);
@@ -236,7 +244,13 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "trim_junctions"_a = TubeTrimOptions{}.enabled,
         "narrow_tubes"_a = NarrowTubeOptions{}.enabled,
         "max_gap"_a = CylinderOptions{}.maxGapLevels,
-        "nested_link_tolerance"_a = CylinderOptions{}.nestedLinkTolerance, "threads"_a = py::none(),
+        "nested_link_tolerance"_a = CylinderOptions{}.nestedLinkTolerance,
+        "trim_keep_fraction"_a = TubeTrimOptions{}.keepFraction,
+        "trim_min_radius"_a = TubeTrimOptions{}.minRadiusScales,
+        "trim_against_share"_a = TubeTrimOptions{}.tubeMinAgainstShare,
+        "narrow_min_arc"_a = NarrowTubeOptions{}.minArcDegrees,
+        "narrow_min_persistence"_a = NarrowTubeOptions{}.minPersistence,
+        "narrow_radius_spread"_a = NarrowTubeOptions{}.maxRadiusSpread, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
@@ -254,9 +268,12 @@ split_by_axes: a region whose points' curvature reads tubes thinner than its own
 axes they propose (x - n / kappa1) into those tubes: the strands of a noisy cable grown into one
 region across their contacts. trim_junctions: a region turned down as no tube, or a tube partly
 curving against itself, is trimmed to its points curving one way and fitted again (a cylinder
-standing on a plane, grown out onto the plane over the junction). narrow_tubes: a region turned
-down for its arc alone (75 degrees or more) is kept where it is found with the same radius at 3
-or more scales (a cylinder seen from one side). max_gap: a component bridges up to this many
+standing on a plane, grown out onto the plane over the junction): the points curving the way
+most do by at least trim_keep_fraction of their median |kappa1| t, kept as a tube of radius at
+least trim_min_radius t; a tube is trimmed when trim_against_share of its points curve against
+it. narrow_tubes: a region turned down for its arc alone (narrow_min_arc degrees or more) is kept
+where it is found over narrow_min_persistence scale steps or more with radii within
+narrow_radius_spread of one another (a cylinder seen from one side). max_gap: a component bridges up to this many
 levels where its tube was not found (0: consecutive levels only, as the thesis).
 nested_link_tolerance: tubes of two levels that fail the Jaccard rule, one holding over half of
 the other's points, are one component when the smaller one's points lie on the larger one's tube
