@@ -412,9 +412,8 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
   linking.minJaccard = options.minJaccard;
   linking.maxGap = options.maxGapLevels;
   linking.bridgeAllowed = [&](const std::vector<RegionLevel>&, int j, int r, int k, int s) {
-    const double a = result.levels[std::size_t(j)].tubes[std::size_t(r)].radius;
-    const double b = result.levels[std::size_t(k)].tubes[std::size_t(s)].radius;
-    return std::abs(a - b) <= 0.1 * std::max(a, b);
+    return radiiAgree(result.levels[std::size_t(j)].tubes[std::size_t(r)],
+                      result.levels[std::size_t(k)].tubes[std::size_t(s)], 0.1);
   };
   if (options.nestedLinkTolerance > 0)
     linking.nestedAllowed = [&](const std::vector<RegionLevel>& regions, int j, int r, int k,

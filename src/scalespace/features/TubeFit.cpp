@@ -486,6 +486,10 @@ double TubeSurface::residual(const Vec3& p, Vec3* radial) const {
   return q.distance - ((1 - q.along) * tube_.radii[s] + q.along * tube_.radii[s + 1]);
 }
 
+bool radiiAgree(const TubeFit& a, const TubeFit& b, double tolerance) {
+  return std::abs(a.radius - b.radius) <= tolerance * std::max(a.radius, b.radius);
+}
+
 double medianRelativeResidual(const std::vector<Vec3>& positions, const std::vector<Index>& points,
                               const TubeFit& tube) {
   if (points.empty()) return 0;

@@ -148,6 +148,9 @@ class TubeSurface {
   AxisLocator locator_;
 };
 
+/// Whether the mean radii of two tubes differ by at most `tolerance` times the larger one.
+bool radiiAgree(const TubeFit& a, const TubeFit& b, double tolerance);
+
 /// The median over `points` (indices into positions) of |TubeSurface::residual| over the tube's
 /// mean radius: how well points fitted elsewhere lie on `tube` (0 for no points, infinity for a
 /// tube without an axis or radius). Every point

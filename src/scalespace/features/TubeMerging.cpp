@@ -61,8 +61,7 @@ void mergeTouchingTubes(const KnnGraph& graph, const std::vector<Vec3>& position
     // the other, two pieces of one strand that the split's density levels cut.
     const double big = std::max(ta.radius, tb.radius);
     const bool oneSplit = share(groups[std::size_t(a)], groups[std::size_t(b)]);
-    if (oneSplit ? !mayBeOneStrand(ta, tb, split) : std::abs(ta.radius - tb.radius) > 0.25 * big)
-      continue;
+    if (oneSplit ? !mayBeOneStrand(ta, tb, split) : !radiiAgree(ta, tb, 0.25)) continue;
     std::vector<Index> both;
     both.reserve(regions[std::size_t(a)].size() + regions[std::size_t(b)].size());
     std::merge(regions[std::size_t(a)].begin(), regions[std::size_t(a)].end(),

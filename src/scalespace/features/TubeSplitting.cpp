@@ -111,8 +111,7 @@ bool continuesAxis(const TubeFit& a, const TubeFit& b, double maxGap, double max
 
 bool mayBeOneStrand(const TubeFit& a, const TubeFit& b, const TubeSplitOptions& options) {
   const double big = std::max(a.radius, b.radius);
-  return std::abs(a.radius - b.radius) <= 0.25 * big &&
-         std::max(shareBeside(a, b), shareBeside(b, a)) <= 0.5 &&
+  return radiiAgree(a, b, 0.25) && std::max(shareBeside(a, b), shareBeside(b, a)) <= 0.5 &&
          continuesAxis(a, b, options.maxJoinGap * big, options.maxJoinOffset * big, 2 * big);
 }
 
