@@ -557,8 +557,19 @@ void printOrientation(const Model& m, const PointCloud& cloud, const char* which
   for (std::size_t i = 0; i < m.meshNormals.size(); ++i)
     flipped += m.meshNormals[i].dot(cloud.normals()[i]) < 0;
   const double share = double(flipped) / double(std::max<std::size_t>(1, m.meshNormals.size()));
-  std::printf("# %s, %s: estimated normals opposite to the mesh's at %.1f %% of the points\n",
+  std::printf("# %s, %s: estimated normals opposite to the mesh's at %.1f %% of the points",
               m.name.c_str(), which, 100 * std::min(share, 1 - share));
+  // Where: among the feature points (within e of a sharp edge) or elsewhere.
+  if (m.gt.size() == m.meshNormals.size()) {
+    std::size_t onFeature = 0, features = 0;
+    for (std::size_t i = 0; i < m.gt.size(); ++i) {
+      if (m.gt[i] < 0) continue;
+      ++features;
+      onFeature += (m.meshNormals[i].dot(cloud.normals()[i]) < 0) != (2 * flipped > m.gt.size());
+    }
+    std::printf(" (%zu of the %zu feature points)", onFeature, features);
+  }
+  std::printf("\n");
 }
 
 Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, double angle) {
@@ -570,7 +581,6 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
   estimateSceneNormals(m.clean);
   m.meshNormals = truth;
-  if (printPerCurve) printOrientation(m, m.clean, "clean");
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
   m.diagonal = m.clean.boundingBoxDiagonal();
   m.spacing = meanKthNeighborDistance(m.clean.positions(), kSpacingNeighbors);  // ours' default
@@ -584,6 +594,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.gt.resize(m.gtEdge.size());
   for (std::size_t i = 0; i < m.gtEdge.size(); ++i)
     m.gt[i] = m.gtEdge[i] < 0 ? -1 : curveOfEdge.at(m.gtEdge[i]);
+  if (printPerCurve) printOrientation(m, m.clean, "clean");
   if (printPerCurve) {
     m.gt2 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                                  2 * m.spacing);
