@@ -101,6 +101,40 @@ TEST(CreaseLine, NoneOnAFlatFaceAndAFilletsMiddleOnAFillet) {
       << "curved beyond a strict flatness";
 }
 
+// Normals blended across the crease, as a neighbourhood straddling it estimates them: within
+// half a spacing of the edge each point's normal turns past the bisector, 10 degrees towards the
+// other face (55 degrees off its own). Split by normals, those points join the wrong side, which
+// is then no longer flat; split by position (the plane through a point on the edge, holding
+// `along` and the mean normal), the sides are the faces, their normals within the 60 degrees
+// that split allows, and the line is the edge. With a margin the points nearest that plane are
+// left out.
+TEST(CreaseLine, SidesByPositionStandBlendedNormals) {
+  Sample s = sharpEdge(90, 14);
+  const double past = 10 * M_PI / 180;
+  for (std::size_t i = 0; i < s.positions.size(); ++i)
+    if (distanceToXAxis(s.positions[i]) < 0.5 * kSpacing) {
+      const double side = s.normals[i].y() > 0 ? 1.0 : -1.0;
+      s.normals[i] = Vec3(0, -side * std::sin(past), std::cos(past));
+    }
+  const auto index = makeSpatialIndex(s.positions);
+  const Vec3 along = Vec3::UnitX(), onEdge = Vec3::Zero();
+  const Vec3 x(0, 0, -0.5 * kSpacing);  // inside the convex edge, where the APSS puts vertices
+  const auto byNormals = fitCreaseLine(s.positions, s.normals, *index, x, along, options());
+  EXPECT_TRUE(!byNormals || distanceToXAxis(byNormals->point) > 0.05 * kSpacing);
+  CreaseLineOptions position = options();
+  position.splitByPosition = true;
+  for (const double margin : {0.0, 0.3 * kSpacing}) {
+    position.sideMargin = margin;
+    const auto line = fitCreaseLine(s.positions, s.normals, *index, x, along, position, &onEdge);
+    ASSERT_TRUE(line) << margin;
+    EXPECT_LT(distanceToXAxis(line->point), 1e-9);
+    EXPECT_NEAR(line->turnDegrees, 90, 1e-6);
+  }
+  // A margin wider than the reach leaves no side.
+  position.sideMargin = 3 * kSpacing;
+  EXPECT_FALSE(fitCreaseLine(s.positions, s.normals, *index, x, along, position, &onEdge));
+}
+
 // A wedge half a spacing thick at its end, its faces tilted by 10 degrees each, its end (the rim)
 // not sampled, as a scan can leave it: within the reach of a point at the end lie both faces, and
 // their planes meet beyond the end, where no point lies.

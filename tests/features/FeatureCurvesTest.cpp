@@ -277,8 +277,14 @@ TEST(FeatureCurves, TheBandIsTrimmedToTheCentrelineOfTheVotes) {
   EXPECT_LT(beyond(trimmed, 1.2 * e), 0.25 * beyond(wide, 1.2 * e)) << beyond(wide, 1.2 * e);
   EXPECT_LT(beyond(trimmed, 1.2 * e), beyond(tight, 1.1 * e)) << "a wider band keeps more";
   // The cube's faces are flat: the line where they meet is the edge itself, and the band is the
-  // points within creaseHalfWidth (1) e of it.
-  EXPECT_EQ(beyond(planes, 1.0 * e + 1e-12), 0.0);
+  // points within creaseHalfWidth (1) e of it. (The sides by position, split by a plane through
+  // the salient vertices' centreline, take now and then a point of the other face next to the
+  // edge, which moves the line by a hundredth of e.)
+  EXPECT_EQ(beyond(planes, 1.02 * e), 0.0);
+  EXPECT_LT(beyond(planes, 1.0 * e + 1e-12), 0.002);
+  FeatureCurveOptions byNormals;
+  byNormals.creaseSidesByPosition = false;
+  EXPECT_EQ(beyond(detectFeatureCurves(cloud, byNormals), 1.0 * e + 1e-12), 0.0);
   EXPECT_GT(beyond(trimmed, 1.0 * e), 0.0) << "the centreline lies inside the edge";
   for (const Edge& edge : cubeEdges())
     EXPECT_GT(labelsAlong(cloud.positions(), planes, edge, 0.9 * e, +1).fraction, 0.95)
@@ -480,6 +486,9 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   refused([](auto& o) { o.creaseReach = -1; }, "FeatureCurveOptions::creaseReach");
   refused([](auto& o) { o.creaseHalfWidth = 0; }, "FeatureCurveOptions::creaseHalfWidth");
   refused([](auto& o) { o.creaseFlatness = std::nan(""); }, "FeatureCurveOptions::creaseFlatness");
+  refused([](auto& o) { o.creaseSideMargin = -1; }, "FeatureCurveOptions::creaseSideMargin");
+  refused([](auto& o) { o.creaseSideNoise = std::nan(""); },
+          "FeatureCurveOptions::creaseSideNoise");
   refused([](auto& o) { o.edgeRejoinAngle = 95; }, "FeatureCurveOptions::edgeRejoinAngle");
   // One scale cannot give the default 3 voting scales: the message names both fields and values.
   refused([](auto& o) { o.scaleCount = 1; },

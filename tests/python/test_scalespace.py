@@ -651,6 +651,8 @@ def test_render_lines_features(data):
         ss.features(cloud.points, noise_curvature=-1)
     with pytest.raises(ss.OptionError, match="crease_reach must be finite and >= 0"):
         ss.features(cloud.points, crease_reach=-1)
+    with pytest.raises(ss.OptionError, match="crease_side_margin must be finite and >= 0"):
+        ss.features(cloud.points, crease_side_margin=-1)
     # Without normals, features estimates sheet normals (0.05, the sign the rays prefer) or, with
     # sheet_normals=0, PCA ones, as estimate_normals does, their sign propagated by reflection.
     for sheet, result in ((0.05, features), (0, ss.features(cloud.points, sheet_normals=0))):

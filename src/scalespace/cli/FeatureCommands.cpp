@@ -290,6 +290,12 @@ void addFeaturesCommand(CLI::App& app) {
                   "a side is flat when its points lie within this x e (RMS; or twice the noise) "
                   "of its plane")
       ->capture_default_str();
+  cmd->add_option("--crease-side-margin", args->features.creaseSideMargin,
+                  "the sides are the points beyond this x e, less 3 noise RMS, of the plane "
+                  "through the centreline that holds their mean normal")
+      ->capture_default_str();
+  cmd->add_flag("!--crease-sides-by-normals", args->features.creaseSidesByPosition,
+                "tell the sides apart by their normals instead, which blend across the crease");
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e, after the joining (0 keeps all)")
       ->capture_default_str();
@@ -433,6 +439,8 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"crease_reach", options.creaseReach},
                                    {"crease_half_width", options.creaseHalfWidth},
                                    {"crease_flatness", options.creaseFlatness},
+                                   {"crease_sides_by_position", options.creaseSidesByPosition},
+                                   {"crease_side_margin", options.creaseSideMargin},
                                    {"edge_reach", options.edgeReach},
                                    {"edge_rejoin_angle", options.edgeRejoinAngle},
                                    {"curved_seeds_first", options.lines.curvedSeedsFirst},

@@ -70,6 +70,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::creaseReach", "--crease-reach"},
     {"FeatureCurveOptions::creaseHalfWidth", "--crease-half-width"},
     {"FeatureCurveOptions::creaseFlatness", "--crease-flatness"},
+    {"FeatureCurveOptions::creaseSideMargin", "--crease-side-margin"},
     {"CylinderOptions::scaleCount", "--scales"},
     {"CylinderOptions::tMin", "--tmin"},
     {"CylinderOptions::tMax", "--tmax"},

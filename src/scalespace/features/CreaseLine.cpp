@@ -17,9 +17,10 @@ struct SidePlane {
 /// Plane of one side's points by weighted least squares, the weights (1 - (d / reach)^2)^2 of
 /// their distance d to the query point, so that a curved face gives its tangent plane near the
 /// crease rather than a chord; oriented as their mean normal. Flat when the weighted RMS is within
-/// maxRms and nine in ten of the side's normals lie within 30 degrees of it.
+/// maxRms and nine in ten of the side's normals lie within normalAngleDegrees of it.
 SidePlane fitSide(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
-                  const std::vector<Neighbor>& side, double reach, double maxRms) {
+                  const std::vector<Neighbor>& side, double reach, double maxRms,
+                  double normalAngleDegrees) {
   SidePlane plane;
   Vec3 meanNormal = Vec3::Zero();
   double total = 0;
@@ -46,7 +47,7 @@ SidePlane fitSide(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   // part thinner than the reach, whose points can fit one plane between them.
   std::size_t along = 0;
   for (const Neighbor& nb : side)
-    along += normals[nb.index].dot(plane.normal) >= std::cos(30.0 * M_PI / 180.0);
+    along += normals[nb.index].dot(plane.normal) >= std::cos(normalAngleDegrees * M_PI / 180.0);
   plane.flat = rms <= maxRms && 10 * along >= 9 * side.size();
   return plane;
 }
@@ -61,7 +62,7 @@ double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirectio
 std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
                                         const std::vector<Vec3>& normals, const SpatialIndex& index,
                                         const Vec3& x, const Vec3& along,
-                                        const CreaseLineOptions& options) {
+                                        const CreaseLineOptions& options, const Vec3* centre) {
   std::vector<Neighbor> found;
   index.radiusSearch(x, options.reach, found);
   if (found.size() < std::size_t(2 * options.minSidePoints)) return std::nullopt;
@@ -73,12 +74,27 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
   const Vec3 across = along.cross(mean);
   if (!(across.norm() > 1e-9 * std::max(1.0, mean.norm()))) return std::nullopt;
   std::vector<Neighbor> sides[2];
-  for (const Neighbor& nb : found) sides[normals[nb.index].dot(across) >= 0 ? 1 : 0].push_back(nb);
+  if (options.splitByPosition) {
+    const Vec3 unitAcross = across.normalized();
+    const Vec3 origin = centre ? *centre : x;
+    for (const Neighbor& nb : found) {
+      const double side = (positions[nb.index] - origin).dot(unitAcross);
+      if (std::abs(side) > options.sideMargin) sides[side >= 0 ? 1 : 0].push_back(nb);
+    }
+  } else {
+    for (const Neighbor& nb : found)
+      sides[normals[nb.index].dot(across) >= 0 ? 1 : 0].push_back(nb);
+  }
   if (sides[0].size() < std::size_t(options.minSidePoints) ||
       sides[1].size() < std::size_t(options.minSidePoints))
     return std::nullopt;
-  const SidePlane a = fitSide(positions, normals, sides[0], options.reach, options.maxRms);
-  const SidePlane b = fitSide(positions, normals, sides[1], options.reach, options.maxRms);
+  // Split by position, normals blended across the crease (45 degrees off on a right angle) must
+  // not fail their side; a corner's third face (90 degrees off) still does.
+  const double normalAngle = options.splitByPosition ? 60.0 : 30.0;
+  const SidePlane a =
+      fitSide(positions, normals, sides[0], options.reach, options.maxRms, normalAngle);
+  const SidePlane b =
+      fitSide(positions, normals, sides[1], options.reach, options.maxRms, normalAngle);
   if (!a.flat || !b.flat) return std::nullopt;
   const Vec3 direction = a.normal.cross(b.normal);
   const double sine = direction.norm();
@@ -87,7 +103,8 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
   CreaseLine line;
   line.direction = direction / sine;
   line.turnDegrees = turn;
-  // The point of both planes nearest x: both plane equations and the foot of x along the line.
+  // The point of both planes nearest x: both plane
+  // equations and the foot of x along the line.
   Eigen::Matrix3d system;
   system.row(0) = a.normal.transpose();
   system.row(1) = b.normal.transpose();

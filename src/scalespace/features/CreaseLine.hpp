@@ -26,6 +26,14 @@ struct CreaseLineOptions {
   /// face lies between them (the rim of a part thinner than the reach) their planes meet beyond
   /// it, half a spacing or more from any point (libcgal-demo's blade). 0: not checked.
   double maxGap = 0;
+  /// Split the points by position rather than by their normals: by the side they lie on of the
+  /// plane through `centre` that holds `along` and their mean normal, leaving out those within
+  /// sideMargin of it. Near the crease the estimated normals blend the two sides (the
+  /// neighbourhood that estimates them straddles it, more so under noise) and send points to the
+  /// wrong side. Nine in ten of a side's normals must then lie within 60 degrees of its plane's
+  /// (30 split by normals): blended ones pass, a corner's third face does not.
+  bool splitByPosition = false;
+  double sideMargin = 0;
 };
 
 struct CreaseLine {
@@ -39,12 +47,15 @@ double distanceToLine(const Vec3& x, const Vec3& point, const Vec3& unitDirectio
 
 /// The crease near `x` running roughly along `along` (unit; e.g. the salient vertices' line):
 /// the points of `positions` (with oriented unit `normals`, searched in `index`) within
-/// options.reach of x are split by the sign of n . (along x m), m their mean normal, and a plane
-/// is fitted to each side (least squares). None when a side is too small or not flat, when the
-/// planes turn by less than minTurnDegrees or when their normals disagree with the side's.
+/// options.reach of x are split by the sign of n . (along x m), m their mean normal, or with
+/// options.splitByPosition by the side of the plane through `centre` (x when null) holding along
+/// and m, and a plane is fitted to each side (least squares). None when a side is too small or not
+/// flat, when the planes turn by less than minTurnDegrees or when their normals disagree with the
+/// side's.
 std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
                                         const std::vector<Vec3>& normals, const SpatialIndex& index,
                                         const Vec3& x, const Vec3& along,
-                                        const CreaseLineOptions& options);
+                                        const CreaseLineOptions& options,
+                                        const Vec3* centre = nullptr);
 
 }  // namespace scalespace

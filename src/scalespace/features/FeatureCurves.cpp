@@ -163,7 +163,7 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
       double width = halfWidth;
       if (crease.line.reach > 0)
         if (const auto line = fitCreaseLine(crease.positions, crease.normals, crease.index,
-                                            targets[i], direction, crease.line);
+                                            targets[i], direction, crease.line, &mean);
             line && distanceToLine(mean, line->point, line->direction) <= crease.halfWidth) {
           // The salient vertices lie along the edge found: not two faces of a thin part, whose
           // planes meet far from it or not at all.
@@ -284,6 +284,10 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::creaseHalfWidth must be finite and > 0");
   require(std::isfinite(o.creaseFlatness) && o.creaseFlatness >= 0,
           "FeatureCurveOptions::creaseFlatness must be finite and >= 0");
+  require(std::isfinite(o.creaseSideMargin) && o.creaseSideMargin >= 0,
+          "FeatureCurveOptions::creaseSideMargin must be finite and >= 0");
+  require(std::isfinite(o.creaseSideNoise) && o.creaseSideNoise >= 0,
+          "FeatureCurveOptions::creaseSideNoise must be finite and >= 0");
   require(std::isfinite(o.centrelineLinearity) && o.centrelineLinearity >= 0 &&
               o.centrelineLinearity <= 1,
           "FeatureCurveOptions::centrelineLinearity must be in [0, 1]");
@@ -362,8 +366,9 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                        : meanKthNeighborDistance(cloud.positions(), options.spacingNeighbors);
   const double e = result.spacing;
   require(e > 0, "detectFeatureCurves: every point is at the same position (spacing 0)");
-  if (options.noiseSalientFactor > 0) {
-    // The noise of the points the lines are traced on (the cloud; a mesh's area samples).
+  if (options.noiseSalientFactor > 0 || options.creaseReach > 0) {
+    // The noise of the points the lines are traced on (the cloud; a mesh's area samples): the
+    // salient floor and the crease sides' flatness and margin scale with it.
     const bool targetsAreCloud = &targets == &cloud.positions();
     result.noiseRms = targetsAreCloud
                           ? pointNoiseRms(cloud.positions(), targetGraph)
@@ -471,6 +476,9 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     crease.line.reach = options.creaseReach * e;
     crease.line.maxRms = std::max(options.creaseFlatness * e, 2 * result.noiseRms);
     crease.line.maxGap = 0.25 * e;
+    crease.line.splitByPosition = options.creaseSidesByPosition;
+    crease.line.sideMargin =
+        std::max(0.0, options.creaseSideMargin * e - options.creaseSideNoise * result.noiseRms);
     crease.halfWidth = options.creaseHalfWidth * e;
     trimToCentreline(targets, salient, salientSign, *salientIndex, options.centrelineReach * e,
                      options.bandHalfWidth * e, options.centrelineLinearity, crease, eligible,

@@ -124,6 +124,15 @@ struct FeatureCurveOptions {
   double creaseReach = 2;
   double creaseHalfWidth = 1;
   double creaseFlatness = 0.1;
+  /// The two sides are the points on either side of the plane through the centreline holding
+  /// their mean normal, leaving out those within max(0, creaseSideMargin * e - creaseSideNoise *
+  /// sigma) of it (clean: 0.3 e, where the APSS's rounding of the edge leaves the sides; under
+  /// noise 1e-3 of the diagonal, sigma = 0.1-0.4 e: none). false: by their normals' side
+  /// (features/CreaseLine), which blend across the crease (bench_features, 11 models, MCC clean
+  /// 0.933 -> 0.937, noisy 0.779 -> 0.783; docs/THESIS_NOTES.md, "Crease sides by position").
+  bool creaseSidesByPosition = true;
+  double creaseSideMargin = 0.3;
+  double creaseSideNoise = 3;
   /// Regions whose points span less than minPieceExtent times e (bounding-box diagonal) are
   /// dropped before the joining below (specks of 1-4 points where a line grazed a corner), and
   /// the curves spanning less than minCurveExtent times e after it: a short piece that joins a

@@ -78,6 +78,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::creaseReach", "crease_reach"},
     {"FeatureCurveOptions::creaseHalfWidth", "crease_half_width"},
     {"FeatureCurveOptions::creaseFlatness", "crease_flatness"},
+    {"FeatureCurveOptions::creaseSideMargin", "crease_side_margin"},
     {"FeatureCurveOptions::edgeReach", "edge_reach"},
     {"FeatureCurveOptions::edgeRejoinAngle", "edge_rejoin_angle"},
     {"CylinderOptions::scaleCount", "scale_count"},

@@ -133,11 +133,11 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     double salientThreshold, double salientCap, double minExtent,
                     double minPieceExtent, double joinGap, double centrelineReach,
                     double bandHalfWidth, double creaseReach, double creaseHalfWidth,
-                    double creaseFlatness, double edgeReach, double edgeRejoinAngle,
-                    bool allSalient, bool salientPerScale, double beta, double gamma,
-                    bool curvedSeedsFirst, bool withLines, const py::handle& triangles,
-                    std::size_t meshSamples, double sheetNormals, std::optional<int> threads,
-                    py::object progress) {
+                    double creaseFlatness, double creaseSideMargin, bool creaseSidesByNormals,
+                    double edgeReach, double edgeRejoinAngle, bool allSalient, bool salientPerScale,
+                    double beta, double gamma, bool curvedSeedsFirst, bool withLines,
+                    const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
+                    std::optional<int> threads, py::object progress) {
   FeatureCurveOptions options;
   options.scaleCount = scales;
   options.spacing = spacing;
@@ -155,6 +155,8 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.creaseReach = creaseReach;
   options.creaseHalfWidth = creaseHalfWidth;
   options.creaseFlatness = creaseFlatness;
+  options.creaseSideMargin = creaseSideMargin;
+  options.creaseSidesByPosition = !creaseSidesByNormals;
   options.edgeReach = edgeReach;
   options.edgeRejoinAngle = edgeRejoinAngle;
   options.ridgeOnly = !allSalient;
@@ -273,7 +275,8 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "crease_reach"_a = FeatureCurveOptions{}.creaseReach,
         "crease_half_width"_a = FeatureCurveOptions{}.creaseHalfWidth,
         "crease_flatness"_a = FeatureCurveOptions{}.creaseFlatness,
-        "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
+        "crease_side_margin"_a = FeatureCurveOptions{}.creaseSideMargin,
+        "crease_sides_by_normals"_a = false, "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
         "edge_rejoin_angle"_a = FeatureCurveOptions{}.edgeRejoinAngle, "all_salient"_a = false,
         "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
         "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
@@ -299,7 +302,9 @@ under min_piece_extent x e are dropped before the joining, curves under min_exte
 it). centreline_reach, band_half_width: a curve keeps the points within
 band_half_width x e of the centreline fitted to the salient vertices within centreline_reach x e;
 where the points within crease_reach x e form two flat sides (RMS within crease_flatness x e or
-twice the noise) the line where their planes meet replaces it, with crease_half_width (0: never).
+twice the noise) the line where their planes meet replaces it, with crease_half_width (0: never);
+the sides are the points beyond crease_side_margin x e, less 3 noise RMS, of the plane through
+the centreline holding their mean normal (crease_sides_by_normals=True: by their normals).
 triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
 is estimated as the plane through the point and two neighbours that the most neighbours lie within
