@@ -19,7 +19,8 @@
 //                  default: featureNormalOptions()')
 //                  (NormalOrientationOptions::acrossWeight and ::visibility of the estimated
 //                  normals)
-//                  [--mesh-normals] (the clean clouds keep the mesh's interpolated normals)
+//                  [--mesh-normals] (the clean and noisy clouds take the mesh's interpolated
+//                  normals)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--crease-reach X (0: off)] [--crease-half-width X] [--crease-flatness X]
@@ -552,10 +553,10 @@ bool scoredCurve(const Model& m, std::size_t curve) {
 
 /// --per-curve: where the estimated orientation disagrees with the mesh's (outward where the mesh
 /// is closed and consistently oriented; on an open mesh either side).
-void printOrientation(const Model& m, const PointCloud& cloud, const char* which) {
+void printOrientation(const Model& m, const std::vector<Vec3>& estimated, const char* which) {
   std::size_t flipped = 0;
   for (std::size_t i = 0; i < m.meshNormals.size(); ++i)
-    flipped += m.meshNormals[i].dot(cloud.normals()[i]) < 0;
+    flipped += m.meshNormals[i].dot(estimated[i]) < 0;
   const double share = double(flipped) / double(std::max<std::size_t>(1, m.meshNormals.size()));
   std::printf("# %s, %s: estimated normals opposite to the mesh's at %.1f %% of the points",
               m.name.c_str(), which, 100 * std::min(share, 1 - share));
@@ -565,7 +566,7 @@ void printOrientation(const Model& m, const PointCloud& cloud, const char* which
     for (std::size_t i = 0; i < m.gt.size(); ++i) {
       if (m.gt[i] < 0) continue;
       ++features;
-      onFeature += (m.meshNormals[i].dot(cloud.normals()[i]) < 0) != (2 * flipped > m.gt.size());
+      onFeature += (m.meshNormals[i].dot(estimated[i]) < 0) != (2 * flipped > m.gt.size());
     }
     std::printf(" (%zu of the %zu feature points)", onFeature, features);
   }
@@ -580,6 +581,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   const std::vector<Vec3> truth = m.clean.normals();
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
   estimateSceneNormals(m.clean);
+  const std::vector<Vec3> estimated = m.clean.normals();
   m.meshNormals = truth;
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
   m.diagonal = m.clean.boundingBoxDiagonal();
@@ -594,7 +596,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.gt.resize(m.gtEdge.size());
   for (std::size_t i = 0; i < m.gtEdge.size(); ++i)
     m.gt[i] = m.gtEdge[i] < 0 ? -1 : curveOfEdge.at(m.gtEdge[i]);
-  if (printPerCurve) printOrientation(m, m.clean, "clean");
+  if (printPerCurve) printOrientation(m, estimated, "clean");
   if (printPerCurve) {
     m.gt2 = featureCurveOfPoints(m.clean.positions(), *index, m.mesh, m.clean.origin(), m.edges,
                                  2 * m.spacing);
@@ -1425,8 +1427,8 @@ static int run(int argc, char** argv) {
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
           estimateSceneNormals(cloud);
+          if (printPerCurve) printOrientation(m, cloud.normals(), "noisy");
           if (meshNormals) cloud.setNormals(m.meshNormals);
-          if (printPerCurve) printOrientation(m, cloud, "noisy");
           runMethods(m, cloud, peers, rows);
         }
       } catch (const Error& error) {

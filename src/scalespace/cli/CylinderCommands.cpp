@@ -163,9 +163,10 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--nested-link-tolerance", args->cylinders.nestedLinkTolerance,
                   "tubes of two scales that fail the Jaccard rule but one of which holds over half "
-                  "of the other's points are one component when the smaller one's points lie on "
-                  "the larger one's tube within this share of its radius (median; 0: off): a "
-                  "scale that finds a piece of a tube the next finds whole")
+                  "of the other's points, the smaller at least a quarter the size, are one "
+                  "component when the smaller one's points lie on the larger one's tube within "
+                  "this share of its radius (median; 0: off): a scale that finds a piece of a tube "
+                  "the next finds whole; narrow tubes whose points lie on one tube are kept too")
       ->capture_default_str();
   cmd->add_flag("--one-curvature-sign", args->cylinders.oneCurvatureSign,
                 "a region only grows over points curving the way its seed does, which stops it at "
@@ -202,7 +203,8 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--narrow-radius-spread", args->cylinders.narrow.maxRadiusSpread,
                   "the radii of a component of narrow tubes alone must lie within this share of "
-                  "one another (the radius of a tube the scale makes grows with t)")
+                  "one another (the radius of a tube the scale makes grows with t), unless its "
+                  "points lie on one tube (--nested-link-tolerance)")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");

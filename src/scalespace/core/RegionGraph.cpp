@@ -125,8 +125,9 @@ bool nestedSizes(std::size_t a, std::size_t b, std::size_t common,
 
 // For each region r of level `from` with wanted[r], the open region of level `to` (of the same
 // kind) with Jaccard index > minJaccard: regions of a level are disjoint, so J > 0.5 holds for at
-// most one and the answer does not depend on the order of the search. With nestedAllowed, the
-// other open regions holding more than minJaccard of the smaller one's points that it accepts.
+// most one and the answer does not depend on the order of the search. With nestedAllowed and no
+// such region, the open regions sharing with it more than minJaccard of the smaller one's points
+// (nestedSizes) that the test accepts.
 LevelLinks linkLevels(const RegionGraph& graph, std::size_t from, std::size_t to,
                       const RegionLinkOptions& options, const std::vector<char>& wanted,
                       const std::vector<char>& open) {
@@ -141,18 +142,21 @@ LevelLinks linkLevels(const RegionGraph& graph, std::size_t from, std::size_t to
     std::unordered_map<int, std::size_t> overlap;
     for (Index i : here[r])
       if (toLabels[i] >= 0) ++overlap[toLabels[i]];
-    for (const auto& [s, common] : overlap) {
-      if (!open[std::size_t(s)]) continue;
-      if (options.kinds && (*options.kinds)[from][r] != (*options.kinds)[to][std::size_t(s)])
-        continue;
-      const std::size_t size = there[std::size_t(s)].size();
-      if (double(common) > options.minJaccard * double(here[r].size() + size - common)) {
+    const auto linkable = [&](int s) {
+      return open[std::size_t(s)] &&
+             (!options.kinds || (*options.kinds)[from][r] == (*options.kinds)[to][std::size_t(s)]);
+    };
+    for (const auto& [s, common] : overlap)
+      if (linkable(s) &&
+          double(common) >
+              options.minJaccard * double(here[r].size() + there[std::size_t(s)].size() - common))
         links.byJaccard[r] = s;  // Eq. 2.1
-      } else if (options.nestedAllowed && nestedSizes(here[r].size(), size, common, options) &&
-                 options.nestedAllowed(graph.levels, int(from), int(r), int(to), s)) {
+    if (links.byJaccard[r] >= 0 || !options.nestedAllowed) return;
+    for (const auto& [s, common] : overlap)
+      if (linkable(s) &&
+          nestedSizes(here[r].size(), there[std::size_t(s)].size(), common, options) &&
+          options.nestedAllowed(graph.levels, int(from), int(r), int(to), s))
         nested[r].push_back({common, int(r), s});
-      }
-    }
   });
   for (const auto& candidates : nested)
     links.nested.insert(links.nested.end(), candidates.begin(), candidates.end());

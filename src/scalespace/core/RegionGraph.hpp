@@ -102,13 +102,15 @@ struct RegionLinkOptions {
   /// radius), since nothing between them vouches for it.
   int maxGap = 0;
   LinkTest bridgeAllowed;
-  /// (Not in the thesis.) Two regions that did not link by J, one holding more than minJaccard of
-  /// the other's points (|A n B| > minJaccard min(|A|, |B|)) and the smaller at least
-  /// nestedMinSizeRatio times as many points as the larger, link when nestedAllowed (when given)
-  /// agrees, between consecutive levels and across gaps alike: a scale that finds a large piece of
-  /// the primitive the next one finds whole. Such links are made after the J links of the same
-  /// levels, the largest overlaps first (then lower region indices), one successor and one
-  /// predecessor per region as ever.
+  /// (Not in the thesis.) Only when nestedAllowed is set: two regions that did not link by J, one
+  /// holding more than minJaccard of the other's points (|A n B| > minJaccard min(|A|, |B|)) and
+  /// the smaller at least nestedMinSizeRatio times as many points as the larger, link when
+  /// nestedAllowed agrees, between consecutive levels and across gaps alike (bridgeAllowed is not
+  /// asked: nestedAllowed is the test): a scale that finds a large piece of the primitive the next
+  /// one finds whole. Such links are made after the J links of the same levels, the largest
+  /// overlaps first (then lower region indices), one successor and one predecessor per region as
+  /// ever; the consecutive ones before any bridge, so a nested link may take an end or a start
+  /// that a bridge would have used.
   LinkTest nestedAllowed;
   double nestedMinSizeRatio = 0.25;  // in (0, 1]
 };

@@ -43,8 +43,8 @@ SidePlane fitSide(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   plane.normal = eigen.eigenvectors().col(0);
   if (plane.normal.dot(meanNormal) < 0) plane.normal = -plane.normal;
   const double rms = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) / total);
-  // Nine in ten of its normals within 30 degrees of the plane's: one face, not the two faces of a
-  // part thinner than the reach, whose points can fit one plane between them.
+  // Nine in ten of its normals within normalAngleDegrees of the plane's: one face, not the two
+  // faces of a part thinner than the reach, whose points can fit one plane between them.
   std::size_t along = 0;
   for (const Neighbor& nb : side)
     along += normals[nb.index].dot(plane.normal) >= std::cos(normalAngleDegrees * M_PI / 180.0);

@@ -1,7 +1,8 @@
 #pragma once
 // The crease through a point as the line where the planes of its two sides meet (not in the
-// thesis): the cloud points near the point split by the side their normal leans to across the
-// crease, a plane fitted to each side, the two planes intersected. On a sharp crease this is the
+// thesis): the cloud points near the point split into the crease's two sides (by the side their
+// normal leans to across it, or by the side of it they lie on), a plane fitted to each side, the
+// two planes intersected. On a sharp crease this is the
 // edge itself, where the salient vertices of the APSS lie 0.2 to 0.4 e inside a convex edge
 // (outside a concave one): the APSS rounds the edge at every scale.
 #include <optional>

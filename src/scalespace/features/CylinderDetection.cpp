@@ -157,10 +157,36 @@ void trimRejectedRegions(const KnnGraph& graph, const std::vector<Vec3>& positio
   });
 }
 
+/// Whether the points of every region of `c` lie on the best-fitting tube of the chain (lowest RMS
+/// over radius): the median of their distances to its surface within `tolerance` of its radius.
+bool liesOnItsBestTube(const RegionGraph& graph, const GraphComponent& c,
+                       const std::vector<Vec3>& positions, const std::vector<CylinderLevel>& levels,
+                       double tolerance) {
+  const auto tubeAt = [&](std::size_t k) -> const TubeFit& {
+    return levels[std::size_t(c.birthLevel) + k].tubes[std::size_t(c.regionAt[k])];
+  };
+  const TubeFit* best = nullptr;
+  for (std::size_t k = 0; k < c.regionAt.size(); ++k)
+    if (c.regionAt[k] >= 0 &&
+        (!best || tubeAt(k).rms * best->radius < best->rms * tubeAt(k).radius))
+      best = &tubeAt(k);
+  for (std::size_t k = 0; k < c.regionAt.size(); ++k) {
+    if (c.regionAt[k] < 0) continue;
+    const auto& points =
+        graph.levels[std::size_t(c.birthLevel) + k].regions[std::size_t(c.regionAt[k])];
+    if (!(medianRelativeResidual(positions, points, *best) <= tolerance)) return false;
+  }
+  return best != nullptr;
+}
+
 /// Drops the narrow-arc tubes (CylinderLevel::narrow) of the components made of them alone that
-/// live under options.minPersistence steps or whose radii spread over options.maxRadiusSpread,
-/// from `levels` and `regionLevels` alike; whether any was dropped (the graph is then stale).
+/// live under options.minPersistence steps, or whose radii spread over options.maxRadiusSpread
+/// unless every level's points lie on the chain's best-fitting tube within onTubeTolerance (0:
+/// never; a narrow arc's fitted radius is loose, its points are not), from `levels` and
+/// `regionLevels` alike; whether any was dropped (the graph is then stale). `regionLevels` may
+/// be graph.levels: it is changed only after every component was read.
 bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOptions& options,
+                                const std::vector<Vec3>& positions, double onTubeTolerance,
                                 std::vector<CylinderLevel>& levels,
                                 std::vector<RegionLevel>& regionLevels) {
   std::vector<std::vector<std::uint8_t>> drop(levels.size());
@@ -177,9 +203,12 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
       smallest = std::min(smallest, radius);
       largest = std::max(largest, radius);
     }
-    if (!allNarrow || (c.persistence() >= options.minPersistence &&
-                       largest <= (1 + options.maxRadiusSpread) * smallest))
-      continue;
+    if (!allNarrow) continue;
+    if (c.persistence() >= options.minPersistence) {
+      if (largest <= (1 + options.maxRadiusSpread) * smallest) continue;
+      if (onTubeTolerance > 0 && liesOnItsBestTube(graph, c, positions, levels, onTubeTolerance))
+        continue;
+    }
     for (std::size_t k = 0; k < c.regionAt.size(); ++k)
       if (c.regionAt[k] >= 0) drop[std::size_t(c.birthLevel) + k][std::size_t(c.regionAt[k])] = 1;
     any = true;
@@ -405,9 +434,11 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     if (progress && !progress(double(s + 1) / count, stage)) throw Cancelled();
   }
 
-  // Across a gap the two tubes must agree in radius (10%): a region that swallowed both walls of
-  // a thick pipe at one scale (radius between them) shares most of its points with the outer
-  // wall's tube of a later scale.
+  // Across a gap the two tubes of a J link must agree in radius (10%): a region that swallowed
+  // both walls of a thick pipe at one scale (radius between them) shares most of its points with
+  // the outer wall's tube of a later scale. A nested link is vouched for by its points instead: the
+  // outer wall's points lie a quarter of the radius off such a region's tube (libcgal-demo's
+  // pipe.off: its walls at 0.17 and 0.31).
   RegionLinkOptions linking;
   linking.minJaccard = options.minJaccard;
   linking.maxGap = options.maxGapLevels;
@@ -426,8 +457,8 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
       return medianRelativeResidual(positions, aOnB ? a : b, tube) <= options.nestedLinkTolerance;
     };
   result.graph = buildRegionGraph(std::move(regionLevels), n, linking);
-  if (dropUnconfirmedNarrowTubes(result.graph, options.narrow, result.levels,
-                                 result.graph.levels)) {
+  if (dropUnconfirmedNarrowTubes(result.graph, options.narrow, positions,
+                                 options.nestedLinkTolerance, result.levels, result.graph.levels)) {
     std::vector<RegionLevel> kept = std::move(result.graph.levels);
     result.graph = buildRegionGraph(std::move(kept), n, linking);
   }

@@ -46,10 +46,14 @@ struct TubeCoverageOptions {
 /// (Not in the thesis.) A region turned down for its arc alone, whose normals still turn by
 /// minArcDegrees around its axis, is a tube where it lives across scales: a component made of
 /// such tubes only is kept if it lives at least minPersistence scale steps with radii within
-/// maxRadiusSpread of one another (largest / smallest - 1). One scan sees a cylinder from one
-/// side: a mug on a table (python3-pcl's stereo scan) reads 75-120 degrees at six scales from
-/// t = 0.008 to 0.027, with radii 0.036-0.045, under the 135 a single scale needs. The radius of
-/// a tube that the scale makes, the fits rounding an edge, grows with t instead.
+/// maxRadiusSpread of one another (largest / smallest - 1), or whose points at every level lie on
+/// its best-fitting tube (lowest RMS over radius) within CylinderOptions::nestedLinkTolerance of
+/// its radius (median distance; a narrow arc's fitted radius is loose, its points are not: the
+/// inner wall of python3-pcl's mug read 0.042, 0.033 and 0.037 at three scales, its points
+/// within 2.7% of the 0.037 tube). One scan sees a cylinder from one side: a mug on a table
+/// (python3-pcl's stereo scan) reads 75-120 degrees at six scales from t = 0.008 to 0.027, with
+/// radii 0.036-0.045, under the 135 a single scale needs. The radius of a tube that the scale
+/// makes, the fits rounding an edge, grows with t instead.
 struct NarrowTubeOptions {
   bool enabled = true;
   double minArcDegrees = 75;
@@ -105,13 +109,15 @@ struct CylinderOptions {
   int maxGapLevels = 2;
   /// (Not in the thesis; 0: off.) Two tubes of linked levels (consecutive, or across a gap as
   /// above) whose regions do not pass the Jaccard rule but one of which holds more than minJaccard
-  /// of the other's points also link when the smaller region's points lie on the larger one's
-  /// tube: the median of their distances to its surface within this share of its radius
-  /// (core/RegionGraph, RegionLinkOptions::nestedAllowed). A scale finds a piece of a tube that the
-  /// next finds whole, or a narrow arc whose fitted radius is loose while its points are not (the
-  /// mug of python3-pcl's mug scene: a wall of radius 0.040 read 0.055 over a 75-degree arc at
-  /// one scale, whole at the next but one). A strand's points on the whole cable's tube lie about
-  /// a quarter of its radius off.
+  /// of the other's points, the smaller at least a quarter the size of the larger, also link when
+  /// the smaller region's points lie on the larger one's tube: the median of their distances to
+  /// its surface within this share of its radius (core/RegionGraph,
+  /// RegionLinkOptions::nestedAllowed; the bridges' radius test does not apply, the points
+  /// vouch instead). The same tolerance confirms narrow tubes (NarrowTubeOptions). A scale finds a
+  /// piece of a tube that the next finds whole, or a narrow arc whose fitted radius is loose while
+  /// its points are not (the mug of python3-pcl's mug scene: a wall of radius 0.040 read 0.055 over
+  /// a 75-degree arc at one scale, whole at the next but one). A strand's points on the whole
+  /// cable's tube lie about a quarter of its radius off.
   double nestedLinkTolerance = 0.1;
 };
 

@@ -366,7 +366,7 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                        : meanKthNeighborDistance(cloud.positions(), options.spacingNeighbors);
   const double e = result.spacing;
   require(e > 0, "detectFeatureCurves: every point is at the same position (spacing 0)");
-  if (options.noiseSalientFactor > 0 || options.creaseReach > 0) {
+  if (options.noiseSalientFactor > 0 || (options.centrelineReach > 0 && options.creaseReach > 0)) {
     // The noise of the points the lines are traced on (the cloud; a mesh's area samples): the
     // salient floor and the crease sides' flatness and margin scale with it.
     const bool targetsAreCloud = &targets == &cloud.positions();

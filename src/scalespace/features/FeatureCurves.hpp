@@ -129,7 +129,7 @@ struct FeatureCurveOptions {
   /// sigma) of it (clean: 0.3 e, where the APSS's rounding of the edge leaves the sides; under
   /// noise 1e-3 of the diagonal, sigma = 0.1-0.4 e: none). false: by their normals' side
   /// (features/CreaseLine), which blend across the crease (bench_features, 11 models, MCC clean
-  /// 0.933 -> 0.937, noisy 0.779 -> 0.783; docs/THESIS_NOTES.md, "Crease sides by position").
+  /// 0.933 -> 0.936, noisy 0.779 -> 0.782; docs/THESIS_NOTES.md, "Crease sides by position").
   bool creaseSidesByPosition = true;
   double creaseSideMargin = 0.3;
   double creaseSideNoise = 3;

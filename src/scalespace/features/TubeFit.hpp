@@ -153,8 +153,7 @@ bool radiiAgree(const TubeFit& a, const TubeFit& b, double tolerance);
 
 /// The median over `points` (indices into positions) of |TubeSurface::residual| over the tube's
 /// mean radius: how well points fitted elsewhere lie on `tube` (0 for no points, infinity for a
-/// tube without an axis or radius). Every point
-/// counts up to 4096, then an even stride of them.
+/// tube without an axis or radius). Every point counts up to 4096, then an even stride of them.
 double medianRelativeResidual(const std::vector<Vec3>& positions, const std::vector<Index>& points,
                               const TubeFit& tube);
 

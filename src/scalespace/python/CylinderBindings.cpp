@@ -276,8 +276,10 @@ where it is found over narrow_min_persistence scale steps or more with radii wit
 narrow_radius_spread of one another (a cylinder seen from one side). max_gap: a component bridges up to this many
 levels where its tube was not found (0: consecutive levels only, as the thesis).
 nested_link_tolerance: tubes of two levels that fail the Jaccard rule, one holding over half of
-the other's points, are one component when the smaller one's points lie on the larger one's tube
-within this share of its radius (median; 0: off). Without normals they are estimated (sheet
+the other's points, the smaller at least a quarter the size, are one component when the smaller
+one's points lie on the larger one's tube within this share of its radius (median; 0: off); a
+component of narrow tubes alone whose points lie on its best tube within it is kept whatever the
+spread of its radii. Without normals they are estimated (sheet
 planes, 10 neighbours) and oriented (MST of the PCA normals), as the CLI does. Returns a
 Cylinders.)doc");
 }
