@@ -103,8 +103,7 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
   CreaseLine line;
   line.direction = direction / sine;
   line.turnDegrees = turn;
-  // The point of both planes nearest x: both plane
-  // equations and the foot of x along the line.
+  // The point of both planes nearest x: both plane equations and the foot of x along the line.
   Eigen::Matrix3d system;
   system.row(0) = a.normal.transpose();
   system.row(1) = b.normal.transpose();

@@ -436,9 +436,9 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
 
   // Across a gap the two tubes of a J link must agree in radius (10%): a region that swallowed
   // both walls of a thick pipe at one scale (radius between them) shares most of its points with
-  // the outer wall's tube of a later scale. A nested link is vouched for by its points instead: the
-  // outer wall's points lie a quarter of the radius off such a region's tube (libcgal-demo's
-  // pipe.off: its walls at 0.17 and 0.31).
+  // the outer wall's tube of a later scale. A nested link is vouched for by its points instead:
+  // the walls of libcgal-demo's pipe.off lie at 0.17 and 0.31, so the outer wall's points lie
+  // (0.31 - r) / r off a tube of radius r between them, 24% for r = 0.25.
   RegionLinkOptions linking;
   linking.minJaccard = options.minJaccard;
   linking.maxGap = options.maxGapLevels;

@@ -116,8 +116,8 @@ struct CylinderOptions {
   /// vouch instead). The same tolerance confirms narrow tubes (NarrowTubeOptions). A scale finds a
   /// piece of a tube that the next finds whole, or a narrow arc whose fitted radius is loose while
   /// its points are not (the mug of python3-pcl's mug scene: a wall of radius 0.040 read 0.055 over
-  /// a 75-degree arc at one scale, whole at the next but one). A strand's points on the whole
-  /// cable's tube lie about a quarter of its radius off.
+  /// a 75-degree arc at one scale, whole at the next but one). A strand's points lie 17-18% of the
+  /// radius off the whole cable's tube (median; the pipe rack at 300k points, exact normals).
   double nestedLinkTolerance = 0.1;
 };
 
