@@ -16,6 +16,7 @@ memory the module keeps for the next call of a similar size (the last call's, up
     pipes = ss.cylinders(cloud.points, cloud.normals)
     uv = ss.parametrize(cloud.points, cloud.normals)["uv"]
 """
+import warnings
 from dataclasses import dataclass, field
 from typing import Dict, Mapping, Optional
 
@@ -83,8 +84,13 @@ class Cloud:
 def read(path: str, *, drop_invalid: bool = False, sample: int = 0, seed: int = 1) -> Cloud:
     """Reads a cloud: PLY, XYZ/TXT/CSV/PTS, PWN (CGAL's points with normals), OFF/OBJ (vertices, or ``sample`` points drawn by
     area with interpolated normals), LAS 1.0-1.4, PCD. Points with NaN/Inf coordinates raise
-    FileError unless ``drop_invalid``. An empty file reads as an empty cloud."""
+    FileError unless ``drop_invalid``. An empty file reads as an empty cloud. A file whose normals
+    are all zero or NaN/Inf (a placeholder from a writer without normals) reads as one without
+    normals (``normals`` None), with a warning."""
     d = _scalespace._read(str(path), drop_invalid=drop_invalid, sample=sample, seed=seed)
+    if d["unusable_normals_dropped"]:
+        warnings.warn(f"{path}: every normal in the file is zero or NaN/Inf: read without normals",
+                      stacklevel=2)
     return Cloud(d["points"], d["normals"], dict(d["attributes"]), d["format"], d["dropped"],
                  d["viewpoint"])
 

@@ -46,6 +46,32 @@ TEST(CloudIO, LazIsRejectedWithAConversionHint) {
   }
 }
 
+// libcgal-demo's blobby.xyz: six columns, every normal 0 0 0, a writer's placeholder.
+TEST(CloudIO, NormalsThatAreAllZeroOrNonFiniteAreDropped) {
+  test::ScratchDir dir;
+  const auto read = [&](const std::string& name, const std::string& text, ReadReport& report) {
+    test::writeText(dir.file(name), text);
+    report = {};
+    return readCloud(dir.file(name), {}, &report);
+  };
+  ReadReport report;
+  PointCloud zeros = read("zeros.xyz", "0 0 0 0 0 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n", report);
+  EXPECT_EQ(zeros.size(), 3u);
+  EXPECT_FALSE(zeros.hasNormals());
+  EXPECT_TRUE(report.unusableNormalsDropped);
+  PointCloud nan = read("nan.xyz", "0 0 0 nan 0 0\n1 0 0 0 0 0\n0 1 0 0 inf 0\n", report);
+  EXPECT_FALSE(nan.hasNormals());
+  EXPECT_TRUE(report.unusableNormalsDropped);
+  // One usable normal: the file has normals, the others are its "no value" (fits say so).
+  PointCloud one = read("one.xyz", "0 0 0 0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 0\n", report);
+  ASSERT_TRUE(one.hasNormals());
+  EXPECT_EQ(one.normals()[1], Vec3(0, 0, 1));
+  EXPECT_FALSE(report.unusableNormalsDropped);
+  PointCloud none = read("none.xyz", "0 0 0\n1 0 0\n", report);
+  EXPECT_FALSE(none.hasNormals());
+  EXPECT_FALSE(report.unusableNormalsDropped);
+}
+
 TEST(CloudIO, MissingFileAndFolderAreFileErrors) {
   test::ScratchDir dir;
   EXPECT_THROW(readCloud(dir.file("missing.ply")), FileError);

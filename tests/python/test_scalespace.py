@@ -101,6 +101,20 @@ def test_write_a_cloud_object_and_read_meshes(tmp_path):
     assert sampled.points.shape == (50, 3) and sampled.normals is not None
 
 
+def test_placeholder_normals_read_as_none(tmp_path):
+    # A writer without normals that fills the columns with zeros (libcgal-demo's blobby.xyz):
+    # read without normals, with a warning; the CLI says so and estimates them.
+    points = sphere_points(500)
+    path = tmp_path / "zeros.xyz"
+    np.savetxt(path, np.hstack([points, np.zeros_like(points)]))
+    with pytest.warns(UserWarning, match="zero or NaN/Inf"):
+        cloud = ss.read(str(path))
+    assert cloud.normals is None and cloud.points.shape == (500, 3)
+    run = subprocess.run([CLI, "features", str(path), "-o", str(tmp_path / "f.ply")],
+                         capture_output=True, text=True, check=True)
+    assert "read without normals" in run.stderr and "input has no normals" in run.stderr
+
+
 # ------------------------------------------------------------------------- equal to the CLI
 def test_curvature_equals_the_cli(data, tmp_path):
     cli("curvature", data / "sphere.ply", "-o", tmp_path / "c.ply", "--scale-k", 20, "--robust")

@@ -64,6 +64,9 @@ PointCloud loadCloud(const InputOptions& input, bool quiet) {
   if (!quiet && report.droppedNonFinite > 0)
     std::fprintf(stderr, "%s: skipped %zu points with NaN/Inf coordinates\n", input.path.c_str(),
                  report.droppedNonFinite);
+  if (!quiet && report.unusableNormalsDropped)
+    std::fprintf(stderr, "%s: every normal in the file is zero or NaN/Inf: read without normals\n",
+                 input.path.c_str());
   return cloud;
 }
 

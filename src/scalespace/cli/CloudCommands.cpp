@@ -70,6 +70,8 @@ void addInfoCommand(CLI::App& app) {
             "normals` re-estimates them)",
             bad, cloud.size());
       std::printf("\n");
+    } else if (report.unusableNormalsDropped) {
+      std::printf("normals     no (the file's are all NaN/Inf or zero: read as none)\n");
     } else {
       std::printf("normals     no\n");
     }

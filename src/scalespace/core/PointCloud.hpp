@@ -69,6 +69,9 @@ class AttributeColumns {
   const Storage* columns_;
 };
 
+/// A normal a fit can use: finite and of non-negligible length (squared norm above 1e-12).
+inline bool isUsableNormal(const Vec3& n) { return n.allFinite() && n.squaredNorm() > 1e-12; }
+
 /// Columns are created and changed through addAttribute / findAttribute, whose references and
 /// pointers stay valid until that column is removed (removeAttribute, setAttributes) or the cloud
 /// is destroyed or assigned: adding more columns never moves the existing ones. (A vector of

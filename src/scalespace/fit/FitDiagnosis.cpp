@@ -7,8 +7,8 @@ namespace scalespace {
 
 std::size_t unusableNormalCount(const PointCloud& cloud) {
   return std::size_t(
-      std::count_if(cloud.normals().begin(), cloud.normals().end(),
-                    [](const Vec3& n) { return !n.allFinite() || !(n.squaredNorm() > 1e-12); }));
+      cloud.normals().size() -
+      std::size_t(std::count_if(cloud.normals().begin(), cloud.normals().end(), isUsableNormal)));
 }
 
 std::vector<std::string> invalidFitWarnings(const PointCloud& cloud, const FitCounts& counts) {

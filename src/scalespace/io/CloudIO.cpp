@@ -1,5 +1,6 @@
 #include "scalespace/io/CloudIO.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <utility>
@@ -83,7 +84,9 @@ const char* formatName(CloudFormat format) {
   return "";
 }
 
-PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadReport* report) {
+namespace {
+
+PointCloud readByFormat(const std::string& path, const ReadOptions& options, ReadReport* report) {
   const CloudFormat format = formatFromPath(path);
   const std::string data = io_detail::readWholeFile(path);
   switch (format) {
@@ -109,6 +112,21 @@ PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadRe
       return readPcd(data, path, options, report);
   }
   throw OptionError(path + ": unknown format");
+}
+
+}  // namespace
+
+PointCloud readCloud(const std::string& path, const ReadOptions& options, ReadReport* report) {
+  PointCloud cloud = readByFormat(path, options, report);
+  // Writers that have no normals often fill the columns with zeros (libcgal-demo's blobby.xyz:
+  // 3,288 points, every normal 0 0 0); read as normals, every fit reaching one is invalid and
+  // `features` found nothing without a word. Such a file is read as one without normals.
+  if (cloud.hasNormals() &&
+      std::none_of(cloud.normals().begin(), cloud.normals().end(), isUsableNormal)) {
+    cloud.setNormals({});
+    if (report) report->unusableNormalsDropped = true;
+  }
+  return cloud;
 }
 
 bool isMeshFormat(CloudFormat format) {

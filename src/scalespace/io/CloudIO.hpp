@@ -44,7 +44,8 @@ CloudFormat formatFromPath(const std::string& path);
 const char* formatName(CloudFormat format);  // "ply", "xyz", "off", "obj", "stl", "las", "pcd"
 
 /// Reads the whole file and parses it according to its extension. An empty cloud (0 points) is
-/// valid and returned as such; callers decide whether that is an error.
+/// valid and returned as such; callers decide whether that is an error. Normals that are all
+/// zero or NaN/Inf are dropped (ReadReport::unusableNormalsDropped).
 PointCloud readCloud(const std::string& path, const ReadOptions& options = {},
                      ReadReport* report = nullptr);
 

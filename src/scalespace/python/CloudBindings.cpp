@@ -52,6 +52,7 @@ py::dict readCloudPy(const std::string& path, bool dropInvalid, std::size_t samp
   out["attributes"] = attributes;
   out["format"] = report.format;
   out["dropped"] = report.droppedNonFinite;
+  out["unusable_normals_dropped"] = report.unusableNormalsDropped;
   if (cloud.viewpoint()) {
     const Vec3& v = *cloud.viewpoint();
     out["viewpoint"] = py::make_tuple(v.x(), v.y(), v.z());
