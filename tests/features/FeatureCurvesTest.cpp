@@ -500,6 +500,21 @@ TEST(FeatureCurves, InvalidOptionsAreRefused) {
   same.setRelativePositions(std::vector<Vec3>(10, Vec3(1, 2, 3)), Vec3::Zero());
   same.setNormals(std::vector<Vec3>(10, Vec3::UnitZ()));
   EXPECT_THROW(detectFeatureCurves(same, FeatureCurveOptions{}), OptionError);
+  // Three positions, each written 20 times: not "one position", and the way out named.
+  std::vector<Vec3> repeated;
+  for (int copy = 0; copy < 20; ++copy)
+    for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}) repeated.push_back(p);
+  PointCloud few;
+  few.setRelativePositions(repeated, Vec3::Zero());
+  few.setNormals(std::vector<Vec3>(repeated.size(), Vec3::UnitZ()));
+  try {
+    detectFeatureCurves(few, FeatureCurveOptions{});
+    FAIL() << "a cloud of three repeated positions was analysed";
+  } catch (const OptionError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("16 or more duplicates"), std::string::npos) << message;
+    EXPECT_NE(message.find("FeatureCurveOptions::spacing"), std::string::npos) << message;
+  }
 }
 
 namespace {

@@ -227,7 +227,7 @@ TEST(Parametrization, BadInputsAreRejected) {
     parametrize(line, std::vector<Vec3>(line.size(), Vec3::UnitZ()));
     FAIL() << "collinear points were parametrized";
   } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("lie on a line"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lie along a line"), std::string::npos) << e.what();
   }
 }
 

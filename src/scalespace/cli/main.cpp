@@ -58,6 +58,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::salientThreshold", "--salient"},
     {"FeatureCurveOptions::salientBoundCap", "--salient-cap"},
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
+    {"FeatureCurveOptions::spacing", "--spacing"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
     {"FeatureCurveOptions::edgeReach", "--edge-reach"},
     {"FeatureCurveOptions::edgeRejoinAngle", "--edge-rejoin-angle"},

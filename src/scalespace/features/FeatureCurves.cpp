@@ -365,7 +365,13 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                        ? options.spacing
                        : meanKthNeighborDistance(cloud.positions(), options.spacingNeighbors);
   const double e = result.spacing;
-  require(e > 0, "detectFeatureCurves: every point is at the same position (spacing 0)");
+  // Zero when every point has spacingNeighbors duplicates or more: a cloud of a few positions
+  // repeated (each written once per scan pass) as well as one single position.
+  require(e > 0,
+          "detectFeatureCurves: every point has " + std::to_string(options.spacingNeighbors) +
+              " or more duplicates (the spacing, the mean distance to the " +
+              std::to_string(options.spacingNeighbors) +
+              "th neighbour, is 0): remove the duplicates or give FeatureCurveOptions::spacing");
   if (options.noiseSalientFactor > 0 || (options.centrelineReach > 0 && options.creaseReach > 0)) {
     // The noise of the points the lines are traced on (the cloud; a mesh's area samples): the
     // salient floor and the crease sides' flatness and margin scale with it.

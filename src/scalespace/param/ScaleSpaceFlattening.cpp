@@ -140,10 +140,12 @@ FlatteningResult flattenScaleSpace(const std::vector<Vec3>& inputPositions,
   // A line has no surface to flow onto: the map would be a curve's, silently (a strip a thousand
   // times longer than wide is one at every scale the flattening visits).
   if (const double ratio = crossSpreadRatio(inputPositions); ratio < 1e-3) {
-    char text[160];
+    // Two small clumps far apart (two scans in different frames) read the same way.
+    char text[200];
     std::snprintf(text, sizeof text,
-                  "the flattening needs points spread over a surface; these lie on a line (their "
-                  "spread across it is %.3g of their spread along it)",
+                  "the flattening needs points spread over a surface; these lie along a line, on "
+                  "it or in clumps far apart (their spread across it is %.3g of their spread along "
+                  "it)",
                   ratio);
     throw OptionError(text);
   }
