@@ -18,6 +18,7 @@
 //                   [--normal-k K] (with --estimate-normals: K neighbours, fixed; default: 10,
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
+//                   [--max-section-shape S] (ours: TubeFitOptions::maxSectionShapeShare; 1: off)
 //                   [--noisy-only] (the scans with noise 1e-3 alone)
 //                   [--no-split] (ours: TubeSplitOptions::enabled off, Eq. 3.10's regions as
 //                   grown) [--split-cell F] [--split-density F] [--split-steps N]
@@ -386,6 +387,8 @@ static int run(int argc, char** argv) {
       pcaNormals = true;
     else if (a == "--min-arc" && i + 1 < argc)
       ours.tube.minArcDegrees = scalespace::bench::numberArgument(argv, ++i);
+    else if (a == "--max-section-shape" && i + 1 < argc)
+      ours.tube.maxSectionShapeShare = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--max-gap" && i + 1 < argc)
       ours.maxGapLevels = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--normal-k" && i + 1 < argc)
@@ -396,7 +399,8 @@ static int run(int argc, char** argv) {
           "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
-          "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-gap LEVELS] "
+          "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] [--max-gap "
+          "LEVELS] "
           "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F] "
           "[--no-junction-trim]\n");
       return 2;

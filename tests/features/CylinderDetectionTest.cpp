@@ -514,6 +514,44 @@ TEST(Cylinders, ANoisySquarePrismIsFacetedThoughItsNormalsFillTheBinsTheyTake) {
   expectFacetedByTheFillAlone(prism, t);
 }
 
+// A square prism whose normals were smeared into a tube's (radial here, so that every normal test
+// passes) keeps its faces in its positions: with TubeFitOptions::maxSectionShapeShare on, the
+// section shape turns it down; a noisy circle of the same size does not show one. Off by
+// default: real table legs read as shapes too (the option's documentation).
+TEST(Cylinders, ASectionShapeTurnsDownAPrismWhenAsked) {
+  const double a = 1, t = 0.5;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0, 0.03);
+  const Section prism = sampleSection(
+      [&](double s, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const int face = std::min(3, int(4 * s));
+        const double angle = face * kPi / 2, along = (8 * s - 2 * face - 1) * a;
+        const Eigen::Vector2d out(std::cos(angle), std::sin(angle));
+        q = (a + noise(rng)) * out + along * Eigen::Vector2d(-out.y(), out.x());
+        n = q.normalized();
+      },
+      1.15 * a, 0, 20000);
+  const Section circle = sampleSection(
+      [&](double s, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        n = Eigen::Vector2d(std::cos(2 * kPi * s), std::sin(2 * kPi * s));
+        q = (1.15 * a + noise(rng)) * n;
+      },
+      1.15 * a, 0, 20000);
+  TubeFitOptions asked;
+  asked.maxSectionShapeShare = 0.2;
+  const auto fit = [&](const Section& s, const TubeFitOptions& options) {
+    return fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, options);
+  };
+  const TubeFit byDefault = fit(prism, TubeFitOptions{});
+  EXPECT_TRUE(byDefault.isTube()) << tubeRejectionName(byDefault.rejection);
+  EXPECT_GT(byDefault.sectionShapeShare, 0.5);
+  EXPECT_EQ(fit(prism, asked).rejection, TubeRejection::Faceted);
+  const TubeFit round = fit(circle, asked);
+  EXPECT_TRUE(round.isTube()) << tubeRejectionName(round.rejection);
+  EXPECT_LT(round.sectionShapeShare, 0.05);
+  EXPECT_NEAR(round.radius, 1.15 * a, 0.01);
+}
+
 // Two parallel unit cylinders along x whose axes lie `distance` apart (< 2: they overlap, and
 // the surface is their union's, a concave groove where they meet), with exact normals; which
 // cylinder each point lies on in `lobe`.
@@ -724,6 +762,10 @@ TEST(Cylinders, OptionsAreChecked) {
   rejects([](CylinderOptions& o) { o.tube.minArcDegrees = 400; }, "TubeFitOptions::minArcDegrees");
   rejects([](CylinderOptions& o) { o.tube.maxRelativeRms = NAN; },
           "TubeFitOptions::maxRelativeRms");
+  rejects([](CylinderOptions& o) { o.tube.maxSectionShapeShare = 2; },
+          "TubeFitOptions::maxSectionShapeShare");
+  rejects([](CylinderOptions& o) { o.tube.maxSectionShapeRms = -1; },
+          "TubeFitOptions::maxSectionShapeRms");
   rejects([](CylinderOptions& o) { o.lines.beta = 0; }, "CurvatureLineOptions::beta");
   rejects([](CylinderOptions& o) { o.trim.keepFraction = 2; }, "TubeTrimOptions::keepFraction");
   rejects([](CylinderOptions& o) { o.narrow.minArcDegrees = -1; },

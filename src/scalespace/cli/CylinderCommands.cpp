@@ -154,6 +154,12 @@ void addCylindersCommand(CLI::App& app) {
                   "the arc its points cover (0 to 1; a box edge rounded into a tube fills about "
                   "half)")
       ->capture_default_str();
+  cmd->add_option("--max-section-shape", args->cylinders.tube.maxSectionShapeShare,
+                  "turn down a straight tube when more than this share of its points' spread "
+                  "about it is a section shape fixed along its axis, of RMS above 0.05 x its "
+                  "radius (a noisy box's faces: 0.23 and more; real table legs read 0.25-0.68 "
+                  "too; 1: off)")
+      ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
       ->capture_default_str();
@@ -292,6 +298,7 @@ void addCylindersCommand(CLI::App& app) {
           {"max_mean_variation", o.filter.maxMeanVariation},
           {"min_arc_degrees", o.tube.minArcDegrees},
           {"min_sector_fill", o.tube.minSectorFill},
+          {"max_section_shape_share", o.tube.maxSectionShapeShare},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
           {"nested_link_tolerance", o.nestedLinkTolerance},

@@ -79,6 +79,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"CylinderOptions::minAnisotropy", "--min-anisotropy"},
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
     {"TubeFitOptions::minSectorFill", "--min-sector-fill"},
+    {"TubeFitOptions::maxSectionShapeShare", "--max-section-shape"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
     {"CylinderOptions::nestedLinkTolerance", "--nested-link-tolerance"},
     {"TubeTrimOptions::keepFraction", "--trim-keep-fraction"},

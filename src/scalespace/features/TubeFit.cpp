@@ -252,7 +252,88 @@ struct AxisEvaluation {
   std::vector<double> radii;
   double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
   double normalDirections = 0, normalSectorFill = 0, evenSectorFill = 0;
+  double sectionShapeShare = 0;
 };
+
+// (Not in the thesis.) The share of the points' spread about the tube that a section shape
+// fixed along the axis explains: the distances to the axis less the radius profile, fitted by
+// least squares on the azimuth's harmonics 2 to 8 against the offset and first harmonic alone
+// (a centre slightly off), each sum of squares over its degrees of freedom so that a small
+// region's noise explains nothing; points beyond 3 robust sigmas of the first fit are left out.
+// A prism's flat faces are such a shape; a tube's noise is not, nor is a twisted cable's relief,
+// which turns along the axis. NaN azimuths (end caps) are skipped; 0 when too few points are
+// left. Measured values: TubeFitOptions::maxSectionShapeShare.
+double sectionShapeShare(const std::vector<double>& azimuths, const std::vector<double>& spread) {
+  // Columns: 1, then cos and sin of orders 1 to 8; the first kBase (the offset and order 1: a
+  // centre slightly off) are the tube's own, the rest its shape. An oval's order 2 counts as
+  // shape: without it a noisy box's rectangular section kept 2 of its 9 false tubes.
+  constexpr int kHarmonics = 8, kBase = 3, kColumns = 1 + 2 * kHarmonics;
+  using Row = Eigen::Matrix<double, kColumns, 1>;
+  std::vector<Row, Eigen::aligned_allocator<Row>> rows;
+  std::vector<double> values;
+  rows.reserve(azimuths.size());
+  values.reserve(azimuths.size());
+  for (std::size_t k = 0; k < azimuths.size(); ++k) {
+    if (!std::isfinite(azimuths[k])) continue;
+    // 1, cos, sin, then cos and sin of orders 2 to 8 by the angle-addition recurrence.
+    const double c1 = std::cos(azimuths[k]), s1 = std::sin(azimuths[k]);
+    Row r;
+    r[0] = 1;
+    r[1] = c1;
+    r[2] = s1;
+    double c = c1, sn = s1;
+    for (int order = 2; order <= kHarmonics; ++order) {
+      const double next = c * c1 - sn * s1;
+      sn = sn * c1 + c * s1;
+      c = next;
+      r[2 * order - 1] = c;
+      r[2 * order] = sn;
+    }
+    rows.push_back(r);
+    values.push_back(spread[k]);
+  }
+  // Least squares on the first n columns over the points kept; the residuals are left in error.
+  std::vector<char> kept(rows.size(), 1);
+  std::vector<double> error(rows.size());
+  auto fit = [&](int n, std::size_t& used) {
+    Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(n, n);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+    used = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      if (!kept[k]) continue;
+      gram.selfadjointView<Eigen::Lower>().rankUpdate(rows[k].head(n));
+      rhs += rows[k].head(n) * values[k];
+      ++used;
+    }
+    gram = gram.selfadjointView<Eigen::Lower>();
+    // A tiny ridge keeps the harmonics of a narrow arc, nearly dependent there, solvable.
+    gram.diagonal().array() += 1e-9 * gram.diagonal().maxCoeff();
+    const Eigen::VectorXd coef = gram.ldlt().solve(rhs);
+    double squares = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      error[k] = values[k] - rows[k].head(n).dot(coef);
+      if (kept[k]) squares += error[k] * error[k];
+    }
+    return squares;
+  };
+  std::size_t used = 0;
+  if (rows.size() < std::size_t(10 * kColumns)) return 0;
+  // Points far off the offset-and-centre fit (beyond 3 robust sigmas: a mug's handle, another
+  // object grown into the region) are left out: a shape must hold along the whole axis, not at
+  // one place. A prism's faces stay in (their spread is bounded).
+  fit(kBase, used);
+  std::vector<double> magnitudes(error.size());
+  for (std::size_t k = 0; k < error.size(); ++k) magnitudes[k] = std::abs(error[k]);
+  const auto middle = magnitudes.begin() + std::ptrdiff_t(magnitudes.size() / 2);
+  std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+  const double bound = 3 * 1.4826 * *middle;
+  for (std::size_t k = 0; k < error.size(); ++k) kept[k] = std::abs(error[k]) <= bound;
+  const double base = fit(kBase, used);
+  if (used < std::size_t(10 * kColumns)) return 0;
+  const double full = fit(kColumns, used);
+  const double perBase = base / double(used - kBase), perFull = full / double(used - kColumns);
+  return perBase > 0 ? std::max(0.0, 1 - perFull / perBase) : 0;
+}
 
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                   const std::vector<Index>& points, bool straight, AxisEvaluation& e) {
@@ -296,6 +377,17 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     if (radial.norm() < 0.5 * d.norm()) return std::numeric_limits<double>::quiet_NaN();
     return std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
   };
+  if (straight) {  // TubeFit::sectionShapeShare is read about a straight axis only
+    std::vector<double> azimuths(points.size()), spread(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const Projection& p = proj[k];
+      const Vec3 foot = e.axis[p.segment] + p.along * (e.axis[p.segment + 1] - e.axis[p.segment]);
+      azimuths[k] = azimuth(p.segment, positions[points[k]] - foot);
+      spread[k] =
+          p.distance - ((1 - p.along) * e.radii[p.segment] + p.along * e.radii[p.segment + 1]);
+    }
+    e.sectionShapeShare = sectionShapeShare(azimuths, spread);
+  }
   // Arcs are counted per axis segment, each in its own frame, and the median over the segments
   // holding enough points is kept: along a polyline that wanders (the axis of a box's rounded
   // footprint turning at its corners) one frame would smear two face normals over many angles.
@@ -542,6 +634,10 @@ void validateTubeFitOptions(const TubeFitOptions& options) {
         "TubeFitOptions::minRadiusFactor must be finite and >= 0");
   check(std::isfinite(options.maxRelativeRms) && options.maxRelativeRms > 0,
         "TubeFitOptions::maxRelativeRms must be finite and > 0");
+  check(options.maxSectionShapeShare >= 0 && options.maxSectionShapeShare <= 1,
+        "TubeFitOptions::maxSectionShapeShare must be in [0, 1] (1: no test)");
+  check(std::isfinite(options.maxSectionShapeRms) && options.maxSectionShapeRms >= 0,
+        "TubeFitOptions::maxSectionShapeRms must be finite and >= 0");
   check(std::isfinite(options.minNormalDirections) && options.minNormalDirections >= 0,
         "TubeFitOptions::minNormalDirections must be finite and >= 0");
   check(options.minSectorFill >= 0 && options.minSectorFill <= 1,
@@ -629,6 +725,9 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   fit.arcDegrees = std::min(chosen.normalArc, chosen.positionArc);
   fit.normalDirections = chosen.normalDirections;
   fit.sectorFill = std::max(chosen.normalSectorFill, chosen.evenSectorFill);
+  // Read about a straight axis only (evaluateAxis): in the frame carried along a curved one, a
+  // twisted strand's run read 0.34 (the noisy one-sided pipe rack, t = 0.0435).
+  fit.sectionShapeShare = chosen.sectionShapeShare;
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 
@@ -644,6 +743,10 @@ TubeRejection judgeTube(const TubeFit& fit, double t, const TubeFitOptions& opti
   if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t))) return TubeRejection::Rough;
   if (fit.normalDirections < std::min(options.minNormalDirections, 0.5 * double(fit.pointCount)) ||
       fit.sectorFill < options.minSectorFill)
+    return TubeRejection::Faceted;
+  // Both the share and the shape's own RMS (TubeFitOptions::maxSectionShapeRms).
+  if (fit.sectionShapeShare > options.maxSectionShapeShare &&
+      std::sqrt(fit.sectionShapeShare) * fit.rms > options.maxSectionShapeRms * fit.radius)
     return TubeRejection::Faceted;
   return TubeRejection::None;
 }

@@ -60,6 +60,22 @@ struct TubeFitOptions {
   /// neighbours smear them, crowd in two directions; a noisy prism's smeared face directions fill
   /// the bins they take, not the span with the gaps between them.
   double minSectorFill = 0.75;
+  /// Off by default (1). When below 1, the positions about a straight axis must not hold a
+  /// section shape fixed along it: a tube is turned down (Faceted) when more than this share of
+  /// its points' spread about it is explained by the azimuth's harmonics 2-8 and that shape's
+  /// RMS is above maxSectionShapeRms x the radius. A prism's faces, whose normals noise smears
+  /// into a tube's, read so (a box standing on a floor, noise 1e-3 of the diagonal, normals
+  /// estimated over 20 neighbours: shares 0.23-0.77, shape RMS 0.08-0.25; with 0.2 its 9 false
+  /// tubes over the scales drop to 1, the 4 poles beside it unchanged), as did the table legs of
+  /// python3-pcl's table_scene_lms400, which it then loses (shares 0.25-0.68, shape RMS 0.06-0.09:
+  /// their points sit 21.7 to 28.6 mm from the axis in a pattern fixed along it), and so does an
+  /// oval tube. The noisy pipe rack's straight tubes and strand runs read up to 0.17; a curved
+  /// axis is not tested (in the frame carried along it a twisted strand's run read 0.34).
+  double maxSectionShapeShare = 1;
+  /// The shape's RMS bound (sqrt(share) x the tube's RMS, over the radius): over a narrow arc the
+  /// harmonics also follow a scan's smooth biases (the stereo mug of python3-pcl's
+  /// table_scene_mug_stereo_textured: share 0.33 at RMS 0.05 r, 0.03 r of shape).
+  double maxSectionShapeRms = 0.05;
   /// The axis is straight unless the curved axis fits the points better: straight when the RMS
   /// about the straight axis is <= straightRmsRatio x that about the curved one (or within 2% of
   /// the radius of it).
@@ -99,15 +115,16 @@ struct TubeFit {
   Vec3 centre = Vec3::Zero();
   double straightRadius = 0;  // radius of the straight fit
   double arcDegrees = 0;  // the arc around the axis covered by both the points and their normals
-  double normalDirections = 0;  // TubeFitOptions::minNormalDirections' measure
-  double sectorFill = 0;        // TubeFitOptions::minSectorFill's measure
-  double length = 0;            // of the axis polyline
+  double normalDirections = 0;   // TubeFitOptions::minNormalDirections' measure
+  double sectorFill = 0;         // TubeFitOptions::minSectorFill's measure
+  double sectionShapeShare = 0;  // TubeFitOptions::maxSectionShapeShare's measure
+  double length = 0;             // of the axis polyline
   std::size_t pointCount = 0;
 };
 
 /// The tests of a fitted tube (fitTube's last step), in order: TooSmall, NarrowArc, Thin, Rough,
 /// Faceted, else None; on its measures (length, arc, radius, RMS, normal directions, sector
-/// fill, point count) at scale t.
+/// fill, section shape, point count) at scale t.
 TubeRejection judgeTube(const TubeFit& fit, double t, const TubeFitOptions& options);
 
 /// Fits the tube of `points` (indices into positions / normals / the scale fields). `normals` are

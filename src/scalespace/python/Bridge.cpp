@@ -97,6 +97,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"CylinderOptions::minAnisotropy", "min_anisotropy"},
     {"TubeFitOptions::minArcDegrees", "min_arc"},
     {"TubeFitOptions::minSectorFill", "min_sector_fill"},
+    {"TubeFitOptions::maxSectionShapeShare", "max_section_shape"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
     {"CylinderOptions::nestedLinkTolerance", "nested_link_tolerance"},
     {"TubeTrimOptions::keepFraction", "trim_keep_fraction"},
