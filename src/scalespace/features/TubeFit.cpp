@@ -266,7 +266,7 @@ struct AxisEvaluation {
 double sectionShapeShare(const std::vector<double>& azimuths, const std::vector<double>& spread) {
   // Columns: 1, then cos and sin of orders 1 to 8; the first kBase (the offset and order 1: a
   // centre slightly off) are the tube's own, the rest its shape. An oval's order 2 counts as
-  // shape: without it a noisy box's rectangular section kept 2 of its 9 false tubes.
+  // shape: without it more of a noisy box's false tubes stayed (its section is a rectangle).
   constexpr int kHarmonics = 8, kBase = 3, kColumns = 1 + 2 * kHarmonics;
   using Row = Eigen::Matrix<double, kColumns, 1>;
   std::vector<Row, Eigen::aligned_allocator<Row>> rows;

@@ -64,13 +64,14 @@ struct TubeFitOptions {
   /// section shape fixed along it: a tube is turned down (Faceted) when more than this share of
   /// its points' spread about it is explained by the azimuth's harmonics 2-8 and that shape's
   /// RMS is above maxSectionShapeRms x the radius. A prism's faces, whose normals noise smears
-  /// into a tube's, read so (a box standing on a floor, noise 1e-3 of the diagonal, normals
-  /// estimated over 20 neighbours: shares 0.23-0.77, shape RMS 0.08-0.25; with 0.2 its 9 false
-  /// tubes over the scales drop to 1, the 4 poles beside it unchanged), as did the table legs of
-  /// python3-pcl's table_scene_lms400, which it then loses (shares 0.25-0.68, shape RMS 0.06-0.09:
-  /// their points sit 21.7 to 28.6 mm from the axis in a pattern fixed along it), and so does an
-  /// oval tube. The noisy pipe rack's straight tubes and strand runs read up to 0.17; a curved
-  /// axis is not tested (in the frame carried along it a twisted strand's run read 0.34).
+  /// into a tube's, read so (bench/python/bench_cylinders_box_and_poles.py: a box on a floor,
+  /// noise 5e-4-1e-3 of the diagonal, normals estimated over 20 neighbours: shares 0.23-0.77,
+  /// shape RMS 0.08-0.25; with 0.2 about half its false tubes go, the poles beside it kept), as
+  /// did the table legs of python3-pcl's table_scene_lms400, which it then loses (shares
+  /// 0.25-0.68, shape RMS 0.06-0.09: their points sit 21.7 to 28.6 mm from the axis in a pattern
+  /// fixed along it), and so does an oval tube. The noisy pipe rack's straight tubes and strand
+  /// runs read up to 0.17; a curved axis is not tested (in the frame carried along it a twisted
+  /// strand's run read 0.34).
   double maxSectionShapeShare = 1;
   /// The shape's RMS bound (sqrt(share) x the tube's RMS, over the radius): over a narrow arc the
   /// harmonics also follow a scan's smooth biases (the stereo mug of python3-pcl's
