@@ -418,7 +418,7 @@ def test_cylinders_equal_the_cli(pipes):
                     "representative_level", "point_count", "straight"):
             assert g[key] == e[key], key
         for key in ("birth_scale", "death_scale", "radius", "rms", "length", "arc_degrees",
-                    "sector_fill"):
+                    "sector_fill", "section_shape"):
             np.testing.assert_allclose(g[key], e[key], rtol=1e-9, err_msg=key)
         np.testing.assert_allclose(g["axis"], e["axis"], rtol=1e-9, atol=1e-9)  # absolute
         np.testing.assert_allclose(g["radii"], e["radii"], rtol=1e-9)

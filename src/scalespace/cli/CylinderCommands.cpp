@@ -94,6 +94,7 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
                            {"length", t.length},
                            {"arc_degrees", t.arcDegrees},
                            {"sector_fill", t.sectorFill},
+                           {"section_shape", t.sectionShapeShare},
                            {"axis", axis},
                            {"radii", t.radii}};
     if (t.straight) {  // the straight axis means nothing for a bent tube

@@ -81,6 +81,7 @@ class Cylinders {
       d["length"] = t.length;
       d["arc_degrees"] = t.arcDegrees;
       d["sector_fill"] = t.sectorFill;
+      d["section_shape"] = t.sectionShapeShare;
       d["direction"] = t.straight ? py::object(vec3Array(t.direction)) : py::object(py::none());
       d["centre"] = t.straight ? py::object(vec3Array(t.centre + origin_)) : py::object(py::none());
       d["axis"] = vectorsToArray(t.axis, origin_);
@@ -211,7 +212,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
           "gap_levels (levels between them where it was not found), persistence (death_level - "
           "birth_level - gap_levels), representative_level and _scale (where it holds the most "
           "points: its "
-          "tube is reported), point_count, straight, radius, rms, length, arc_degrees, direction "
+          "tube is reported), point_count, straight, radius, rms, length, arc_degrees, "
+          "sector_fill, section_shape (max_section_shape's measure; 0 for a bent tube), direction "
           "(3,) and centre (3,) of the straight axis (None for a bent tube), axis (K, 3), radii "
           "(K,: the radius at each axis vertex)")
       .def("anisotropy", &Cylinders::anisotropy, "level"_a,
