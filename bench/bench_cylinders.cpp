@@ -399,8 +399,8 @@ static int run(int argc, char** argv) {
           "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
-          "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] [--max-gap "
-          "LEVELS] "
+          "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] "
+          "[--max-gap LEVELS] "
           "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F] "
           "[--no-junction-trim]\n");
       return 2;

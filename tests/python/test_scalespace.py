@@ -577,6 +577,8 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"scale_count": 0}, "scale_count"), ({"min_arc": 400}, "min_arc"),
                          ({"max_rms": 0}, "max_rms"), ({"tmin": -1}, "tmin"),
                          ({"min_sector_fill": 2}, "min_sector_fill"),
+                         ({"max_section_shape": 2}, "max_section_shape"),
+                         ({"max_section_shape_rms": -1}, "max_section_shape_rms"),
                          ({"max_gap": -1}, "max_gap"),
                          ({"nested_link_tolerance": 1}, "nested_link_tolerance"),
                          ({"narrow_min_arc": -1}, "narrow_min_arc"),

@@ -157,9 +157,13 @@ void addCylindersCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-section-shape", args->cylinders.tube.maxSectionShapeShare,
                   "turn down a straight tube when more than this share of its points' spread "
-                  "about it is a section shape fixed along its axis, of RMS above 0.05 x its "
-                  "radius (a noisy box's faces: 0.23 and more; real table legs read 0.25-0.68 "
-                  "too; 1: off)")
+                  "about it is a section shape fixed along its axis and that shape's RMS is over "
+                  "--max-section-shape-rms (a noisy box's faces: 0.23 and more; real table legs "
+                  "read 0.25-0.68 too; 1: off)")
+      ->capture_default_str();
+  cmd->add_option("--max-section-shape-rms", args->cylinders.tube.maxSectionShapeRms,
+                  "with --max-section-shape: the shape's RMS must also be over this x the "
+                  "radius (a noisy box: 0.08 and more; a stereo scan's mug wall: 0.03)")
       ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
@@ -300,6 +304,7 @@ void addCylindersCommand(CLI::App& app) {
           {"min_arc_degrees", o.tube.minArcDegrees},
           {"min_sector_fill", o.tube.minSectorFill},
           {"max_section_shape_share", o.tube.maxSectionShapeShare},
+          {"max_section_shape_rms", o.tube.maxSectionShapeRms},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
           {"nested_link_tolerance", o.nestedLinkTolerance},

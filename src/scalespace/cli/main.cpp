@@ -80,6 +80,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"TubeFitOptions::minArcDegrees", "--min-arc"},
     {"TubeFitOptions::minSectorFill", "--min-sector-fill"},
     {"TubeFitOptions::maxSectionShapeShare", "--max-section-shape"},
+    {"TubeFitOptions::maxSectionShapeRms", "--max-section-shape-rms"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
     {"CylinderOptions::nestedLinkTolerance", "--nested-link-tolerance"},
     {"TubeTrimOptions::keepFraction", "--trim-keep-fraction"},

@@ -252,7 +252,6 @@ struct AxisEvaluation {
   std::vector<double> radii;
   double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
   double normalDirections = 0, normalSectorFill = 0, evenSectorFill = 0;
-  double sectionShapeShare = 0;
 };
 
 // (Not in the thesis.) The share of the points' spread about the tube that a section shape
@@ -263,7 +262,7 @@ struct AxisEvaluation {
 // A prism's flat faces are such a shape; a tube's noise is not, nor is a twisted cable's relief,
 // which turns along the axis. NaN azimuths (end caps) are skipped; 0 when too few points are
 // left. Measured values: TubeFitOptions::maxSectionShapeShare.
-double sectionShapeShare(const std::vector<double>& azimuths, const std::vector<double>& spread) {
+double shapeShareOf(const std::vector<double>& azimuths, const std::vector<double>& spread) {
   // Columns: 1, then cos and sin of orders 1 to 8; the first kBase (the offset and order 1: a
   // centre slightly off) are the tube's own, the rest its shape. An oval's order 2 counts as
   // shape: without it more of a noisy box's false tubes stayed (its section is a rectangle).
@@ -335,6 +334,26 @@ double sectionShapeShare(const std::vector<double>& azimuths, const std::vector<
   return perBase > 0 ? std::max(0.0, 1 - perFull / perBase) : 0;
 }
 
+// The azimuths about a straight axis (one frame along it) and the distances less the radius
+// profile; NaN where the offset runs along the axis (beyond its ends).
+double sectionShapeShare(const std::vector<Vec3>& positions, const std::vector<Index>& points,
+                         const std::vector<Vec3>& axis, const std::vector<double>& radii) {
+  const Vec3 along = (axis.back() - axis.front()).normalized();
+  const Vec3 u = anyPerpendicular(along), v = along.cross(u);
+  const AxisLocator locator(axis);
+  std::vector<double> azimuths(points.size()), spread(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const AxisLocator::Projection p = locator.project(positions[points[k]]);
+    const Vec3 offset = positions[points[k]] -
+                        (axis[p.segment] + p.along * (axis[p.segment + 1] - axis[p.segment]));
+    const Vec3 radial = offset - offset.dot(along) * along;
+    azimuths[k] = radial.norm() < 0.5 * offset.norm() ? std::numeric_limits<double>::quiet_NaN()
+                                                      : std::atan2(radial.dot(v), radial.dot(u));
+    spread[k] = p.distance - ((1 - p.along) * radii[p.segment] + p.along * radii[p.segment + 1]);
+  }
+  return shapeShareOf(azimuths, spread);
+}
+
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                   const std::vector<Index>& points, bool straight, AxisEvaluation& e) {
   const std::size_t m = e.axis.size();
@@ -377,17 +396,6 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     if (radial.norm() < 0.5 * d.norm()) return std::numeric_limits<double>::quiet_NaN();
     return std::atan2(radial.dot(tangent[s].cross(across[s])), radial.dot(across[s]));
   };
-  if (straight) {  // TubeFit::sectionShapeShare is read about a straight axis only
-    std::vector<double> azimuths(points.size()), spread(points.size());
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const Projection& p = proj[k];
-      const Vec3 foot = e.axis[p.segment] + p.along * (e.axis[p.segment + 1] - e.axis[p.segment]);
-      azimuths[k] = azimuth(p.segment, positions[points[k]] - foot);
-      spread[k] =
-          p.distance - ((1 - p.along) * e.radii[p.segment] + p.along * e.radii[p.segment + 1]);
-    }
-    e.sectionShapeShare = sectionShapeShare(azimuths, spread);
-  }
   // Arcs are counted per axis segment, each in its own frame, and the median over the segments
   // holding enough points is kept: along a polyline that wanders (the axis of a box's rounded
   // footprint turning at its corners) one frame would smear two face normals over many angles.
@@ -725,9 +733,10 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
   fit.arcDegrees = std::min(chosen.normalArc, chosen.positionArc);
   fit.normalDirections = chosen.normalDirections;
   fit.sectorFill = std::max(chosen.normalSectorFill, chosen.evenSectorFill);
-  // Read about a straight axis only (evaluateAxis): in the frame carried along a curved one, a
-  // twisted strand's run read 0.34 (the noisy one-sided pipe rack, t = 0.0435).
-  fit.sectionShapeShare = chosen.sectionShapeShare;
+  // Read about a straight axis only: in the frame carried along a curved one, a twisted strand's
+  // run read 0.34 (the noisy one-sided pipe rack, t = 0.0435).
+  if (fit.straight)
+    fit.sectionShapeShare = sectionShapeShare(positions, points, fit.axis, fit.radii);
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
 

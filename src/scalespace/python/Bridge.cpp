@@ -98,6 +98,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"TubeFitOptions::minArcDegrees", "min_arc"},
     {"TubeFitOptions::minSectorFill", "min_sector_fill"},
     {"TubeFitOptions::maxSectionShapeShare", "max_section_shape"},
+    {"TubeFitOptions::maxSectionShapeRms", "max_section_shape_rms"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
     {"CylinderOptions::nestedLinkTolerance", "nested_link_tolerance"},
     {"TubeTrimOptions::keepFraction", "trim_keep_fraction"},

@@ -148,8 +148,8 @@ std::unique_ptr<Cylinders> cylindersPy(
     const py::handle& points, const py::handle& normals, const py::handle& viewpoint,
     const std::optional<std::vector<double>>& scales, int scaleCount, double tmin, double tmax,
     double epsilon, double minAnisotropy, double minArc, double minSectorFill,
-    double maxSectionShape, double maxRms, bool oneCurvatureSign, bool splitByAxes,
-    bool trimJunctions, bool narrowTubes, int maxGap, double nestedLinkTolerance,
+    double maxSectionShape, double maxSectionShapeRms, double maxRms, bool oneCurvatureSign,
+    bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap, double nestedLinkTolerance,
     double trimKeepFraction, double trimMinRadius, double trimAgainstShare, double narrowMinArc,
     int narrowMinPersistence, double narrowRadiusSpread, std::optional<int> threads,
     py::object progress) {
@@ -164,6 +164,7 @@ std::unique_ptr<Cylinders> cylindersPy(
   options.tube.minArcDegrees = minArc;
   options.tube.minSectorFill = minSectorFill;
   options.tube.maxSectionShapeShare = maxSectionShape;
+  options.tube.maxSectionShapeRms = maxSectionShapeRms;
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
   options.split.enabled = splitByAxes;
@@ -243,7 +244,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5,
         "min_arc"_a = TubeFitOptions{}.minArcDegrees,
         "min_sector_fill"_a = TubeFitOptions{}.minSectorFill,
-        "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare, "max_rms"_a = 0.25,
+        "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare,
+        "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms, "max_rms"_a = 0.25,
         "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
         "split_by_axes"_a = TubeSplitOptions{}.enabled,
         "trim_junctions"_a = TubeTrimOptions{}.enabled,
@@ -269,7 +271,8 @@ sectors of that arc the normals must fill (a box edge rounded into a tube fills 
 max_section_shape: below 1, a straight tube is turned down when more than this share of its
 points' spread about it is a section shape fixed along its axis (the azimuth's harmonics 2-8) of
 RMS above 0.05 x its radius: a noisy box's faces read 0.23 and more, but so did the real table
-legs of python3-pcl's table scan (0.25-0.68); 1 (default): off;
+legs of python3-pcl's table scan (0.25-0.68); 1 (default): off; max_section_shape_rms: that RMS
+bound, over the radius;
 max_rms: a tube's RMS distance to its surface over its radius. one_curvature_sign: a region
 only grows over points curving the way its seed does, which stops it at the groove between a
 noisy cable's strands (needs consistently oriented normals; off: Eq. 3.10 alone).
