@@ -21,6 +21,9 @@
 //                  normals)
 //                  [--mesh-normals] (the clean and noisy clouds take the mesh's interpolated
 //                  normals)
+//                  [--fold-borders auto|on|off] [--fold-share X] [--fold-reach X]
+//                  (FeatureCurveOptions::foldBorders, auto: where the rays found the cloud closed,
+//                  as `features`; foldBorderShare, foldReach)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--crease-reach X (0: off)] [--crease-half-width X] [--crease-flatness X]
@@ -301,7 +304,8 @@ struct MeshEdges {
   std::vector<bool> curveFold;      // per curve: a fold of the triangulation (findSharpEdges)
   std::size_t convex = 0, concave = 0;
   std::size_t border = 0, nonManifold = 0,
-              inconsistent = 0;  // edges with 1, > 2 faces; bad winding
+              inconsistent = 0;                      // edges with 1, > 2 faces; bad winding
+  std::vector<std::pair<Index, Index>> borderEdges;  // --per-curve: false positives near them
   bool flipped = false;
 };
 
@@ -353,6 +357,8 @@ MeshEdges findSharpEdges(const TriangleMesh& mesh, double angleDegrees, double s
   for (const auto& [key, list] : faces) {
     if (list.size() != 2) {
       ++(list.size() == 1 ? out.border : out.nonManifold);
+      if (list.size() == 1)
+        out.borderEdges.emplace_back(Index(key >> 32), Index(key & 0xffffffffu));
       continue;
     }
     const Index a = Index(key >> 32), b = Index(key & 0xffffffffu);
@@ -487,9 +493,14 @@ bool reflect = featureNormalOptions().orientation.reflectAcrossBisector;
 SheetSign sheetSign = featureNormalOptions().sheetSign;
 
 bool printPerCurve = false;  // --per-curve
+// --fold-borders auto|on|off (FeatureCurveOptions::foldBorders; auto: as `features`, where the
+// rays found the cloud closed).
+enum class FoldBorders { Auto, On, Off };
+FoldBorders foldBorders = FoldBorders::Auto;
 
-// As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals).
-void estimateSceneNormals(PointCloud& cloud) {
+// As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals); returns
+// whether the rays found the surface closed (NormalOrientationResult::closedSurface).
+bool estimateSceneNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
   OrientedNormalsOptions options = featureNormalOptions(sheetNormals);
   options.orientation.acrossWeight = acrossWeight;
@@ -503,7 +514,13 @@ void estimateSceneNormals(PointCloud& cloud) {
         "%zu: kept %s\n",
         normals.rays.differing, normals.rays.firstInward, normals.rays.secondInward,
         normals.rays.sampled, normals.signSource == SheetSign::OwnTree ? "own tree" : "PCA signs");
+  if (printPerCurve)
+    std::printf("# orientation: k %zu, %zu components, %zu pieces, %zu closed, closed surface %s\n",
+                normals.estimation.k, normals.orientation.componentCount,
+                normals.orientation.pieceCount, normals.orientation.closedComponents,
+                normals.orientation.closedSurface ? "yes" : "no");
   cloud.setNormals(std::move(normals.normals));
+  return normals.orientation.closedSurface;
 }
 
 PointCloud noisyCopy(const PointCloud& clean, double sigma) {
@@ -526,6 +543,7 @@ const PointCloud* lastCloud = nullptr;  // the cloud ours ran on
 struct Model {
   std::string name;
   TriangleMesh mesh;
+  bool cleanClosed = false;       // the rays found the clean cloud's surface closed
   PointCloud clean;               // with estimated normals
   std::vector<Vec3> meshNormals;  // of the samples, interpolated from the mesh
   std::vector<int> gt;            // per point: ground-truth curve or -1
@@ -580,7 +598,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.clean = sampleMesh(m.mesh, points, kSampleSeed);
   const std::vector<Vec3> truth = m.clean.normals();
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
-  estimateSceneNormals(m.clean);
+  m.cleanClosed = estimateSceneNormals(m.clean);
   const std::vector<Vec3> estimated = m.clean.normals();
   m.meshNormals = truth;
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
@@ -1033,12 +1051,22 @@ Scores score(const Model& m, const std::vector<int>& detected, int detectedCount
     if (l) labelledSet.push_back(Index(i));
   }
   if (printPerCurve) {  // false positives just beside an edge (a band too wide) or far from it
-    std::size_t within2 = 0, within3 = 0, far = 0;
+    std::size_t within2 = 0, within3 = 0, far = 0, farNearBorder = 0;
     for (std::size_t i = 0; i < m.gt.size(); ++i)
-      if (m.gt[i] < 0 && detected[i] >= 0)
+      if (m.gt[i] < 0 && detected[i] >= 0) {
         ++(m.gt2[i] >= 0 ? within2 : m.gt3[i] >= 0 ? within3 : far);
-    std::printf("#   false positives %.0f: within 2e %zu, 2e-3e %zu, beyond 3e %zu\n", fp, within2,
-                within3, far);
+        if (m.gt3[i] >= 0) continue;
+        for (const auto& [a, b] : m.edges.borderEdges)
+          if (segmentDistance(m.clean.positions()[i], m.mesh.vertices[a] - m.clean.origin(),
+                              m.mesh.vertices[b] - m.clean.origin()) < 3 * m.spacing) {
+            ++farNearBorder;
+            break;
+          }
+      }
+    std::printf(
+        "#   false positives %.0f: within 2e %zu, 2e-3e %zu, beyond 3e %zu (%zu of them within 3e "
+        "of the mesh's border)\n",
+        fp, within2, within3, far, farNearBorder);
   }
   Scores s;
   s.labelled = (tp + fp) / double(m.gt.size());
@@ -1066,8 +1094,14 @@ struct Detection {
 // Ours with the library's defaults unless --salient / --vote-threshold / --min-curvature /
 // --vote-radius say otherwise (to measure a setting against the same ground truth).
 
-Detection runOurs(const PointCloud& cloud) {
-  FeatureCurveResult result = detectFeatureCurves(cloud, ourOptions);
+Detection runOurs(const PointCloud& cloud, bool closed) {
+  FeatureCurveOptions options = ourOptions;
+  // As `features` does for a cloud whose estimated normals' rays found it closed.
+  options.foldBorders = foldBorders == FoldBorders::Auto ? closed : foldBorders == FoldBorders::On;
+  FeatureCurveResult result = detectFeatureCurves(cloud, options);
+  if (printPerCurve)
+    std::printf("# fold borders %s: %zu points\n", options.foldBorders ? "on" : "off",
+                result.foldPoints);
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
@@ -1229,7 +1263,8 @@ bool makeMesh(const std::string& name, const std::string& dir, std::size_t point
 }
 
 // Every method on one cloud (clean or noisy) of a model.
-void runMethods(const Model& m, const PointCloud& cloud, bool peers, std::vector<Row>& rows) {
+void runMethods(const Model& m, const PointCloud& cloud, bool closed, bool peers,
+                std::vector<Row>& rows) {
   const auto add = [&](const std::string& method, const Detection& d, double seconds) {
     Row row{method, d.edge.empty() ? score(m, d.curve, d.count, d.curve, d.count)
                                    : score(m, d.curve, d.count, d.edge, d.edgeCount)};
@@ -1238,7 +1273,7 @@ void runMethods(const Model& m, const PointCloud& cloud, bool peers, std::vector
     rows.push_back(row);
   };
   Clock::time_point start = Clock::now();
-  const Detection ours = runOurs(cloud);
+  const Detection ours = runOurs(cloud, closed);
   add("ours", ours, secondsSince(start));
   if (printPerCurve && lastOurs) {
     // How far ours' salient vertices lie from the sharp edges, per scale, in units of e: the APSS
@@ -1323,6 +1358,17 @@ static int run(int argc, char** argv) {
       models = splitList(argv[++i]);
     } else if (a == "--angle" && hasValue) {
       angle = scalespace::bench::numberArgument(argv, ++i);
+    } else if (a == "--fold-borders" && hasValue) {
+      const std::string v = argv[++i];
+      if (v != "auto" && v != "on" && v != "off") {
+        std::fprintf(stderr, "--fold-borders takes auto, on or off\n");
+        return 2;
+      }
+      foldBorders = v == "on" ? FoldBorders::On : v == "off" ? FoldBorders::Off : FoldBorders::Auto;
+    } else if (a == "--fold-share" && hasValue) {
+      ourOptions.foldBorderShare = scalespace::bench::numberArgument(argv, ++i);
+    } else if (a == "--fold-reach" && hasValue) {
+      ourOptions.foldReach = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--clean-only") {
       noisy = false;
     } else if (a == "--noise-only") {
@@ -1423,13 +1469,13 @@ static int run(int argc, char** argv) {
         printModel(
             m, std::size_t(std::count_if(m.gt.begin(), m.gt.end(), [](int c) { return c >= 0; })));
         if (noise == 0) {
-          runMethods(m, m.clean, peers, rows);
+          runMethods(m, m.clean, m.cleanClosed, peers, rows);
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
-          estimateSceneNormals(cloud);
+          const bool closed = estimateSceneNormals(cloud);
           if (printPerCurve) printOrientation(m, cloud.normals(), "noisy");
           if (meshNormals) cloud.setNormals(m.meshNormals);
-          runMethods(m, cloud, peers, rows);
+          runMethods(m, cloud, closed, peers, rows);
         }
       } catch (const Error& error) {
         std::printf("# %s: skipped (%s)\n", name.c_str(), error.what());

@@ -179,6 +179,15 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("coincide"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("o4")));
+  // A mesh read as its 8 vertices: the error says how to sample its faces instead.
+  std::ofstream(path("cube.off"))
+      << "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+         "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  r = run("cylinders " + path("cube.off") + " -q -o " + path("o5"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("8 points"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("read as its 8 vertices: --sample N"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("o5")));
   // --one-sided belongs to the pipes scene.
   r = run("generate box --one-sided -q -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);

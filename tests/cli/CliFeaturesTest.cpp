@@ -146,6 +146,9 @@ TEST_F(Cli, FeatureCommandsRefuseBadOptionsAndInputs) {
   refused("features " + c + " --crease-half-width 0 -o " + path("out.ply"), "--crease-half-width");
   refused("features " + c + " --crease-side-margin -1 -o " + path("out.ply"),
           "--crease-side-margin");
+  refused("features " + c + " --fold-borders yes -o " + path("out.ply"), "--fold-borders");
+  refused("features " + c + " --fold-reach 0 -o " + path("out.ply"), "--fold-reach");
+  refused("features " + c + " --fold-share 1.5 -o " + path("out.ply"), "--fold-share");
   std::ofstream(path("bad.off")) << "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n";
   refused("features " + path("bad.off") + " -o " + path("out.ply"), "vertex 2", 1);
   std::ofstream(path("bad.stl")) << "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n";

@@ -601,3 +601,50 @@ TEST(FeatureCurves, ACappedSalientBoundFindsAWeakRidgeBesideStrongEdges) {
   negative.salientBoundCap = -1;
   EXPECT_THROW(detectFeatureCurves(cloud, negative), OptionError);
 }
+
+// A part thinner than its noise reads as one sheet: its rim has no crease for the lines, only
+// a border. With foldBorders (a closed surface) the border is a convex curve; without (an open
+// scan) it is where the sampling stops and nothing is labelled.
+TEST(FeatureCurves, TheBordersOfASheetAreFoldsOnlyWhenAsked) {
+  RectangleSampler s;
+  s.add(Vec3(0, 0, 0), Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), 8000);
+  std::normal_distribution<double> noise(0, 0.002);
+  for (Vec3& p : s.positions) p.z() += noise(s.random);
+  const PointCloud cloud = s.cloud();
+  const FeatureCurveResult off = detectFeatureCurves(cloud, FeatureCurveOptions{});
+  EXPECT_EQ(off.foldPoints, 0u);
+  EXPECT_TRUE(off.curves.empty());
+  FeatureCurveOptions folds;
+  folds.foldBorders = true;
+  const FeatureCurveResult on = detectFeatureCurves(cloud, folds);
+  const double e = on.spacing;
+  EXPECT_GT(on.foldPoints, 0u);
+  std::size_t rim = 0, rimConvex = 0, inside = 0, insideLabelled = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.positions()[i];
+    const double toBorder = std::min({p.x(), 1 - p.x(), p.y(), 1 - p.y()});
+    if (toBorder < 0.5 * e) {
+      ++rim;
+      rimConvex += on.curveId[i] >= 0 && on.convexity[i] == 1;
+    } else if (toBorder > 2.5 * e) {
+      ++inside;
+      insideLabelled += on.curveId[i] >= 0;
+    }
+  }
+  EXPECT_GT(double(rimConvex), 0.9 * double(rim));
+  EXPECT_EQ(insideLabelled, 0u);
+  // The four sides meet at the corners: one curve around the sheet, about 4 long.
+  ASSERT_EQ(on.curves.size(), 1u);
+  EXPECT_EQ(on.curves[0].convexity, 1);
+  EXPECT_NEAR(on.curves[0].length, 4.0, 0.6);
+  // The same labels for any thread count.
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(detectFeatureCurves(cloud, folds).curveId, on.curveId);
+  }
+  folds.foldReach = 0;
+  EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
+  folds.foldReach = 3;
+  folds.foldBorderShare = 1.5;
+  EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
+}

@@ -971,3 +971,41 @@ def test_parametrize_a_sphere_and_bad_arguments():
         ss.distortion(p, uv=np.zeros((10, 2)))
     with pytest.raises(ss.Cancelled):
         ss.parametrize(p, scales=10, progress=lambda f, stage: False)
+
+
+def test_fold_borders_follow_the_rays_or_the_keyword(tmp_path):
+    # A closed box without normals: the rays find it closed, so 'auto' looks for folds (a box has
+    # none: its fits see its creases), as the CLI does; the summary says it applied.
+    cli("generate", "box", "-n", 12000, "--seed", 2, "-o", tmp_path / "generated.xyz")
+    np.savetxt(tmp_path / "box.xyz", ss.read(str(tmp_path / "generated.xyz")).points)
+    box = ss.read(str(tmp_path / "box.xyz"))
+    assert box.normals is None
+    cli("features", tmp_path / "box.xyz", "-o", tmp_path / "box.ply")
+    summary = json.loads((tmp_path / "box.json").read_text())
+    result = ss.features(box.points)
+    assert result["fold_borders"] is True
+    assert summary["parameters"]["fold_borders"] is True
+    assert summary["fold_points"] == result["fold_points"]
+    written = ss.read(str(tmp_path / "box.ply")).attributes["curve_id"]
+    np.testing.assert_array_equal(result["curve_id"].astype(written.dtype), written)
+    # An open noisy sheet: 'auto' leaves its border alone (where a scan stops); 'on' makes it a
+    # convex curve around the sheet, and nothing inside it.
+    rng = np.random.default_rng(4)
+    sheet = np.column_stack([rng.random(8000), rng.random(8000), rng.normal(0, 0.002, 8000)])
+    auto = ss.features(sheet)
+    assert auto["fold_borders"] is False and auto["fold_points"] == 0
+    on = ss.features(sheet, fold_borders="on")
+    assert on["fold_borders"] is True and on["fold_points"] > 0
+    labelled = sheet[on["curve_id"] >= 0]
+    to_border = np.minimum.reduce([labelled[:, 0], 1 - labelled[:, 0],
+                                   labelled[:, 1], 1 - labelled[:, 1]])
+    assert len(labelled) > 0 and to_border.max() < 3 * on["spacing"]
+    assert set(on["convexity"][on["curve_id"] >= 0]) == {1}
+    off = ss.features(sheet, fold_borders="off")
+    assert off["fold_points"] == 0
+    with pytest.raises(ss.OptionError, match="fold_borders"):
+        ss.features(sheet, fold_borders="yes")
+    with pytest.raises(ss.OptionError, match="fold_reach"):
+        ss.features(sheet, fold_reach=0)
+    with pytest.raises(ss.OptionError, match="fold_share"):
+        ss.features(sheet, fold_share=2)

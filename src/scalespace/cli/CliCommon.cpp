@@ -76,8 +76,8 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
   orientation.viewpoint = *cloud.viewpoint() - cloud.origin();  // recentred, as the points
 }
 
-void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options) {
-  if (cloud.hasNormals()) return;
+bool ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options) {
+  if (cloud.hasNormals()) return false;
   const NormalEstimationOptions& estimation = options.estimation;
   if (!quiet)
     std::fprintf(stderr,
@@ -100,6 +100,7 @@ void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& 
     std::fprintf(stderr, "normals: noisy input, estimated over %zu neighbours\n",
                  normals.estimation.k);
   cloud.setNormals(std::move(normals.normals));
+  return normals.orientation.closedSurface;
 }
 
 namespace {

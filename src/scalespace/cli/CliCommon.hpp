@@ -7,10 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "scalespace/core/Error.hpp"
 #include "scalespace/core/NormalEstimation.hpp"
 #include "scalespace/core/NormalOrientation.hpp"
 #include "scalespace/core/OrientedNormals.hpp"
 #include "scalespace/core/PointCloud.hpp"
+#include "scalespace/io/CloudIO.hpp"
 
 namespace scalespace::cli {
 
@@ -25,6 +27,21 @@ void addInputOptions(CLI::App& command, InputOptions& input);
 
 /// Reads the cloud; throws if it has no points (nothing to analyse).
 PointCloud loadCloud(const InputOptions& input, bool quiet);
+
+/// Runs `analyse()`. When the input is a mesh read as its vertices and the analysis turns the
+/// cloud down (OptionError: too few or too sparse points), the error ends with what to do about
+/// it, since the start-up line that said so has usually scrolled away by then.
+template <class Analyse>
+auto withMeshSampleHint(const InputOptions& input, std::size_t pointCount, Analyse&& analyse) {
+  try {
+    return analyse();
+  } catch (const OptionError& e) {
+    if (input.meshSamples > 0 || !isMeshPath(input.path)) throw;
+    throw OptionError(std::string(e.what()) + "; " + input.path + " is a mesh read as its " +
+                      std::to_string(pointCount) +
+                      " vertices: --sample N draws N points on its faces");
+  }
+}
 
 /// The cloud a saved result (`planes`, `cylinders`) was computed on: `override` when given, else
 /// `recorded` (the path the result names), checked to exist and to hold `pointCount` points, after
@@ -41,9 +58,9 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
 
 /// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST, facing the file's
 /// viewpoint if any) normals when the cloud has none; says so on stderr unless quiet. The APSS
-/// fits need oriented normals.
-
-void ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options = {});
+/// fits need oriented normals. Returns whether the visibility rays found every component of the
+/// cloud closed (NormalOrientationResult::closedSurface); false when the cloud had normals.
+bool ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options = {});
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {

@@ -232,8 +232,9 @@ void addCylindersCommand(CLI::App& app) {
     checkOutput(args->output, OutputKind::CylindersResult, {args->input.path});
     PointCloud cloud = loadCloud(args->input, args->quiet);
     ensureNormals(cloud, args->quiet, cylinderNormalOptions());
-    const CylinderDetection detection =
-        detectCylinders(cloud, args->cylinders, makeProgressBar(args->quiet));
+    const CylinderDetection detection = withMeshSampleHint(args->input, cloud.size(), [&] {
+      return detectCylinders(cloud, args->cylinders, makeProgressBar(args->quiet));
+    });
 
     int level = -1;
     std::vector<int> labels;

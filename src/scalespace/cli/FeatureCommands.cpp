@@ -212,6 +212,7 @@ void addFeaturesCommand(CLI::App& app) {
     FeatureCurveOptions features;
     std::size_t samplesPerVertex = 100;
     double sheetNormals = kFeatureSheetNormals;
+    std::string foldBorders = "auto";
     bool ascii = false, quiet = false;
     int threads = 0;
   };
@@ -312,6 +313,19 @@ void addFeaturesCommand(CLI::App& app) {
                   "point and two neighbours, one side's at a crease (0: PCA); oriented as "
                   "'normals --sign-by-rays --reflect' does")
       ->capture_default_str();
+  cmd->add_option("--fold-borders", args->foldBorders,
+                  "where the sampled surface is closed, its borders are folds thinner than the "
+                  "noise (a thin part's rim) and join the convex curves: auto (a cloud whose "
+                  "estimated normals' rays find it closed), on, off (meshes: auto is off)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--fold-reach", args->features.foldReach,
+                  "--fold-borders: the neighbourhood's radius, x e")
+      ->capture_default_str();
+  cmd->add_option("--fold-share", args->features.foldBorderShare,
+                  "--fold-borders: a point is on a border when its neighbours' centroid lies "
+                  "this x the radius off it in their plane (0.42 on a straight border)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   cmd->add_flag("--ascii", args->ascii, "write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on stderr");
@@ -319,6 +333,7 @@ void addFeaturesCommand(CLI::App& app) {
     const auto start = Clock::now();
     ThreadScope threads(args->threads);
     FeatureCurveOptions options = args->features;
+    options.foldBorders = args->foldBorders == "on";
     validateFeatureCurveOptions(options);  // before the read
     if (args->samplesPerVertex < 1 || args->samplesPerVertex > 10000)
       throw OptionError("--mesh-samples must be in [1, 10000]");
@@ -356,8 +371,15 @@ void addFeaturesCommand(CLI::App& app) {
       result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
-      ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
+      const bool closed =
+          ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
+      if (args->foldBorders == "auto") options.foldBorders = closed;
       result = detectFeatureCurves(cloud, options, progress);
+      if (!args->quiet && options.foldBorders)
+        std::fprintf(
+            stderr, "features: %s; %zu points on its borders (folds) joined the curves\n",
+            args->foldBorders == "auto" ? "the rays found the surface closed" : "--fold-borders on",
+            result.foldPoints);
     }
     PointCloud& out = mesh ? targets : cloud;
     AttributeColumn& votes = out.addAttribute("feature_votes", ScalarType::Float32);
@@ -419,6 +441,7 @@ void addFeaturesCommand(CLI::App& app) {
                                  {"noise_rms", result.noiseRms},
                                  {"salient_curvature_floor", result.salientCurvatureFloor},
                                  {"feature_points", labelled},
+                                 {"fold_points", result.foldPoints},
                                  {"parameters",
                                   {{"scale_count", options.scaleCount},
                                    {"salient_threshold", options.salientThreshold},
@@ -432,6 +455,9 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"ridge_only", options.ridgeOnly},
                                    {"min_piece_extent", options.minPieceExtent},
                                    {"min_curve_extent", options.minCurveExtent},
+                                   {"fold_borders", options.foldBorders},
+                                   {"fold_reach", options.foldReach},
+                                   {"fold_border_share", options.foldBorderShare},
                                    {"join_gap", options.joinGap},
                                    {"centreline_reach", options.centrelineReach},
                                    {"band_half_width", options.bandHalfWidth},

@@ -60,6 +60,8 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"FeatureCurveOptions::voteThreshold", "--vote-threshold"},
     {"FeatureCurveOptions::spacing", "--spacing"},
     {"FeatureCurveOptions::minCurveExtent", "--min-extent"},
+    {"FeatureCurveOptions::foldReach", "--fold-reach"},
+    {"FeatureCurveOptions::foldBorderShare", "--fold-share"},
     {"FeatureCurveOptions::edgeReach", "--edge-reach"},
     {"FeatureCurveOptions::edgeRejoinAngle", "--edge-rejoin-angle"},
     {"FeatureCurveOptions::joinGap", "--join-gap"},

@@ -158,6 +158,19 @@ struct FeatureCurveOptions {
   /// are joined again where no third edge meets them (CurveEdgeOptions::mergeAngleDegrees): a
   /// scan's noisy band breaks the linearity test here and there along a straight edge. 0: never.
   double edgeRejoinAngle = 20;
+  /// (Not in the thesis) set when the cloud samples a closed surface (a solid's boundary: a mesh
+  /// without border edges; the visibility rays of the estimated normals found every component
+  /// closed). A closed surface has no border, so a point where its neighbours within foldReach *
+  /// e fill one side only (core/SheetBorder share >= foldBorderShare) is on a fold: the rim of a
+  /// part thinner than the noise, whose two sides the points no longer tell apart and whose lines
+  /// then see one open sheet with no crease. Such points join the convex curves. On an open
+  /// surface (a scan, a ground square) the border is where the sampling stops, not a feature, so
+  /// false leaves it out. bench_features' noisy blade (sides 0.37 apart, noise sigma 0.13).
+  bool foldBorders = false;
+  double foldReach = 3;
+  /// 0.42 on a straight border, 0.17 at half the reach inside (core/SheetBorder.hpp): 0.2 keeps
+  /// the points within about 0.9 e of the fold, the width the votes give a crease.
+  double foldBorderShare = 0.25;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
   /// Also return the salient vertices and, per target point, the scales that voted for it
@@ -211,6 +224,9 @@ struct FeatureCurveResult {
   std::vector<int> edgeId;  // per target point, -1 none (in no curve)
   std::vector<FeatureEdge> edges;
   double maxVote = 0;  // V_max
+  /// Points labelled as on a fold only (FeatureCurveOptions::foldBorders), before the curves
+  /// shorter than minCurveExtent are dropped.
+  std::size_t foldPoints = 0;
   /// The salient line vertices of every scale, for drawing: positions and their scale index.
   std::vector<CurvatureLineSet> lineSets;
   double seconds = 0;

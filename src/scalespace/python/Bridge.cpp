@@ -68,6 +68,8 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"FeatureCurveOptions::salientBoundCap", "salient_cap"},
     {"FeatureCurveOptions::voteThreshold", "vote_threshold"},
     {"FeatureCurveOptions::minCurveExtent", "min_extent"},
+    {"FeatureCurveOptions::foldReach", "fold_reach"},
+    {"FeatureCurveOptions::foldBorderShare", "fold_share"},
     {"FeatureCurveOptions::minPieceExtent", "min_piece_extent"},
     {"FeatureCurveOptions::joinGap", "join_gap"},
     {"FeatureCurveOptions::minSalientCurvature", "min_curvature"},
@@ -429,7 +431,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
 std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOptions options,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
-                                            const ProgressCallback& progress) {
+                                            const ProgressCallback& progress, bool* closedSurface) {
   const std::size_t k = options.estimation.k;
   if (k >= cloud.size())
     throw OptionError("k " + std::to_string(k) + " must be smaller than the number of points (" +
@@ -451,6 +453,7 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOp
   const auto index = makeSpatialIndex(cloud.positions());
   OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options, progress);
   cloud.setNormals(std::move(normals.normals));
+  if (closedSurface) *closedSurface = normals.orientation.closedSurface;
   return std::move(normals.orientation.reliable);
 }
 

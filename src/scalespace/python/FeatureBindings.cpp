@@ -137,8 +137,14 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     double edgeReach, double edgeRejoinAngle, bool allSalient, bool salientPerScale,
                     double beta, double gamma, bool curvedSeedsFirst, bool withLines,
                     const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
+                    const std::string& foldBorders, double foldReach, double foldShare,
                     std::optional<int> threads, py::object progress) {
+  if (foldBorders != "auto" && foldBorders != "on" && foldBorders != "off")
+    throw OptionError("fold_borders takes 'auto', 'on' or 'off', got '" + foldBorders + "'");
   FeatureCurveOptions options;
+  options.foldBorders = foldBorders == "on";
+  options.foldReach = foldReach;
+  options.foldBorderShare = foldShare;
   options.scaleCount = scales;
   options.spacing = spacing;
   options.voteThreshold = voteThreshold;
@@ -185,8 +191,12 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   Call call(std::move(progress), threads);
   FeatureCurveResult result = call([&] {
     if (!mesh) {
-      if (!cloud.hasNormals())
-        estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress());
+      if (!cloud.hasNormals()) {
+        bool closed = false;
+        estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress(),
+                          &closed);
+        if (foldBorders == "auto") options.foldBorders = closed;
+      }
       return detectFeatureCurves(cloud, options, call.progress());
     }
     MeshFeatureCurves onMesh =
@@ -208,6 +218,8 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   d["max_vote"] = result.maxVote;
   d["noise_rms"] = result.noiseRms;
   d["salient_curvature_floor"] = result.salientCurvatureFloor;
+  d["fold_borders"] = options.foldBorders;
+  d["fold_points"] = result.foldPoints;
   py::list curves;
   for (FeatureCurve& curve : result.curves) {
     py::dict c;
@@ -282,7 +294,9 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
         "curved_seeds_first"_a = CurvatureLineOptions{}.curvedSeedsFirst, "with_lines"_a = false,
         "triangles"_a = py::none(), "mesh_samples"_a = 100,
-        "sheet_normals"_a = kFeatureSheetNormals, "threads"_a = py::none(),
+        "sheet_normals"_a = kFeatureSheetNormals, "fold_borders"_a = "auto",
+        "fold_reach"_a = FeatureCurveOptions{}.foldReach,
+        "fold_share"_a = FeatureCurveOptions{}.foldBorderShare, "threads"_a = py::none(),
         "progress"_a = py::none(),
         R"doc(Feature curves (Sec. 3.4.1), as `scalespace features` on a cloud.
 
@@ -312,7 +326,13 @@ is estimated as the plane through the point and two neighbours that the most nei
 sheet_normals times the 10th neighbour's distance (or 8 noise RMS) of, where the PCA plane does not
 hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...,
 sign_by_rays=True, reflect=True), and oriented (MST, the sign carried by the reflected agreement;
-each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the CLI does).)doc");
+each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the CLI does).
+fold_borders: 'auto' (a cloud without normals whose estimated normals' rays find it closed; off
+for meshes and clouds with normals), 'on' or 'off': on a closed surface the points at a border
+of the sheet their neighbours within fold_reach x e sample (the neighbours' centroid off the point
+by fold_share x that radius or more, in their plane) are a fold thinner than the noise (a thin
+part's rim) and join the convex curves; the dict's fold_borders says whether it applied and
+fold_points how many points it added.)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
