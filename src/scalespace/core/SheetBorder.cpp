@@ -20,6 +20,8 @@ std::vector<float> sheetBorderShare(const std::vector<Vec3>& positions, const Sp
   if (!(options.radius > 0 && std::isfinite(options.radius)))
     throw OptionError("SheetBorderOptions::radius must be finite and > 0");
   if (options.minCount < 3) throw OptionError("SheetBorderOptions::minCount must be >= 3");
+  if (!(options.maxVariation >= 0 && options.maxVariation <= 1))
+    throw OptionError("SheetBorderOptions::maxVariation must be in [0, 1]");
   if (!skip.empty() && skip.size() != queries.size())
     throw OptionError("sheetBorderShare: skip holds " + std::to_string(skip.size()) +
                       " flags for " + std::to_string(queries.size()) + " queries");
@@ -35,6 +37,8 @@ std::vector<float> sheetBorderShare(const std::vector<Vec3>& positions, const Sp
       PointMoments moments;
       for (const Neighbor& nb : found) moments.add(positions[nb.index] - queries[i]);
       const Eigen::SelfAdjointEigenSolver<Mat3> eig(moments.covariance());
+      const Vec3 lambda = eig.eigenvalues();
+      if (!(lambda[0] <= options.maxVariation * lambda.sum())) continue;
       const Vec3 normal = eig.eigenvectors().col(0);
       const Vec3 offset = moments.mean - normal.dot(moments.mean) * normal;
       share[i] = float(std::min(1.0, offset.norm() / options.radius));

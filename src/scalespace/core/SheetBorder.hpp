@@ -17,6 +17,11 @@ namespace scalespace {
 struct SheetBorderOptions {
   double radius = 0;         // of the neighbourhood; must be > 0
   std::size_t minCount = 8;  // fewer neighbours (the point included) read 0: too few to tell
+  /// Neighbours that do not lie near a plane read 0: no sheet, no border (a volume, a corner of
+  /// three faces, a cap smaller than the radius). The surface variation lambda0 / (lambda0 +
+  /// lambda1 + lambda2) is 1/3 in a ball; on a half disc of a sheet whose off-plane spread is a
+  /// fifth of the radius (two sides merged by noise: bench_features' noisy blade) 0.125.
+  double maxVariation = 0.2;
 };
 
 /// Per query, the border share above (0 where fewer than minCount points lie within the radius,
