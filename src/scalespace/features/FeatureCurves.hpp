@@ -158,18 +158,22 @@ struct FeatureCurveOptions {
   /// are joined again where no third edge meets them (CurveEdgeOptions::mergeAngleDegrees): a
   /// scan's noisy band breaks the linearity test here and there along a straight edge. 0: never.
   double edgeRejoinAngle = 20;
-  /// (Not in the thesis) set when the cloud samples a closed surface (a solid's boundary: a mesh
-  /// without border edges; the visibility rays of the estimated normals found every component
-  /// closed). A closed surface has no border, so a point where its neighbours within foldReach *
-  /// e fill one side only (core/SheetBorder share >= foldBorderShare) is on a fold: the rim of a
-  /// part thinner than the noise, whose two sides the points no longer tell apart and whose lines
-  /// then see one open sheet with no crease. Such points join the convex curves. On an open
-  /// surface (a scan, a ground square) the border is where the sampling stops, not a feature, so
-  /// false leaves it out. bench_features' noisy blade (sides 0.37 apart, noise sigma 0.13).
+  /// (Not in the thesis) set when the cloud samples a closed surface, a solid's boundary
+  /// (`features` and Python's features() set it where the visibility rays of the normals they
+  /// estimate find every component closed). A closed surface has no border, so a point where its
+  /// neighbours within foldReach * e fill one side only (core/SheetBorder share >= foldBorderShare)
+  /// is on a fold: the rim of a part thinner than the noise, whose two sides the points no longer
+  /// tell apart and whose lines then see one open sheet with no crease. Such points join the convex
+  /// curves. On an open surface (a scan, a ground square) the border is where the sampling stops,
+  /// not a feature, so false leaves it out. bench_features' noisy creases model (V creases of 150
+  /// degrees): MCC 0.792 -> 0.825 (docs/THESIS_NOTES.md, "Folds thinner than the noise").
   bool foldBorders = false;
+  /// Over 2 e (about 64 neighbours) the voids of a random sample read as borders; over 3 e (144)
+  /// by chance with odds of about exp(-18).
   double foldReach = 3;
-  /// 0.42 on a straight border, 0.17 at half the reach inside (core/SheetBorder.hpp): 0.2 keeps
-  /// the points within about 0.9 e of the fold, the width the votes give a crease.
+  /// 0.42 on a straight border, 0.27 at 0.3 reach inside, 0.17 at half the reach
+  /// (core/SheetBorder.hpp): 0.25 keeps the points within about e of the fold, the width the votes
+  /// give a crease.
   double foldBorderShare = 0.25;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
