@@ -182,12 +182,6 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
   });
 }
 
-std::vector<Index> allIndices(std::size_t count) {
-  std::vector<Index> all(count);
-  std::iota(all.begin(), all.end(), Index(0));
-  return all;
-}
-
 std::vector<Vec3> positionsOf(const std::vector<Vec3>& from, const std::vector<Index>& kept) {
   std::vector<Vec3> out(kept.size());
   for (std::size_t k = 0; k < kept.size(); ++k) out[k] = from[kept[k]];
@@ -202,20 +196,19 @@ std::vector<Vec3> positionsOf(const std::vector<Vec3>& from, const std::vector<I
 // border at a reach of 3 e). The samples, evenly spread, give a centroid as steady as all the
 // points. Reading it at every point with all of them cost 5-9 s on 1M points, this 1.6 s; the
 // labels of bench_features' models are the same but for 0-3 points.
-std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const std::vector<Vec3>& targets,
+std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex& cloudIndex,
+                                     const std::vector<Vec3>& targets,
                                      const std::vector<std::uint8_t>& eligible, double e,
                                      const FeatureCurveOptions& options) {
   constexpr double kFoldMargin = 0.1;
   constexpr std::uint64_t kSampleSeed = 11;
   const bool cloudTargets = &targets == &cloud.positions();
-  const std::vector<Index> samples =
-      poissonDiskSample(targets, allIndices(targets.size()), 0.5 * e, kSampleSeed);
+  const std::vector<Index> samples = poissonDiskSample(targets, 0.5 * e, kSampleSeed);
   const std::vector<Vec3> sampled = positionsOf(targets, samples);
   const std::vector<Vec3> sampledCloud =
       cloudTargets ? std::vector<Vec3>()
                    : positionsOf(cloud.positions(),
-                                 poissonDiskSample(cloud.positions(), allIndices(cloud.size()),
-                                                   0.5 * e, kSampleSeed));
+                                 poissonDiskSample(cloud.positions(), 0.5 * e, kSampleSeed));
   const std::vector<Vec3>& sparseCloud = cloudTargets ? sampled : sampledCloud;
   SheetBorderOptions border;
   border.radius = options.foldReach * e;
@@ -224,9 +217,8 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const std::vector<
   const std::vector<float> coarse =
       sheetBorderShare(sparseCloud, *makeSpatialIndex(sparseCloud), sampled, sparse);
 
-  const auto cloudIndex = makeSpatialIndex(cloud.positions());
   const auto ownIndex = cloudTargets ? nullptr : makeSpatialIndex(targets);
-  const SpatialIndex& targetIndex = ownIndex ? *ownIndex : *cloudIndex;
+  const SpatialIndex& targetIndex = ownIndex ? *ownIndex : cloudIndex;
   std::vector<std::uint8_t> skip(targets.size(), 1);
   std::vector<Neighbor> near;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -236,7 +228,7 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const std::vector<
     skip[samples[k]] = eligible[samples[k]];
   }
   const std::vector<float> share =
-      sheetBorderShare(cloud.positions(), *cloudIndex, targets, border, skip);
+      sheetBorderShare(cloud.positions(), cloudIndex, targets, border, skip);
   std::vector<std::uint8_t> fold(targets.size(), 0);
   for (std::size_t i = 0; i < targets.size(); ++i)
     fold[i] = !skip[i] && share[i] >= options.foldBorderShare ? 1 : 0;
@@ -542,11 +534,15 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
+  // The cloud's index, shared by the crease lines and the fold test when either runs.
+  const bool creaseLines =
+      options.centrelineReach > 0 && options.creaseReach > 0 && !salient.empty();
+  const auto cloudIndex =
+      creaseLines || options.foldBorders ? makeSpatialIndex(cloud.positions()) : nullptr;
   if (options.centrelineReach > 0 && !salient.empty()) {
     const auto salientIndex = makeSpatialIndex(salient);
-    const auto cloudIndex = options.creaseReach > 0 ? makeSpatialIndex(cloud.positions()) : nullptr;
     CreaseBand crease{
-        cloud.positions(), cloud.normals(), cloudIndex ? *cloudIndex : *salientIndex, {}, 0};
+        cloud.positions(), cloud.normals(), creaseLines ? *cloudIndex : *salientIndex, {}, 0};
     crease.line.reach = options.creaseReach * e;
     crease.line.maxRms = std::max(options.creaseFlatness * e, 2 * result.noiseRms);
     crease.line.maxGap = 0.25 * e;
@@ -559,7 +555,8 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
                      result.convexity);
   }
   if (options.foldBorders) {
-    const std::vector<std::uint8_t> fold = foldPoints(cloud, targets, eligible, e, options);
+    const std::vector<std::uint8_t> fold =
+        foldPoints(cloud, *cloudIndex, targets, eligible, e, options);
     for (std::size_t i = 0; i < n; ++i)
       if (fold[i]) {
         eligible[i] = 1;

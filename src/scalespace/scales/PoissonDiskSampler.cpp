@@ -196,6 +196,13 @@ std::uint64_t pyramidLevelSeed(std::uint64_t seed, std::size_t level) {
   return seed + 0x632be59bd9b4e019ULL * (level + 1);
 }
 
+std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions, double separation,
+                                     std::uint64_t seed) {
+  std::vector<Index> all(positions.size());
+  std::iota(all.begin(), all.end(), Index(0));
+  return poissonDiskSample(positions, all, separation, seed);
+}
+
 std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
                                      const std::vector<Index>& candidates, double separation,
                                      std::uint64_t seed) {

@@ -35,6 +35,9 @@ namespace scalespace {
 std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions,
                                      const std::vector<Index>& candidates, double separation,
                                      std::uint64_t seed);
+/// The same over every point of `positions`.
+std::vector<Index> poissonDiskSample(const std::vector<Vec3>& positions, double separation,
+                                     std::uint64_t seed);
 
 /// Adaptive variant: separations[i] is the separation of point i (indexed like `positions`).
 std::vector<Index> poissonDiskSampleAdaptive(const std::vector<Vec3>& positions,
