@@ -205,10 +205,10 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
   const bool cloudTargets = &targets == &cloud.positions();
   const std::vector<Index> samples = poissonDiskSample(targets, 0.5 * e, kSampleSeed);
   const std::vector<Vec3> sampled = positionsOf(targets, samples);
-  const std::vector<Vec3> sampledCloud =
-      cloudTargets ? std::vector<Vec3>()
-                   : positionsOf(cloud.positions(),
-                                 poissonDiskSample(cloud.positions(), 0.5 * e, kSampleSeed));
+  const std::vector<Index> cloudSamples =
+      cloudTargets ? std::vector<Index>()
+                   : poissonDiskSample(cloud.positions(), 0.5 * e, kSampleSeed);
+  const std::vector<Vec3> sampledCloud = positionsOf(cloud.positions(), cloudSamples);
   const std::vector<Vec3>& sparseCloud = cloudTargets ? sampled : sampledCloud;
   SheetBorderOptions border;
   border.radius = options.foldReach * e;
@@ -432,14 +432,14 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
               " or more duplicates (the spacing, the mean distance to the " +
               std::to_string(options.spacingNeighbors) +
               "th neighbour, is 0): remove the duplicates or give FeatureCurveOptions::spacing");
-  if (options.noiseSalientFactor > 0 || (options.centrelineReach > 0 && options.creaseReach > 0)) {
-    // The noise of the points the lines are traced on (the cloud; a mesh's area samples): the
-    // salient floor and the crease sides' flatness and margin scale with it.
-    const bool targetsAreCloud = &targets == &cloud.positions();
-    result.noiseRms = targetsAreCloud
-                          ? pointNoiseRms(cloud.positions(), targetGraph)
-                          : pointNoiseRms(cloud.positions(), buildKnnGraph(cloud.positions(), 10));
-  }
+  // The cloud's index, shared by the noise estimate, the crease lines and the fold test.
+  const bool creaseLines = options.centrelineReach > 0 && options.creaseReach > 0;
+  const bool needNoise = options.noiseSalientFactor > 0 || creaseLines;
+  const auto cloudIndex =
+      needNoise || options.foldBorders ? makeSpatialIndex(cloud.positions()) : nullptr;
+  // The noise of the points the lines are traced on (the cloud; a mesh's area samples): the
+  // salient floor and the crease sides' flatness and margin scale with it.
+  if (needNoise) result.noiseRms = surfaceNoiseRms(cloud.positions(), *cloudIndex);
   result.salientCurvatureFloor =
       std::max(options.minSalientCurvature, options.noiseSalientFactor * result.noiseRms / e);
 
@@ -534,11 +534,6 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
       eligible[i] = 1;
       result.convexity[i] = result.votes[i] > 0 ? 1 : -1;
     }
-  // The cloud's index, shared by the crease lines and the fold test when either runs.
-  const bool creaseLines =
-      options.centrelineReach > 0 && options.creaseReach > 0 && !salient.empty();
-  const auto cloudIndex =
-      creaseLines || options.foldBorders ? makeSpatialIndex(cloud.positions()) : nullptr;
   if (options.centrelineReach > 0 && !salient.empty()) {
     const auto salientIndex = makeSpatialIndex(salient);
     CreaseBand crease{

@@ -83,7 +83,8 @@ struct FeatureCurveOptions {
   /// 0 turns it off (the thesis' relative bound).
   double salientBoundCap = 0.7;
   /// (Not in the thesis) and |kappa1| t >= noiseSalientFactor * sigma / e, sigma the cloud's
-  /// sensor noise (scales/PointNoise.hpp): a noise-aware floor for minSalientCurvature. Noise of
+  /// sensor noise (surfaceNoiseRms, scales/PointNoise.hpp): a noise-aware floor for
+  /// minSalientCurvature. Noise of
   /// sigma gives flat faces a |kappa1| t that grows with sigma / e, and at 1e-3 of the diagonal
   /// (sigma / e about 0.13 on bench_features' models) it passes 0.6 all over them. On clean samples
   /// sigma is about 0 and the floor stays minSalientCurvature. bench_features, 11 models, noisy:
@@ -208,7 +209,7 @@ struct FeatureCurveScale {
 
 struct FeatureCurveResult {
   double spacing = 0;
-  double noiseRms = 0;  // sigma (scales/PointNoise.hpp): 0 when noiseSalientFactor is 0
+  double noiseRms = 0;  // sigma (surfaceNoiseRms, scales/PointNoise.hpp); 0 when not needed
   /// The floor on |kappa1| t of salient vertices: max(minSalientCurvature, noiseSalientFactor *
   /// noiseRms / spacing).
   double salientCurvatureFloor = 0;
