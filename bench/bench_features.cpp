@@ -515,10 +515,12 @@ bool estimateSceneNormals(PointCloud& cloud) {
         normals.rays.differing, normals.rays.firstInward, normals.rays.secondInward,
         normals.rays.sampled, normals.signSource == SheetSign::OwnTree ? "own tree" : "PCA signs");
   if (printPerCurve)
-    std::printf("# orientation: k %zu, %zu components, %zu pieces, %zu closed, closed surface %s\n",
-                normals.estimation.k, normals.orientation.componentCount,
-                normals.orientation.pieceCount, normals.orientation.closedComponents,
-                normals.orientation.closedSurface ? "yes" : "no");
+    std::printf(
+        "# orientation: k %zu, %zu components, %zu pieces, %zu closed, closed surface %s, open "
+        "share %.3f\n",
+        normals.estimation.k, normals.orientation.componentCount, normals.orientation.pieceCount,
+        normals.orientation.closedComponents, normals.orientation.closedSurface ? "yes" : "no",
+        normals.orientation.openShare);
   cloud.setNormals(std::move(normals.normals));
   return normals.orientation.closedSurface;
 }

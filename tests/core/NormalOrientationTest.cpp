@@ -267,6 +267,8 @@ TEST(NormalOrientation, VisibilityTurnsTheWrongSideOfANoisyThinClosedPlate) {
     outward += one.normals[i].dot(truth[i]) > 0 ? 1 : 0;
   EXPECT_GT(double(outward) / double(points.size()), 0.98);
   EXPECT_TRUE(one.result.closedSurface);
+  EXPECT_LE(one.result.openShare, 0.05);
+  EXPECT_EQ(one.result.openShare, two.result.openShare);
   EXPECT_GT(one.result.piecesFlipped, 0u);
   EXPECT_EQ(one.normals, two.normals);
   EXPECT_EQ(one.result.pieceCount, two.result.pieceCount);
@@ -287,6 +289,7 @@ TEST(NormalOrientation, AGroundUnderATableTopStaysUp) {
   const auto estimate = estimateNormals(points);
   const OrientedOn oriented = orientOn(2, points, estimate);
   EXPECT_FALSE(oriented.result.closedSurface);
+  EXPECT_GT(oriented.result.openShare, 0.5);
   EXPECT_GT(
       fractionWhere(points, oriented.normals, [](const Vec3&, const Vec3& n) { return n.z() > 0; }),
       0.99);
@@ -316,6 +319,7 @@ TEST(NormalOrientation, AClosedObjectAboveAnOpenGroundIsTakenAsClosed) {
   EXPECT_GT(double(groundUp) / 40000.0, 0.99);
   EXPECT_EQ(one.result.closedComponents, 1u);
   EXPECT_FALSE(one.result.closedSurface);
+  EXPECT_GT(one.result.openShare, 0.5);  // the ground's; the largest over the components
   EXPECT_EQ(one.normals, two.normals);
 }
 

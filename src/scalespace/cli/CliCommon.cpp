@@ -76,8 +76,9 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
   orientation.viewpoint = *cloud.viewpoint() - cloud.origin();  // recentred, as the points
 }
 
-bool ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options) {
-  if (cloud.hasNormals()) return false;
+NormalOrientationResult ensureNormals(PointCloud& cloud, bool quiet,
+                                      const OrientedNormalsOptions& options) {
+  if (cloud.hasNormals()) return {};
   const NormalEstimationOptions& estimation = options.estimation;
   if (!quiet)
     std::fprintf(stderr,
@@ -100,7 +101,10 @@ bool ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& 
     std::fprintf(stderr, "normals: noisy input, estimated over %zu neighbours\n",
                  normals.estimation.k);
   cloud.setNormals(std::move(normals.normals));
-  return normals.orientation.closedSurface;
+  NormalOrientationResult found = std::move(normals.orientation);
+  found.reliable.clear();
+  found.reliable.shrink_to_fit();
+  return found;
 }
 
 namespace {

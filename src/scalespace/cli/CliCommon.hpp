@@ -58,9 +58,11 @@ void faceFileViewpoint(const PointCloud& cloud, NormalOrientationOptions& orient
 
 /// Estimates (PCA, 10 neighbours; `estimation` widens it) and orients (MST, facing the file's
 /// viewpoint if any) normals when the cloud has none; says so on stderr unless quiet. The APSS
-/// fits need oriented normals. Returns whether the visibility rays found every component of the
-/// cloud closed (NormalOrientationResult::closedSurface); false when the cloud had normals.
-bool ensureNormals(PointCloud& cloud, bool quiet, const OrientedNormalsOptions& options = {});
+/// fits need oriented normals. Returns what the orientation found (closedSurface: whether the
+/// visibility rays found every component of the cloud closed); all false and 0 when the cloud had
+/// normals.
+NormalOrientationResult ensureNormals(PointCloud& cloud, bool quiet,
+                                      const OrientedNormalsOptions& options = {});
 
 /// What a command writes, for checkOutput.
 enum class OutputKind {

@@ -336,6 +336,7 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
   for (Index c = 0; c < components; ++c) {
     if (casters[c] == 0) continue;
     closedComponent[c] = double(open[c]) <= kClosedOpenShare * double(casters[c]) ? 1 : 0;
+    result.openShare = std::max(result.openShare, double(open[c]) / double(casters[c]));
     anyClosed = anyClosed || closedComponent[c];
     anyOpen = anyOpen || !closedComponent[c];
     result.closedComponents += closedComponent[c];
