@@ -20,10 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// `features --fold-borders auto` on an open cloud whose rays leak at fewer than this share of
-/// its points suggests `on` (NormalOrientationResult::openShare).
-constexpr double kNearlyClosedShare = 0.15;
-
 /// Every line of `sets` as one polyline set with the per-vertex attributes of Sec. 3.3:
 /// line id, scale, kappa1, kappa2, |kappa1| - |kappa2|, nu, tangent (and the normal).
 PolylineSet toPolylines(const std::vector<CurvatureLineSet>& sets, const Vec3& origin) {
@@ -378,11 +374,7 @@ void addFeaturesCommand(CLI::App& app) {
       const NormalOrientationResult orientation =
           ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
       if (args->foldBorders == "auto") options.foldBorders = orientation.closedSurface;
-      // Over the closed parts' 0.5% and under most open scans (libcgal-demo's oni 11%, spheres
-      // 17%, building 18%, the table scan 38%): a thin part whose rim, or an opening, lets a
-      // few rays through (bench_features' blade, open at its root: 8.4-9.5%).
-      if (!args->quiet && args->foldBorders == "auto" && !orientation.closedSurface &&
-          orientation.openShare > 0 && orientation.openShare < kNearlyClosedShare)
+      if (!args->quiet && args->foldBorders == "auto" && nearlyClosed(orientation))
         std::fprintf(stderr,
                      "features: the rays found the surface open at %.1f%% of the points (a closed "
                      "surface: at most 5%%); if it is a thin closed part whose rim is thinner than "

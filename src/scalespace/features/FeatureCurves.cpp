@@ -284,6 +284,12 @@ std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& p
 
 }  // namespace
 
+bool nearlyClosed(const NormalOrientationResult& orientation) {
+  constexpr double kNearlyClosedShare = 0.15;
+  return !orientation.closedSurface && orientation.openShare > 0 &&
+         orientation.openShare < kNearlyClosedShare;
+}
+
 OrientedNormalsOptions featureNormalOptions(double sheetTolerance) {
   OrientedNormalsOptions options;
   options.estimation.sheetTolerance = sheetTolerance;

@@ -49,6 +49,14 @@ constexpr double kFeatureSheetNormals = 0.05;
 /// -> 1.00).
 OrientedNormalsOptions featureNormalOptions(double sheetTolerance = kFeatureSheetNormals);
 
+/// Whether the orientation of those normals found the cloud open, but only just: its rays see out
+/// on both sides at under 15% of the points of every component (NormalOrientationResult::
+/// openShare). Over the closed parts' 0.5% and under most open scans (libcgal-demo's oni 11%,
+/// spheres 17%, building 18%, the table scan 38%): a thin part whose rim, or an opening, lets a
+/// few rays through (bench_features' blade, open at its root: 8.4-9.5%). `features` then suggests
+/// FeatureCurveOptions::foldBorders, which `auto` leaves off.
+bool nearlyClosed(const NormalOrientationResult& orientation);
+
 struct FeatureCurveOptions {
   /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance
   /// to the spacingNeighbors-th nearest neighbour (the thesis uses the median edge length of a

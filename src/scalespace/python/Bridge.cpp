@@ -431,7 +431,8 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, std::size_t k,
 std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOptions options,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
-                                            const ProgressCallback& progress, bool* closedSurface) {
+                                            const ProgressCallback& progress,
+                                            NormalOrientationResult* orientation) {
   const std::size_t k = options.estimation.k;
   if (k >= cloud.size())
     throw OptionError("k " + std::to_string(k) + " must be smaller than the number of points (" +
@@ -453,8 +454,9 @@ std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOp
   const auto index = makeSpatialIndex(cloud.positions());
   OrientedNormals normals = estimateOrientedNormals(cloud.positions(), *index, options, progress);
   cloud.setNormals(std::move(normals.normals));
-  if (closedSurface) *closedSurface = normals.orientation.closedSurface;
-  return std::move(normals.orientation.reliable);
+  std::vector<std::uint8_t> reliable = std::move(normals.orientation.reliable);
+  if (orientation) *orientation = std::move(normals.orientation);
+  return reliable;
 }
 
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name) {

@@ -153,13 +153,14 @@ std::vector<std::uint8_t> estimateAndOrient(
     bool reflect = NormalOrientationOptions{}.reflectAcrossBisector);
 
 /// Same with the estimation and orientation of `options` (e.g. cylinderNormalOptions()); `orient`
-/// and `viewpoint` as above replace its orientation method and viewpoint. `closedSurface`, when
-/// given, receives NormalOrientationResult::closedSurface (the rays found every component closed).
+/// and `viewpoint` as above replace its orientation method and viewpoint. `orientation`, when
+/// given, receives the orientation's result (closedSurface: the rays found every component
+/// closed; openShare).
 std::vector<std::uint8_t> estimateAndOrient(PointCloud& cloud, OrientedNormalsOptions options,
                                             const std::string& orient,
                                             const std::optional<Vec3>& viewpoint,
                                             const ProgressCallback& progress,
-                                            bool* closedSurface = nullptr);
+                                            NormalOrientationResult* orientation = nullptr);
 
 /// Three numbers (x, y, z) or None.
 std::optional<Vec3> asOptionalVec3(const py::handle& object, const char* name);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/features/CurvatureLines.hpp"
@@ -192,10 +193,18 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   FeatureCurveResult result = call([&] {
     if (!mesh) {
       if (!cloud.hasNormals()) {
-        bool closed = false;
+        NormalOrientationResult orientation;
         estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress(),
-                          &closed);
-        if (foldBorders == "auto") options.foldBorders = closed;
+                          &orientation);
+        if (foldBorders == "auto") options.foldBorders = orientation.closedSurface;
+        if (foldBorders == "auto" && nearlyClosed(orientation)) {
+          char share[32];
+          std::snprintf(share, sizeof share, "%.1f%%", 100 * orientation.openShare);
+          warnings.push_back(std::string("the rays found the surface open at ") + share +
+                             " of the points (a closed surface: at most 5%); if it is a thin "
+                             "closed part whose rim is thinner than the noise, fold_borders='on' "
+                             "makes that rim a convex curve");
+        }
       }
       return detectFeatureCurves(cloud, options, call.progress());
     }
