@@ -205,10 +205,10 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
   const bool cloudTargets = &targets == &cloud.positions();
   const std::vector<Index> samples = poissonDiskSample(targets, 0.5 * e, kSampleSeed);
   const std::vector<Vec3> sampled = positionsOf(targets, samples);
-  const std::vector<Index> cloudSamples =
-      cloudTargets ? std::vector<Index>()
-                   : poissonDiskSample(cloud.positions(), 0.5 * e, kSampleSeed);
-  const std::vector<Vec3> sampledCloud = positionsOf(cloud.positions(), cloudSamples);
+  const std::vector<Vec3> sampledCloud =
+      cloudTargets ? std::vector<Vec3>()
+                   : positionsOf(cloud.positions(),
+                                 poissonDiskSample(cloud.positions(), 0.5 * e, kSampleSeed));
   const std::vector<Vec3>& sparseCloud = cloudTargets ? sampled : sampledCloud;
   SheetBorderOptions border;
   border.radius = options.foldReach * e;
