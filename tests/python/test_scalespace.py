@@ -998,13 +998,18 @@ def test_a_nearly_closed_surface_gets_the_fold_hint(tmp_path):
     result, said = hints(box_with_hole(0.8))
     assert result["fold_borders"] is False and len(said) == 1
     share = float(said[0].split("open at ")[1].split("%")[0])
-    assert 5 < share < 15
+    assert 5 < share < 15 and abs(100 * result["rays_open_share"] - share) <= 0.05
     np.savetxt(tmp_path / "holed.xyz", box_with_hole(0.8))
     run = subprocess.run([CLI, "features", str(tmp_path / "holed.xyz"), "-o", str(tmp_path / "holed.ply")],
                          capture_output=True, text=True)
     assert run.returncode == 0 and "--fold-borders on" in run.stderr
+    summary = json.loads((tmp_path / "holed.json").read_text())
+    assert summary["rays_open_share"] == pytest.approx(result["rays_open_share"])
+    # Given normals, nothing was measured: null, None.
+    assert ss.features(box_with_hole(0.8), normals=np.tile([0.0, 0.0, 1.0], (1, 1)).repeat(
+        len(box_with_hole(0.8)), 0))["rays_open_share"] is None
     result, said = hints(box_with_hole(0.5))
-    assert result["fold_borders"] is True and said == []
+    assert result["fold_borders"] is True and said == [] and result["rays_open_share"] <= 0.05
     rng = np.random.default_rng(4)
     sheet = np.column_stack([rng.random(8000), rng.random(8000), rng.normal(0, 0.002, 8000)])
     result, said = hints(sheet)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "scalespace/cli/CliCommon.hpp"
 #include "scalespace/cli/ProgressBar.hpp"
@@ -353,6 +354,9 @@ void addFeaturesCommand(CLI::App& app) {
     const bool mesh = faces.has_value();
     PointCloud cloud, targets;
     FeatureCurveResult result;
+    // The share of points whose rays see out on both sides, where `features` estimated the
+    // normals (NormalOrientationResult::openShare); null in the summary otherwise.
+    std::optional<double> openShare;
     const auto progress = makeProgressBar(args->quiet);
     if (mesh) {
       const TriangleMesh triangles = std::move(*faces);
@@ -371,8 +375,10 @@ void addFeaturesCommand(CLI::App& app) {
       result = std::move(onMesh.curves);
     } else {
       cloud = loadCloud(args->input, args->quiet);
+      const bool estimated = !cloud.hasNormals();
       const NormalOrientationResult orientation =
           ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
+      if (estimated) openShare = orientation.openShare;
       if (args->foldBorders == "auto") options.foldBorders = orientation.closedSurface;
       if (!args->quiet && args->foldBorders == "auto" && nearlyClosed(orientation))
         std::fprintf(stderr,
@@ -435,52 +441,54 @@ void addFeaturesCommand(CLI::App& app) {
                        {"points", result.edges[k].points.size()},
                        {"length", result.edges[k].length}});
     const double total = std::chrono::duration<double>(Clock::now() - start).count();
-    const nlohmann::json json = {{"command", "features"},
-                                 {"version", SCALESPACE_VERSION},
-                                 {"input", args->input.path},
-                                 {"output", args->output},
-                                 {"labelled", mesh ? "mesh vertices" : "points"},
-                                 {"points", out.size()},
-                                 {"samples", cloud.size()},
-                                 {"spacing", result.spacing},
-                                 {"max_vote", result.maxVote},
-                                 {"noise_rms", result.noiseRms},
-                                 {"salient_curvature_floor", result.salientCurvatureFloor},
-                                 {"feature_points", labelled},
-                                 {"fold_points", result.foldPoints},
-                                 {"parameters",
-                                  {{"scale_count", options.scaleCount},
-                                   {"salient_threshold", options.salientThreshold},
-                                   {"salient_percentile", options.salientPercentile},
-                                   {"salient_bound_from_finest", options.salientBoundFromFinest},
-                                   {"salient_bound_cap", options.salientBoundCap},
-                                   {"vote_threshold", options.voteThreshold},
-                                   {"min_salient_curvature", options.minSalientCurvature},
-                                   {"noise_salient_factor", options.noiseSalientFactor},
-                                   {"min_voting_scales", options.minVotingScales},
-                                   {"ridge_only", options.ridgeOnly},
-                                   {"min_piece_extent", options.minPieceExtent},
-                                   {"min_curve_extent", options.minCurveExtent},
-                                   {"fold_borders", options.foldBorders},
-                                   {"fold_reach", options.foldReach},
-                                   {"fold_border_share", options.foldBorderShare},
-                                   {"join_gap", options.joinGap},
-                                   {"centreline_reach", options.centrelineReach},
-                                   {"band_half_width", options.bandHalfWidth},
-                                   {"centreline_linearity", options.centrelineLinearity},
-                                   {"crease_reach", options.creaseReach},
-                                   {"crease_half_width", options.creaseHalfWidth},
-                                   {"crease_flatness", options.creaseFlatness},
-                                   {"crease_sides_by_position", options.creaseSidesByPosition},
-                                   {"crease_side_margin", options.creaseSideMargin},
-                                   {"edge_reach", options.edgeReach},
-                                   {"edge_rejoin_angle", options.edgeRejoinAngle},
-                                   {"curved_seeds_first", options.lines.curvedSeedsFirst},
-                                   {"threads", args->threads}}},
-                                 {"scales", scales},
-                                 {"curves", curves},
-                                 {"edges", edges},
-                                 {"seconds", total}};
+    const nlohmann::json json = {
+        {"command", "features"},
+        {"version", SCALESPACE_VERSION},
+        {"input", args->input.path},
+        {"output", args->output},
+        {"labelled", mesh ? "mesh vertices" : "points"},
+        {"points", out.size()},
+        {"samples", cloud.size()},
+        {"spacing", result.spacing},
+        {"max_vote", result.maxVote},
+        {"noise_rms", result.noiseRms},
+        {"salient_curvature_floor", result.salientCurvatureFloor},
+        {"feature_points", labelled},
+        {"fold_points", result.foldPoints},
+        {"rays_open_share", openShare ? nlohmann::json(*openShare) : nlohmann::json(nullptr)},
+        {"parameters",
+         {{"scale_count", options.scaleCount},
+          {"salient_threshold", options.salientThreshold},
+          {"salient_percentile", options.salientPercentile},
+          {"salient_bound_from_finest", options.salientBoundFromFinest},
+          {"salient_bound_cap", options.salientBoundCap},
+          {"vote_threshold", options.voteThreshold},
+          {"min_salient_curvature", options.minSalientCurvature},
+          {"noise_salient_factor", options.noiseSalientFactor},
+          {"min_voting_scales", options.minVotingScales},
+          {"ridge_only", options.ridgeOnly},
+          {"min_piece_extent", options.minPieceExtent},
+          {"min_curve_extent", options.minCurveExtent},
+          {"fold_borders", options.foldBorders},
+          {"fold_reach", options.foldReach},
+          {"fold_border_share", options.foldBorderShare},
+          {"join_gap", options.joinGap},
+          {"centreline_reach", options.centrelineReach},
+          {"band_half_width", options.bandHalfWidth},
+          {"centreline_linearity", options.centrelineLinearity},
+          {"crease_reach", options.creaseReach},
+          {"crease_half_width", options.creaseHalfWidth},
+          {"crease_flatness", options.creaseFlatness},
+          {"crease_sides_by_position", options.creaseSidesByPosition},
+          {"crease_side_margin", options.creaseSideMargin},
+          {"edge_reach", options.edgeReach},
+          {"edge_rejoin_angle", options.edgeRejoinAngle},
+          {"curved_seeds_first", options.lines.curvedSeedsFirst},
+          {"threads", args->threads}}},
+        {"scales", scales},
+        {"curves", curves},
+        {"edges", edges},
+        {"seconds", total}};
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);
     if (!args->quiet)

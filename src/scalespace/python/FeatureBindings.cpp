@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "scalespace/core/Error.hpp"
 #include "scalespace/features/CurvatureLines.hpp"
@@ -190,12 +191,14 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
     mesh = meshFrom(asPoints(points), triangles);
   }
   Call call(std::move(progress), threads);
+  std::optional<double> openShare;  // where the normals were estimated here
   FeatureCurveResult result = call([&] {
     if (!mesh) {
       if (!cloud.hasNormals()) {
         NormalOrientationResult orientation;
         estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress(),
                           &orientation);
+        openShare = orientation.openShare;
         if (foldBorders == "auto") options.foldBorders = orientation.closedSurface;
         if (foldBorders == "auto" && nearlyClosed(orientation)) {
           char share[32];
@@ -229,6 +232,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   d["salient_curvature_floor"] = result.salientCurvatureFloor;
   d["fold_borders"] = options.foldBorders;
   d["fold_points"] = result.foldPoints;
+  d["rays_open_share"] = openShare ? py::object(py::float_(*openShare)) : py::object(py::none());
   py::list curves;
   for (FeatureCurve& curve : result.curves) {
     py::dict c;
@@ -341,7 +345,9 @@ for meshes and clouds with normals), 'on' or 'off': on a closed surface the poin
 of the sheet their neighbours within fold_reach x e sample (the neighbours' centroid off the point
 by fold_share x that radius or more, in their plane) are a fold thinner than the noise (a thin
 part's rim) and join the convex curves; the dict's fold_borders says whether it applied and
-fold_points how many points it added.)doc");
+fold_points how many points it added; rays_open_share the share of the points whose
+visibility rays see out on both sides where the normals were estimated here, else None: up to 0.05
+is closed, and between that and 0.15 a warning suggests fold_borders='on'.)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
