@@ -380,12 +380,9 @@ void addFeaturesCommand(CLI::App& app) {
           ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
       if (estimated) openShare = orientation.openShare;
       if (args->foldBorders == "auto") options.foldBorders = orientation.closedSurface;
-      if (!args->quiet && args->foldBorders == "auto" && nearlyClosed(orientation))
-        std::fprintf(stderr,
-                     "features: the rays found the surface open at %.1f%% of the points (a closed "
-                     "surface: at most 5%%); if it is a thin closed part whose rim is thinner than "
-                     "the noise, --fold-borders on makes that rim a convex curve\n",
-                     100 * orientation.openShare);
+      const std::string hint = foldBordersHint(orientation, "--fold-borders on");
+      if (!args->quiet && args->foldBorders == "auto" && !hint.empty())
+        std::fprintf(stderr, "features: %s\n", hint.c_str());
       result = detectFeatureCurves(cloud, options, progress);
       if (!args->quiet && options.foldBorders)
         std::fprintf(
@@ -441,54 +438,54 @@ void addFeaturesCommand(CLI::App& app) {
                        {"points", result.edges[k].points.size()},
                        {"length", result.edges[k].length}});
     const double total = std::chrono::duration<double>(Clock::now() - start).count();
-    const nlohmann::json json = {
-        {"command", "features"},
-        {"version", SCALESPACE_VERSION},
-        {"input", args->input.path},
-        {"output", args->output},
-        {"labelled", mesh ? "mesh vertices" : "points"},
-        {"points", out.size()},
-        {"samples", cloud.size()},
-        {"spacing", result.spacing},
-        {"max_vote", result.maxVote},
-        {"noise_rms", result.noiseRms},
-        {"salient_curvature_floor", result.salientCurvatureFloor},
-        {"feature_points", labelled},
-        {"fold_points", result.foldPoints},
-        {"rays_open_share", openShare ? nlohmann::json(*openShare) : nlohmann::json(nullptr)},
-        {"parameters",
-         {{"scale_count", options.scaleCount},
-          {"salient_threshold", options.salientThreshold},
-          {"salient_percentile", options.salientPercentile},
-          {"salient_bound_from_finest", options.salientBoundFromFinest},
-          {"salient_bound_cap", options.salientBoundCap},
-          {"vote_threshold", options.voteThreshold},
-          {"min_salient_curvature", options.minSalientCurvature},
-          {"noise_salient_factor", options.noiseSalientFactor},
-          {"min_voting_scales", options.minVotingScales},
-          {"ridge_only", options.ridgeOnly},
-          {"min_piece_extent", options.minPieceExtent},
-          {"min_curve_extent", options.minCurveExtent},
-          {"fold_borders", options.foldBorders},
-          {"fold_reach", options.foldReach},
-          {"fold_border_share", options.foldBorderShare},
-          {"join_gap", options.joinGap},
-          {"centreline_reach", options.centrelineReach},
-          {"band_half_width", options.bandHalfWidth},
-          {"centreline_linearity", options.centrelineLinearity},
-          {"crease_reach", options.creaseReach},
-          {"crease_half_width", options.creaseHalfWidth},
-          {"crease_flatness", options.creaseFlatness},
-          {"crease_sides_by_position", options.creaseSidesByPosition},
-          {"crease_side_margin", options.creaseSideMargin},
-          {"edge_reach", options.edgeReach},
-          {"edge_rejoin_angle", options.edgeRejoinAngle},
-          {"curved_seeds_first", options.lines.curvedSeedsFirst},
-          {"threads", args->threads}}},
-        {"scales", scales},
-        {"curves", curves},
-        {"edges", edges},
-        {"seconds", total}};
+    const nlohmann::json openShareJson = openShare ? nlohmann::json(*openShare) : nullptr;
+    const nlohmann::json json = {{"command", "features"},
+                                 {"version", SCALESPACE_VERSION},
+                                 {"input", args->input.path},
+                                 {"output", args->output},
+                                 {"labelled", mesh ? "mesh vertices" : "points"},
+                                 {"points", out.size()},
+                                 {"samples", cloud.size()},
+                                 {"spacing", result.spacing},
+                                 {"max_vote", result.maxVote},
+                                 {"noise_rms", result.noiseRms},
+                                 {"salient_curvature_floor", result.salientCurvatureFloor},
+                                 {"feature_points", labelled},
+                                 {"fold_points", result.foldPoints},
+                                 {"rays_open_share", openShareJson},
+                                 {"parameters",
+                                  {{"scale_count", options.scaleCount},
+                                   {"salient_threshold", options.salientThreshold},
+                                   {"salient_percentile", options.salientPercentile},
+                                   {"salient_bound_from_finest", options.salientBoundFromFinest},
+                                   {"salient_bound_cap", options.salientBoundCap},
+                                   {"vote_threshold", options.voteThreshold},
+                                   {"min_salient_curvature", options.minSalientCurvature},
+                                   {"noise_salient_factor", options.noiseSalientFactor},
+                                   {"min_voting_scales", options.minVotingScales},
+                                   {"ridge_only", options.ridgeOnly},
+                                   {"min_piece_extent", options.minPieceExtent},
+                                   {"min_curve_extent", options.minCurveExtent},
+                                   {"fold_borders", options.foldBorders},
+                                   {"fold_reach", options.foldReach},
+                                   {"fold_border_share", options.foldBorderShare},
+                                   {"join_gap", options.joinGap},
+                                   {"centreline_reach", options.centrelineReach},
+                                   {"band_half_width", options.bandHalfWidth},
+                                   {"centreline_linearity", options.centrelineLinearity},
+                                   {"crease_reach", options.creaseReach},
+                                   {"crease_half_width", options.creaseHalfWidth},
+                                   {"crease_flatness", options.creaseFlatness},
+                                   {"crease_sides_by_position", options.creaseSidesByPosition},
+                                   {"crease_side_margin", options.creaseSideMargin},
+                                   {"edge_reach", options.edgeReach},
+                                   {"edge_rejoin_angle", options.edgeRejoinAngle},
+                                   {"curved_seeds_first", options.lines.curvedSeedsFirst},
+                                   {"threads", args->threads}}},
+                                 {"scales", scales},
+                                 {"curves", curves},
+                                 {"edges", edges},
+                                 {"seconds", total}};
     const std::string summaryPath = summaryPathFor(args->output);
     writeJson(summaryPath, json);
     if (!args->quiet)

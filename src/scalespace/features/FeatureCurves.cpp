@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -284,10 +285,17 @@ std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& p
 
 }  // namespace
 
-bool nearlyClosed(const NormalOrientationResult& orientation) {
+std::string foldBordersHint(const NormalOrientationResult& orientation, std::string_view turnOn) {
   constexpr double kNearlyClosedShare = 0.15;
-  return !orientation.closedSurface && orientation.openShare > 0 &&
-         orientation.openShare < kNearlyClosedShare;
+  if (orientation.closedSurface || !(orientation.openShare > 0) ||
+      !(orientation.openShare < kNearlyClosedShare))
+    return {};
+  char share[32];
+  std::snprintf(share, sizeof share, "%.1f%%", 100 * orientation.openShare);
+  return std::string("the rays found the surface open at ") + share +
+         " of the points (a closed surface: at most 5%); if it is a thin closed part whose rim "
+         "is thinner than the noise, " +
+         std::string(turnOn) + " makes that rim a convex curve";
 }
 
 OrientedNormalsOptions featureNormalOptions(double sheetTolerance) {

@@ -20,6 +20,8 @@
 //      joinGap * e of each other are joined (the gaps where lines stop at corners).
 #include <array>
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "scalespace/core/KnnGraph.hpp"
@@ -54,8 +56,9 @@ OrientedNormalsOptions featureNormalOptions(double sheetTolerance = kFeatureShee
 /// openShare). Over the closed parts' 0.5% and under most open scans (libcgal-demo's oni 11%,
 /// spheres 17%, building 18%, the table scan 38%): a thin part whose rim, or an opening, lets a
 /// few rays through (bench_features' blade, open at its root: 8.4-9.5%). `features` then suggests
-/// FeatureCurveOptions::foldBorders, which `auto` leaves off.
-bool nearlyClosed(const NormalOrientationResult& orientation);
+/// FeatureCurveOptions::foldBorders, which `auto` leaves off: the message saying so, with
+/// `turnOn` the way to ask for it (a flag, a keyword); empty where the cloud is not nearly closed.
+std::string foldBordersHint(const NormalOrientationResult& orientation, std::string_view turnOn);
 
 struct FeatureCurveOptions {
   /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance

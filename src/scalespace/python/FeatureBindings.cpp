@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 
 #include "scalespace/core/Error.hpp"
@@ -200,14 +199,8 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                           &orientation);
         openShare = orientation.openShare;
         if (foldBorders == "auto") options.foldBorders = orientation.closedSurface;
-        if (foldBorders == "auto" && nearlyClosed(orientation)) {
-          char share[32];
-          std::snprintf(share, sizeof share, "%.1f%%", 100 * orientation.openShare);
-          warnings.push_back(std::string("the rays found the surface open at ") + share +
-                             " of the points (a closed surface: at most 5%); if it is a thin "
-                             "closed part whose rim is thinner than the noise, fold_borders='on' "
-                             "makes that rim a convex curve");
-        }
+        const std::string hint = foldBordersHint(orientation, "fold_borders='on'");
+        if (foldBorders == "auto" && !hint.empty()) warnings.push_back(hint);
       }
       return detectFeatureCurves(cloud, options, call.progress());
     }
