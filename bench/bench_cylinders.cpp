@@ -19,6 +19,7 @@
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
 //                   [--max-section-shape S] (ours: TubeFitOptions::maxSectionShapeShare; 1: off)
+//                   [--max-face-sectors N] (ours: TubeFitOptions::maxFaceSectors; 36: off)
 //                   [--noisy-only] (the scans with noise 1e-3 alone)
 //                   [--no-split] (ours: TubeSplitOptions::enabled off, Eq. 3.10's regions as
 //                   grown) [--split-cell F] [--split-density F] [--split-steps N]
@@ -387,6 +388,8 @@ static int run(int argc, char** argv) {
       pcaNormals = true;
     else if (a == "--min-arc" && i + 1 < argc)
       ours.tube.minArcDegrees = scalespace::bench::numberArgument(argv, ++i);
+    else if (a == "--max-face-sectors" && i + 1 < argc)
+      ours.tube.maxFaceSectors = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--max-section-shape" && i + 1 < argc)
       ours.tube.maxSectionShapeShare = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--max-gap" && i + 1 < argc)
@@ -400,6 +403,7 @@ static int run(int argc, char** argv) {
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
           "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] "
+          "[--max-face-sectors N] "
           "[--max-gap LEVELS] "
           "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F] "
           "[--no-junction-trim]\n");

@@ -8,6 +8,9 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cli/CliTestSupport.hpp"
 #include "scalespace/core/PipeScene.hpp"
@@ -123,21 +126,19 @@ TEST_F(Cli, CylindersFindThePipesOfTheRack) {
 
 TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   ASSERT_EQ(run("generate cylinder -n 3000 -q -o " + path("c.ply")).code, 0);
-  auto r = run("cylinders " + path("c.ply") + " --epsilon 1 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--epsilon"), std::string::npos) << r.err;
-  r = run("cylinders " + path("c.ply") + " --min-arc 500 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--min-arc"), std::string::npos) << r.err;
-  r = run("cylinders " + path("c.ply") + " --min-sector-fill 1.5 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--min-sector-fill"), std::string::npos) << r.err;
-  r = run("cylinders " + path("c.ply") + " --max-gap -1 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--max-gap"), std::string::npos) << r.err;
-  r = run("cylinders " + path("c.ply") + " --nested-link-tolerance 1 -q -o " + path("o"));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--nested-link-tolerance"), std::string::npos) << r.err;
+  test::Result r;
+  for (const auto& [flag, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--epsilon", "1"},
+                                                        {"--min-arc", "500"},
+                                                        {"--min-sector-fill", "1.5"},
+                                                        {"--max-face-sectors", "-1"},
+                                                        {"--min-face-lean", "-1"},
+                                                        {"--max-gap", "-1"},
+                                                        {"--nested-link-tolerance", "1"}}) {
+    r = run("cylinders " + path("c.ply") + " " + flag + " " + value + " -q -o " + path("o"));
+    EXPECT_EQ(r.code, 2) << flag;
+    EXPECT_NE(r.err.find(flag), std::string::npos) << r.err;
+  }
   for (const char* flag : {"--narrow-min-arc", "--narrow-min-persistence", "--narrow-radius-spread",
                            "--trim-keep-fraction", "--trim-min-radius", "--trim-against-share"}) {
     r = run("cylinders " + path("c.ply") + " " + flag + " -1 -q -o " + path("o"));

@@ -406,6 +406,7 @@ TEST(Cylinders, APrismsFewFaceDirectionsAreNoTube) {
   CylinderOptions options;
   options.tube.minNormalDirections = 0;
   options.tube.minSectorFill = 0;
+  options.tube.maxFaceSectors = 36;
   const std::size_t without = detectCylinders(octahedron, options).components.size();
   EXPECT_GE(without, 1u);  // the other tests alone let it through
   const CylinderDetection d = detectCylinders(octahedron, {});
@@ -447,15 +448,18 @@ Section sampleSection(Place place, double r, double normalNoise, std::size_t cou
 }
 
 // The section passes every tube test at scale t but the fill (TubeFitOptions::minSectorFill),
-// which turns it down with a fill under 0.7.
+// which turns it down with a fill under 0.7 (the faces' own test, maxFaceSectors, left off).
 void expectFacetedByTheFillAlone(const Section& s, double t) {
   TubeFitOptions without;
   without.minSectorFill = 0;
+  without.maxFaceSectors = 36;
   const TubeFit loose =
       fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, without);
   EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " arc " << loose.arcDegrees;
+  TubeFitOptions fill;
+  fill.maxFaceSectors = 36;
   const TubeFit strict =
-      fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, TubeFitOptions{});
+      fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, fill);
   EXPECT_EQ(strict.rejection, TubeRejection::Faceted) << "fill " << strict.sectorFill;
   EXPECT_LT(strict.sectorFill, 0.7);
 }
@@ -512,6 +516,50 @@ TEST(Cylinders, ANoisySquarePrismIsFacetedThoughItsNormalsFillTheBinsTheyTake) {
       },
       a, noise, 20000);
   expectFacetedByTheFillAlone(prism, t);
+}
+
+// A box edge rounded into a tube whose normals, smeared over a wide band about the corner and by
+// 12 degrees of noise, fill the arc's sectors as well as a tube's (a noisy box on a floor, normals
+// estimated over many neighbours): away from the corner each face keeps its normal while the
+// points go round, so over several neighbouring 10-degree sectors the normals turn less than half
+// as far as the points, and their mean lean from the radial is large
+// (TubeFitOptions::maxFaceSectors, minFaceLeanDegrees). A half pipe with the same noise reads
+// neither.
+TEST(Cylinders, ABoxEdgeWhoseNormalsFillTheArcIsFacetedByItsFaces) {
+  const double r = 1, noise = 12 * kPi / 180, t = 0.5;
+  const double c = 0.99 * r;
+  const Section edge = sampleSection(
+      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const double along = (4 * a - 1) * c;
+        const double blend = 0.5 * std::max(0.0, 1 - std::abs(along - c) / (0.9 * c));
+        const double angle = (along < c ? blend : 1 - blend) * kPi / 2;
+        n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
+      },
+      r, noise, 20000);
+  TubeFitOptions without;
+  without.maxFaceSectors = 36;
+  const auto fit = [&](const Section& s, const TubeFitOptions& options) {
+    return fitTube(s.positions, s.normals, s.scaleNormals, s.kappa1, s.points, t, options);
+  };
+  const TubeFit loose = fit(edge, without);
+  EXPECT_TRUE(loose.isTube()) << tubeRejectionName(loose.rejection) << " fill " << loose.sectorFill;
+  const TubeFit strict = fit(edge, TubeFitOptions{});
+  EXPECT_EQ(strict.rejection, TubeRejection::Faceted);
+  EXPECT_GE(strict.faceSectors, 3);
+  EXPECT_GT(strict.normalLean, 12);
+
+  const Section pipe = sampleSection(
+      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+        const double angle = (a - 0.75) * kPi;
+        n = Eigen::Vector2d(std::cos(angle + kPi / 2), std::sin(angle + kPi / 2));
+        q = r * n;
+      },
+      r, noise, 20000);
+  const TubeFit tube = fit(pipe, TubeFitOptions{});
+  EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
+  EXPECT_LE(tube.faceSectors, 1);
+  EXPECT_LT(tube.normalLean, 2);
 }
 
 // A square prism whose normals were smeared into a tube's (radial here, so that every normal test
@@ -766,6 +814,9 @@ TEST(Cylinders, OptionsAreChecked) {
           "TubeFitOptions::maxSectionShapeShare");
   rejects([](CylinderOptions& o) { o.tube.maxSectionShapeRms = -1; },
           "TubeFitOptions::maxSectionShapeRms");
+  rejects([](CylinderOptions& o) { o.tube.maxFaceSectors = -1; }, "TubeFitOptions::maxFaceSectors");
+  rejects([](CylinderOptions& o) { o.tube.minFaceLeanDegrees = NAN; },
+          "TubeFitOptions::minFaceLeanDegrees");
   rejects([](CylinderOptions& o) { o.lines.beta = 0; }, "CurvatureLineOptions::beta");
   rejects([](CylinderOptions& o) { o.trim.keepFraction = 2; }, "TubeTrimOptions::keepFraction");
   rejects([](CylinderOptions& o) { o.narrow.minArcDegrees = -1; },

@@ -418,6 +418,10 @@ def test_cylinders_equal_the_cli(pipes):
         for key in ("id", "birth_level", "death_level", "gap_levels", "persistence",
                     "representative_level", "point_count", "straight"):
             assert g[key] == e[key], key
+        for key in ("face_sectors",):
+            assert g[key] == e[key], key
+        for key in ("normal_lean",):
+            np.testing.assert_allclose(g[key], e[key], rtol=1e-9, atol=1e-12, err_msg=key)
         for key in ("birth_scale", "death_scale", "radius", "rms", "length", "arc_degrees",
                     "sector_fill", "section_shape"):
             np.testing.assert_allclose(g[key], e[key], rtol=1e-9, err_msg=key)
@@ -580,6 +584,8 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"min_sector_fill": 2}, "min_sector_fill"),
                          ({"max_section_shape": 2}, "max_section_shape"),
                          ({"max_section_shape_rms": -1}, "max_section_shape_rms"),
+                         ({"max_face_sectors": -1}, "max_face_sectors"),
+                         ({"min_face_lean": float("nan")}, "min_face_lean"),
                          ({"max_gap": -1}, "max_gap"),
                          ({"nested_link_tolerance": 1}, "nested_link_tolerance"),
                          ({"narrow_min_arc": -1}, "narrow_min_arc"),

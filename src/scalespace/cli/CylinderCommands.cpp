@@ -95,6 +95,8 @@ nlohmann::json componentsJson(const CylinderDetection& detection, const Vec3& or
                            {"arc_degrees", t.arcDegrees},
                            {"sector_fill", t.sectorFill},
                            {"section_shape", t.sectionShapeShare},
+                           {"face_sectors", t.faceSectors},
+                           {"normal_lean", t.normalLean},
                            {"axis", axis},
                            {"radii", t.radii}};
     if (t.straight) {  // the straight axis means nothing for a bent tube
@@ -164,6 +166,16 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_option("--max-section-shape-rms", args->cylinders.tube.maxSectionShapeRms,
                   "with --max-section-shape: the shape's RMS must also be over this x the "
                   "radius (a noisy box: 0.08 and more; a stereo scan's mug wall: 0.03)")
+      ->capture_default_str();
+  cmd->add_option("--max-face-sectors", args->cylinders.tube.maxFaceSectors,
+                  "turn down a tube whose normals turn less than half as far as its points over "
+                  "more than this many neighbouring 10-degree sectors round its axis (a prism's "
+                  "face), with --min-face-lean (36: off)")
+      ->capture_default_str();
+  cmd->add_option("--min-face-lean", args->cylinders.tube.minFaceLeanDegrees,
+                  "with --max-face-sectors: the RMS of the sectors' mean lean of the normals from "
+                  "the radial must also be at least this (degrees; a noisy box: 14 and more, "
+                  "pipes: under 4)")
       ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")
@@ -306,6 +318,8 @@ void addCylindersCommand(CLI::App& app) {
           {"min_sector_fill", o.tube.minSectorFill},
           {"max_section_shape_share", o.tube.maxSectionShapeShare},
           {"max_section_shape_rms", o.tube.maxSectionShapeRms},
+          {"max_face_sectors", o.tube.maxFaceSectors},
+          {"min_face_lean_degrees", o.tube.minFaceLeanDegrees},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
           {"nested_link_tolerance", o.nestedLinkTolerance},

@@ -83,6 +83,8 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"TubeFitOptions::minSectorFill", "--min-sector-fill"},
     {"TubeFitOptions::maxSectionShapeShare", "--max-section-shape"},
     {"TubeFitOptions::maxSectionShapeRms", "--max-section-shape-rms"},
+    {"TubeFitOptions::maxFaceSectors", "--max-face-sectors"},
+    {"TubeFitOptions::minFaceLeanDegrees", "--min-face-lean"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
     {"CylinderOptions::nestedLinkTolerance", "--nested-link-tolerance"},
     {"TubeTrimOptions::keepFraction", "--trim-keep-fraction"},

@@ -251,7 +251,8 @@ struct AxisEvaluation {
   std::vector<Vec3> axis;
   std::vector<double> radii;
   double rms = 0, meanDistance = 0, normalArc = 0, positionArc = 0;
-  double normalDirections = 0, normalSectorFill = 0, evenSectorFill = 0;
+  double normalDirections = 0, normalSectorFill = 0, evenSectorFill = 0, normalLean = 0;
+  int faceSectors = 0;
 };
 
 // (Not in the thesis.) The share of the points' spread about the tube that a section shape
@@ -461,6 +462,44 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
     positionAngle[k] = azimuth(s, Vec3(positions[points[k]] - foot));
   }
+  // (Not in the thesis.) Each normal's lean from its point's radial direction, signed and taken
+  // as a line (an inner wall's normals face the axis), averaged per 10-degree sector of the
+  // points' azimuth over the whole axis. A tube's normals are radial: its sector means stay near
+  // 0, and a twisted cable's strands, turning along it, average out. A prism's face keeps one
+  // normal while the points go round: over the sectors it spans the mean lean falls as fast as
+  // the azimuth rises. Read: the RMS of the sector means (degrees) and the longest run of
+  // neighbouring sectors over which the normals turn less than half as far as the points.
+  const auto faceReading = [&](const std::vector<double>& angles, double& lean, int& run) {
+    constexpr int kLeanSectors = 36;
+    constexpr double kMinInSector = 10;
+    std::array<double, kLeanSectors> sum{}, count{};
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (std::isnan(angles[k]) || std::isnan(positionAngle[k])) continue;
+      double d = std::remainder(angles[k] - positionAngle[k], 2 * kPi);
+      if (d > kPi / 2) d -= kPi;
+      if (d < -kPi / 2) d += kPi;
+      const std::size_t b = binOf(positionAngle[k], kLeanSectors);
+      sum[b] += d;
+      count[b] += 1;
+    }
+    double squares = 0, weight = 0;
+    for (std::size_t b = 0; b < std::size_t(kLeanSectors); ++b) {
+      if (count[b] < kMinInSector) continue;
+      squares += sum[b] * sum[b] / count[b];
+      weight += count[b];
+    }
+    lean = weight > 0 ? std::sqrt(squares / weight) * 180 / kPi : 0;
+    run = 0;
+    int current = 0;
+    for (int b = 0; b < 2 * kLeanSectors; ++b) {
+      const std::size_t i = std::size_t(b % kLeanSectors), j = std::size_t((b + 1) % kLeanSectors);
+      const bool stall = count[i] >= kMinInSector && count[j] >= kMinInSector &&
+                         sum[j] / count[j] - sum[i] / count[i] < -kPi / kLeanSectors;
+      current = stall ? current + 1 : 0;
+      run = std::max(run, std::min(current, kLeanSectors));
+    }
+  };
+  faceReading(normalAngle, e.normalLean, e.faceSectors);
   const SegmentArcs normalArcs = segmentArcs(normalAngle),
                     positionArcs = segmentArcs(positionAngle);
   e.normalArc = median(normalArcs.filled);
@@ -646,6 +685,9 @@ void validateTubeFitOptions(const TubeFitOptions& options) {
         "TubeFitOptions::maxSectionShapeShare must be in [0, 1] (1: no test)");
   check(std::isfinite(options.maxSectionShapeRms) && options.maxSectionShapeRms >= 0,
         "TubeFitOptions::maxSectionShapeRms must be finite and >= 0");
+  check(options.maxFaceSectors >= 0, "TubeFitOptions::maxFaceSectors must be >= 0 (36: no test)");
+  check(std::isfinite(options.minFaceLeanDegrees) && options.minFaceLeanDegrees >= 0,
+        "TubeFitOptions::minFaceLeanDegrees must be finite and >= 0");
   check(std::isfinite(options.minNormalDirections) && options.minNormalDirections >= 0,
         "TubeFitOptions::minNormalDirections must be finite and >= 0");
   check(options.minSectorFill >= 0 && options.minSectorFill <= 1,
@@ -739,6 +781,8 @@ TubeFit fitTube(const std::vector<Vec3>& positions, const std::vector<Vec3>& nor
     fit.sectionShapeShare = sectionShapeShare(positions, points, fit.axis, fit.radii);
   for (std::size_t k = 0; k + 1 < fit.axis.size(); ++k)
     fit.length += (fit.axis[k + 1] - fit.axis[k]).norm();
+  fit.faceSectors = chosen.faceSectors;
+  fit.normalLean = chosen.normalLean;
 
   fit.rejection = judgeTube(fit, t, options);
   return fit;
@@ -752,6 +796,8 @@ TubeRejection judgeTube(const TubeFit& fit, double t, const TubeFitOptions& opti
   if (!(fit.rms <= options.maxRelativeRms * std::max(fit.radius, t))) return TubeRejection::Rough;
   if (fit.normalDirections < std::min(options.minNormalDirections, 0.5 * double(fit.pointCount)) ||
       fit.sectorFill < options.minSectorFill)
+    return TubeRejection::Faceted;
+  if (fit.faceSectors > options.maxFaceSectors && fit.normalLean >= options.minFaceLeanDegrees)
     return TubeRejection::Faceted;
   // Both the share and the shape's own RMS (TubeFitOptions::maxSectionShapeRms).
   if (fit.sectionShapeShare > options.maxSectionShapeShare &&

@@ -101,6 +101,8 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"TubeFitOptions::minSectorFill", "min_sector_fill"},
     {"TubeFitOptions::maxSectionShapeShare", "max_section_shape"},
     {"TubeFitOptions::maxSectionShapeRms", "max_section_shape_rms"},
+    {"TubeFitOptions::maxFaceSectors", "max_face_sectors"},
+    {"TubeFitOptions::minFaceLeanDegrees", "min_face_lean"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
     {"CylinderOptions::nestedLinkTolerance", "nested_link_tolerance"},
     {"TubeTrimOptions::keepFraction", "trim_keep_fraction"},

@@ -82,6 +82,8 @@ class Cylinders {
       d["arc_degrees"] = t.arcDegrees;
       d["sector_fill"] = t.sectorFill;
       d["section_shape"] = t.sectionShapeShare;
+      d["normal_lean"] = t.normalLean;
+      d["face_sectors"] = t.faceSectors;
       d["direction"] = t.straight ? py::object(vec3Array(t.direction)) : py::object(py::none());
       d["centre"] = t.straight ? py::object(vec3Array(t.centre + origin_)) : py::object(py::none());
       d["axis"] = vectorsToArray(t.axis, origin_);
@@ -148,11 +150,11 @@ std::unique_ptr<Cylinders> cylindersPy(
     const py::handle& points, const py::handle& normals, const py::handle& viewpoint,
     const std::optional<std::vector<double>>& scales, int scaleCount, double tmin, double tmax,
     double epsilon, double minAnisotropy, double minArc, double minSectorFill,
-    double maxSectionShape, double maxSectionShapeRms, double maxRms, bool oneCurvatureSign,
-    bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap, double nestedLinkTolerance,
-    double trimKeepFraction, double trimMinRadius, double trimAgainstShare, double narrowMinArc,
-    int narrowMinPersistence, double narrowRadiusSpread, std::optional<int> threads,
-    py::object progress) {
+    double maxSectionShape, double maxSectionShapeRms, int maxFaceSectors, double minFaceLean,
+    double maxRms, bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes,
+    int maxGap, double nestedLinkTolerance, double trimKeepFraction, double trimMinRadius,
+    double trimAgainstShare, double narrowMinArc, int narrowMinPersistence,
+    double narrowRadiusSpread, std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
   if (scales) options.scales = *scales;
@@ -165,6 +167,8 @@ std::unique_ptr<Cylinders> cylindersPy(
   options.tube.minSectorFill = minSectorFill;
   options.tube.maxSectionShapeShare = maxSectionShape;
   options.tube.maxSectionShapeRms = maxSectionShapeRms;
+  options.tube.maxFaceSectors = maxFaceSectors;
+  options.tube.minFaceLeanDegrees = minFaceLean;
   options.tube.maxRelativeRms = maxRms;
   options.oneCurvatureSign = oneCurvatureSign;
   options.split.enabled = splitByAxes;
@@ -245,7 +249,9 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
         "min_arc"_a = TubeFitOptions{}.minArcDegrees,
         "min_sector_fill"_a = TubeFitOptions{}.minSectorFill,
         "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare,
-        "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms, "max_rms"_a = 0.25,
+        "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms,
+        "max_face_sectors"_a = TubeFitOptions{}.maxFaceSectors,
+        "min_face_lean"_a = TubeFitOptions{}.minFaceLeanDegrees, "max_rms"_a = 0.25,
         "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
         "split_by_axes"_a = TubeSplitOptions{}.enabled,
         "trim_junctions"_a = TubeTrimOptions{}.enabled,
@@ -272,7 +278,11 @@ max_section_shape: below 1, a straight tube is turned down when more than this s
 points' spread about it is a section shape fixed along its axis (the azimuth's harmonics 2-8) of
 RMS above 0.05 x its radius: a noisy box's faces read 0.23 and more, but so did the real table
 legs of python3-pcl's table scan (0.25-0.68); 1 (default): off; max_section_shape_rms: that RMS
-bound, over the radius;
+bound, over the radius; max_face_sectors: a tube is turned down when its normals turn less
+than half as far as its points over more than this many neighbouring 10-degree sectors round its
+axis (a prism's face keeps one normal while its points go round; 36: off) and the RMS of the
+sectors' mean lean of the normals from the radial is at least min_face_lean degrees (a noisy
+box's faces: 14 and more; pipes: under 4);
 max_rms: a tube's RMS distance to its surface over its radius. one_curvature_sign: a region
 only grows over points curving the way its seed does, which stops it at the groove between a
 noisy cable's strands (needs consistently oriented normals; off: Eq. 3.10 alone).
