@@ -447,6 +447,28 @@ Section sampleSection(Place place, double r, double normalNoise, std::size_t cou
   return s;
 }
 
+// The faces of a right angle, y = c (z in [-c, c]) and z = c (y in [-c, c]), end to end: a box
+// edge as the fits round it into a tube of radius about c. Normals estimated over many
+// neighbours lean towards the other face near the corner, over `blendWidth` x c of each face.
+auto roundedBoxEdge(double c, double blendWidth) {
+  return [c, blendWidth](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+    const double along = (4 * a - 1) * c;  // [-c, 3c]
+    const double blend = 0.5 * std::max(0.0, 1 - std::abs(along - c) / (blendWidth * c));
+    const double angle = (along < c ? blend : 1 - blend) * kPi / 2;
+    n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
+  };
+}
+
+// A tube of radius r seen over the same half turn as roundedBoxEdge, from -135 to 45 degrees.
+auto halfPipe(double r) {
+  return [r](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
+    const double angle = (a - 0.75) * kPi;
+    n = Eigen::Vector2d(std::cos(angle + kPi / 2), std::sin(angle + kPi / 2));
+    q = r * n;
+  };
+}
+
 // The section passes every tube test at scale t but the fill (TubeFitOptions::minSectorFill),
 // which turns it down with a fill under 0.7 (the faces' own test, maxFaceSectors, left off).
 void expectFacetedByTheFillAlone(const Section& s, double t) {
@@ -472,26 +494,8 @@ void expectFacetedByTheFillAlone(const Section& s, double t) {
 // them.
 TEST(Cylinders, ARoundedBoxEdgeIsNoTubeButAHalfPipeIs) {
   const double r = 1, noise = 9 * kPi / 180, t = 0.5;
-  const double c = 0.99 * r;  // the faces: y = c (z in [-c, c]) and z = c (y in [-c, c])
-  const Section edge = sampleSection(
-      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
-        const double along = (4 * a - 1) * c;  // [-c, 3c]: the two faces, end to end
-        // Normals estimated over many neighbours lean towards the other face near the corner.
-        const double blend = 0.5 * std::max(0.0, 1 - std::abs(along - c) / (0.2 * c));
-        const double angle = (along < c ? blend : 1 - blend) * kPi / 2;
-        n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
-        q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
-      },
-      r, noise, 20000);
-  expectFacetedByTheFillAlone(edge, t);
-
-  const Section pipe = sampleSection(
-      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
-        const double angle = (a - 0.75) * kPi;  // the same half turn, from -135 to 45 degrees
-        n = Eigen::Vector2d(std::cos(angle + kPi / 2), std::sin(angle + kPi / 2));
-        q = r * n;
-      },
-      r, noise, 20000);
+  expectFacetedByTheFillAlone(sampleSection(roundedBoxEdge(0.99 * r, 0.2), r, noise, 20000), t);
+  const Section pipe = sampleSection(halfPipe(r), r, noise, 20000);
   const TubeFit tube = fitTube(pipe.positions, pipe.normals, pipe.scaleNormals, pipe.kappa1,
                                pipe.points, t, TubeFitOptions{});
   EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
@@ -527,16 +531,7 @@ TEST(Cylinders, ANoisySquarePrismIsFacetedThoughItsNormalsFillTheBinsTheyTake) {
 // neither.
 TEST(Cylinders, ABoxEdgeWhoseNormalsFillTheArcIsFacetedByItsFaces) {
   const double r = 1, noise = 12 * kPi / 180, t = 0.5;
-  const double c = 0.99 * r;
-  const Section edge = sampleSection(
-      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
-        const double along = (4 * a - 1) * c;
-        const double blend = 0.5 * std::max(0.0, 1 - std::abs(along - c) / (0.9 * c));
-        const double angle = (along < c ? blend : 1 - blend) * kPi / 2;
-        n = Eigen::Vector2d(std::cos(angle), std::sin(angle));
-        q = along < c ? Eigen::Vector2d(c, along) : Eigen::Vector2d(c - (along - c), c);
-      },
-      r, noise, 20000);
+  const Section edge = sampleSection(roundedBoxEdge(0.99 * r, 0.9), r, noise, 20000);
   TubeFitOptions without;
   without.maxFaceSectors = 36;
   const auto fit = [&](const Section& s, const TubeFitOptions& options) {
@@ -549,14 +544,7 @@ TEST(Cylinders, ABoxEdgeWhoseNormalsFillTheArcIsFacetedByItsFaces) {
   EXPECT_GE(strict.faceSectors, 3);
   EXPECT_GT(strict.normalLean, 12);
 
-  const Section pipe = sampleSection(
-      [&](double a, Eigen::Vector2d& q, Eigen::Vector2d& n) {
-        const double angle = (a - 0.75) * kPi;
-        n = Eigen::Vector2d(std::cos(angle + kPi / 2), std::sin(angle + kPi / 2));
-        q = r * n;
-      },
-      r, noise, 20000);
-  const TubeFit tube = fit(pipe, TubeFitOptions{});
+  const TubeFit tube = fit(sampleSection(halfPipe(r), r, noise, 20000), TubeFitOptions{});
   EXPECT_TRUE(tube.isTube()) << tubeRejectionName(tube.rejection);
   EXPECT_LE(tube.faceSectors, 1);
   EXPECT_LT(tube.normalLean, 2);

@@ -175,7 +175,7 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_option("--min-face-lean", args->cylinders.tube.minFaceLeanDegrees,
                   "with --max-face-sectors: the RMS of the sectors' mean lean of the normals from "
                   "the radial must also be at least this (degrees; a noisy box: 14 and more, "
-                  "pipes: under 4)")
+                  "pipes and a cable's strands: under 9)")
       ->capture_default_str();
   cmd->add_option("--max-rms", args->cylinders.tube.maxRelativeRms,
                   "a tube's RMS distance to its surface is at most this x its radius")

@@ -355,6 +355,50 @@ double sectionShapeShare(const std::vector<Vec3>& positions, const std::vector<I
   return shapeShareOf(azimuths, spread);
 }
 
+// The bin of an azimuth in [-pi, pi] among `bins` equal ones round the circle.
+std::size_t azimuthBin(double angle, int bins) {
+  return std::size_t(std::min(bins - 1, int((angle + kPi) / (2 * kPi) * bins)));
+}
+
+// (Not in the thesis.) Each normal's lean from its point's radial direction (azimuths about the
+// axis; NaN skipped), signed and taken as a line (an inner wall's normals face the axis),
+// averaged per 10-degree sector of the points' azimuth over the whole axis. A tube's normals are
+// radial: its sector means stay near 0, and a twisted cable's strands, turning along it, average
+// out. A prism's face keeps one normal while the points go round: over the sectors it spans the
+// mean lean falls as fast as the azimuth rises. Reads the RMS of the sector means (degrees) and
+// the longest run of neighbouring sectors over which the normals turn less than half as far as
+// the points (TubeFitOptions::maxFaceSectors, minFaceLeanDegrees).
+void readFaces(const std::vector<double>& normalAngle, const std::vector<double>& positionAngle,
+               double& lean, int& run) {
+  constexpr int kSectors = 36;
+  constexpr double kMinInSector = 10;
+  std::array<double, kSectors> sum{}, count{};
+  for (std::size_t k = 0; k < normalAngle.size(); ++k) {
+    if (std::isnan(normalAngle[k]) || std::isnan(positionAngle[k])) continue;
+    double d = std::remainder(normalAngle[k] - positionAngle[k], 2 * kPi);
+    if (d > kPi / 2) d -= kPi;
+    if (d < -kPi / 2) d += kPi;
+    const std::size_t b = azimuthBin(positionAngle[k], kSectors);
+    sum[b] += d;
+    count[b] += 1;
+  }
+  double squares = 0, weight = 0;
+  for (std::size_t b = 0; b < std::size_t(kSectors); ++b) {
+    if (count[b] < kMinInSector) continue;
+    squares += sum[b] * sum[b] / count[b];
+    weight += count[b];
+  }
+  lean = weight > 0 ? std::sqrt(squares / weight) * 180 / kPi : 0;
+  run = 0;
+  for (int b = 0, current = 0; b < 2 * kSectors; ++b) {
+    const std::size_t i = std::size_t(b % kSectors), j = std::size_t((b + 1) % kSectors);
+    const bool stall = count[i] >= kMinInSector && count[j] >= kMinInSector &&
+                       sum[j] / count[j] - sum[i] / count[i] < -kPi / kSectors;
+    current = stall ? current + 1 : 0;
+    run = std::max(run, std::min(current, kSectors));
+  }
+}
+
 void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
                   const std::vector<Index>& points, bool straight, AxisEvaluation& e) {
   const std::size_t m = e.axis.size();
@@ -403,9 +447,6 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   // Per segment, NaN where it holds too few points: the arc (degrees) of the bins holding at least
   // a quarter of the mean count, and its span, all but the longest run of bins under that count
   // round the circle (the gaps between a prism's faces included).
-  const auto binOf = [](double angle, int bins) {
-    return std::size_t(std::min(bins - 1, int((angle + kPi) / (2 * kPi) * bins)));
-  };
   struct SegmentArcs {
     std::vector<double> filled, span;
   };
@@ -413,7 +454,7 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     std::vector<std::array<std::uint32_t, kBins>> bins(m - 1);
     for (auto& b : bins) b.fill(0);
     for (std::size_t k = 0; k < points.size(); ++k)
-      if (!std::isnan(angles[k])) ++bins[proj[k].segment][binOf(angles[k], kBins)];
+      if (!std::isnan(angles[k])) ++bins[proj[k].segment][azimuthBin(angles[k], kBins)];
     SegmentArcs arcs{std::vector<double>(m - 1, std::numeric_limits<double>::quiet_NaN()),
                      std::vector<double>(m - 1, std::numeric_limits<double>::quiet_NaN())};
     for (std::size_t s = 0; s + 1 < m; ++s) {
@@ -439,7 +480,7 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     std::array<std::uint32_t, kBins> all{};
     std::uint32_t counted = 0;
     for (const double angle : angles)
-      if (!std::isnan(angle)) ++all[binOf(angle, kBins)], ++counted;
+      if (!std::isnan(angle)) ++all[azimuthBin(angle, kBins)], ++counted;
     int filled = 0;
     for (const std::uint32_t c : all) filled += double(c) >= std::max(2.0, 0.25 * counted / kBins);
     return 360.0 * filled / kBins;
@@ -462,44 +503,7 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
     const Vec3 foot = e.axis[s] + proj[k].along * (e.axis[s + 1] - e.axis[s]);
     positionAngle[k] = azimuth(s, Vec3(positions[points[k]] - foot));
   }
-  // (Not in the thesis.) Each normal's lean from its point's radial direction, signed and taken
-  // as a line (an inner wall's normals face the axis), averaged per 10-degree sector of the
-  // points' azimuth over the whole axis. A tube's normals are radial: its sector means stay near
-  // 0, and a twisted cable's strands, turning along it, average out. A prism's face keeps one
-  // normal while the points go round: over the sectors it spans the mean lean falls as fast as
-  // the azimuth rises. Read: the RMS of the sector means (degrees) and the longest run of
-  // neighbouring sectors over which the normals turn less than half as far as the points.
-  const auto faceReading = [&](const std::vector<double>& angles, double& lean, int& run) {
-    constexpr int kLeanSectors = 36;
-    constexpr double kMinInSector = 10;
-    std::array<double, kLeanSectors> sum{}, count{};
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      if (std::isnan(angles[k]) || std::isnan(positionAngle[k])) continue;
-      double d = std::remainder(angles[k] - positionAngle[k], 2 * kPi);
-      if (d > kPi / 2) d -= kPi;
-      if (d < -kPi / 2) d += kPi;
-      const std::size_t b = binOf(positionAngle[k], kLeanSectors);
-      sum[b] += d;
-      count[b] += 1;
-    }
-    double squares = 0, weight = 0;
-    for (std::size_t b = 0; b < std::size_t(kLeanSectors); ++b) {
-      if (count[b] < kMinInSector) continue;
-      squares += sum[b] * sum[b] / count[b];
-      weight += count[b];
-    }
-    lean = weight > 0 ? std::sqrt(squares / weight) * 180 / kPi : 0;
-    run = 0;
-    int current = 0;
-    for (int b = 0; b < 2 * kLeanSectors; ++b) {
-      const std::size_t i = std::size_t(b % kLeanSectors), j = std::size_t((b + 1) % kLeanSectors);
-      const bool stall = count[i] >= kMinInSector && count[j] >= kMinInSector &&
-                         sum[j] / count[j] - sum[i] / count[i] < -kPi / kLeanSectors;
-      current = stall ? current + 1 : 0;
-      run = std::max(run, std::min(current, kLeanSectors));
-    }
-  };
-  faceReading(normalAngle, e.normalLean, e.faceSectors);
+  readFaces(normalAngle, positionAngle, e.normalLean, e.faceSectors);
   const SegmentArcs normalArcs = segmentArcs(normalAngle),
                     positionArcs = segmentArcs(positionAngle);
   e.normalArc = median(normalArcs.filled);
@@ -519,7 +523,7 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   const auto effectiveBins = [&](const std::vector<double>& angles, int bins) {
     std::vector<std::uint32_t> histogram(std::size_t(bins), 0);
     for (const double angle : angles)
-      if (!std::isnan(angle)) ++histogram[binOf(angle, bins)];
+      if (!std::isnan(angle)) ++histogram[azimuthBin(angle, bins)];
     return histogramBins(histogram);
   };
   // The 2-degree directions the normals take around the axis: a tube's turn continuously, a
@@ -540,7 +544,8 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   constexpr int kSectors = 36;
   std::vector<std::vector<std::uint32_t>> sectors(m - 1, std::vector<std::uint32_t>(kSectors, 0));
   for (std::size_t k = 0; k < points.size(); ++k)
-    if (!std::isnan(normalAngle[k])) ++sectors[proj[k].segment][binOf(normalAngle[k], kSectors)];
+    if (!std::isnan(normalAngle[k]))
+      ++sectors[proj[k].segment][azimuthBin(normalAngle[k], kSectors)];
   std::vector<double> spanFills(m - 1, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t s = 0; s + 1 < m; ++s) {
     if (std::isnan(normalArcs.span[s]) || std::isnan(positionArcs.span[s])) continue;
@@ -552,7 +557,7 @@ void evaluateAxis(const std::vector<Vec3>& positions, const std::vector<Vec3>& n
   const double spanFill = median(spanFills);
   e.normalSectorFill = std::isnan(spanFill) ? binFill : std::min(binFill, spanFill);
   {
-    const auto sectorOf = [&](double angle) { return binOf(angle, kSectors); };
+    const auto sectorOf = [&](double angle) { return azimuthBin(angle, kSectors); };
     std::array<double, kSectors> pointsIn{}, normalsIn{};
     double counted = 0;
     for (const double angle : positionAngle)

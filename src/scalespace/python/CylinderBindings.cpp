@@ -282,7 +282,7 @@ bound, over the radius; max_face_sectors: a tube is turned down when its normals
 than half as far as its points over more than this many neighbouring 10-degree sectors round its
 axis (a prism's face keeps one normal while its points go round; 36: off) and the RMS of the
 sectors' mean lean of the normals from the radial is at least min_face_lean degrees (a noisy
-box's faces: 14 and more; pipes: under 4);
+box's faces: 14 and more; pipes and a cable's strands: under 9);
 max_rms: a tube's RMS distance to its surface over its radius. one_curvature_sign: a region
 only grows over points curving the way its seed does, which stops it at the groove between a
 noisy cable's strands (needs consistently oriented normals; off: Eq. 3.10 alone).
