@@ -1,9 +1,12 @@
 // Cylinders across scales (Sec. 3.5) against CGAL's Efficient RANSAC [Schnabel 2007] (planes and
-// cylinders: the peer users reach for), on the pipe rack of `scalespace generate pipes` (ground
-// truth per point: core/PipeScene.hpp), full and one-sided ("half-pipe") scans, noise 0 and 1e-3
-// of the diagonal.
+// cylinders: the peer users reach for), on the pipe rack of `scalespace generate pipes` or the
+// poles of `scalespace generate poles` (ground truth per point: core/PipeScene.hpp), full and
+// one-sided ("half-pipe") scans, noise 0 and 1e-3 of the diagonal.
 //
-//   bench_cylinders [--points N (1000000)] [--no-peers] [--clean-only] [--scan full|one-sided]
+//   bench_cylinders [--scene rack|poles (rack)]
+//                   [--points N (rack 1000000; poles 216000, a 2 cm spacing, where the box's
+//                   edges round into tubes)] [--noise F (that noise alone)]
+//                   [--no-peers] [--clean-only] [--scan full|one-sided]
 //                   [--scales M (ours: 8)] [--tmin T (ours: automatic)] [--seed S]
 //                   [--curved-seeds-first] (ours: CurvatureLineOptions::curvedSeedsFirst on,
 //                   the features' seed order; the cylinders' default is the random order)
@@ -28,14 +31,17 @@
 //                   [--no-junction-trim] (ours: TubeTrimOptions::enabled off)
 //
 // Scores, per scene and method:
-//   - per pipe (thin, medium, thick, bent, tapering, cable): the best IoU with one detected set
+//   - per pipe (the rack: thin, medium, thick, bent, tapering, cable; the poles: four straight
+//     poles): the best IoU with one detected set
 //     (ours: a component's points at one scale, any scale; RANSAC: one cylinder's points); found
 //     when >= 0.8;
-//   - the cable read both ways: each strand found (IoU >= 0.8; seen from one side, a strand is
+//   - the rack's cable read both ways: each strand found (IoU >= 0.8; seen from one side, a strand
+//   is
 //     the runs along the cable where the others do not hide it, each to be found) and the whole
 //     cable found;
 //   - on the straight pipes, the radius error (%) and axis angle (degrees) of the best match;
-//   - false cylinders: detected sets whose points lie mostly (> 50%) on the floor, wall and box.
+//   - false cylinders: detected sets whose points lie mostly (> 50%) on the floor, wall and box
+//     (their persistence, ours, where a component holds the set).
 // Timings are the detection alone (k-NN graph and every scale for ours; detect() for RANSAC), on
 // all cores.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -70,7 +76,8 @@ struct Detected {
   bool straight = false;
   Vec3 direction = Vec3::UnitX();
   double radius = 0;
-  std::string where;  // "t=0.025" or "ransac"
+  std::string where;     // "t=0.025" or "ransac"
+  int persistence = -1;  // ours: its component's
 };
 
 struct Method {
@@ -104,7 +111,9 @@ Method runOurs(const PointCloud& cloud, const CylinderOptions& options) {
       const TubeFit& tube = d.levels[std::size_t(level)].tubes[r];
       char where[32];
       std::snprintf(where, sizeof where, "t=%.3g", d.levels[std::size_t(level)].scale);
-      m.sets.push_back({regions[r], tube.straight, tube.direction, tube.radius, where});
+      const int component = d.graph.componentOf[std::size_t(level)][r];
+      m.sets.push_back({regions[r], tube.straight, tube.direction, tube.radius, where,
+                        d.components[std::size_t(component)].persistence});
     }
   }
   std::printf("  scalespace: %zu components over %d scales (%zu regions)\n", d.components.size(),
@@ -172,22 +181,20 @@ struct Score {
   int found = 0, strandsFound = 0;
   bool cableWhole = false;
   double worstRadiusError = 0, worstAngle = 0;
-  int falseCylinders = 0;
+  int falseCylinders = 0, falsePersistence = -1;  // the most persistent false one's (ours)
 };
 
-Score score(const Method& m, const PointCloud& cloud, bool print) {
-  const std::vector<PipeTruth> truth = pipeSceneTruth();
+Score score(const Method& m, const PointCloud& cloud, const std::vector<PipeTruth>& truth,
+            bool print) {
   const auto& pipe = cloud.findAttribute("gt_pipe")->values;
   const auto& part = cloud.findAttribute("gt_part")->values;
-  std::vector<std::vector<Index>> gt(truth.size()), strands(3);
-  std::size_t planar = 0;
+  const bool cable = std::any_of(truth.begin(), truth.end(),
+                                 [](const PipeTruth& t) { return t.kind == PipeKind::Cable; });
+  std::vector<std::vector<Index>> gt(truth.size()), strands(cable ? 3 : 0);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int p = int(pipe[i]);
-    if (p >= 0)
-      gt[std::size_t(p)].push_back(Index(i));
-    else
-      ++planar;
-    if (p == 5) strands[std::size_t(part[i])].push_back(Index(i));
+    if (p >= 0) gt[std::size_t(p)].push_back(Index(i));
+    if (cable && p == 5) strands[std::size_t(part[i])].push_back(Index(i));
   }
   Score s;
   auto best = [&](const std::vector<Index>& target, std::size_t& which) {
@@ -231,7 +238,7 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
                   target.size(), m.sets[k].points.size(), m.sets[k].where.c_str(), elsewhere);
     }
   }
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < int(strands.size()); ++k) {
     // What a scan sees of a strand: one piece all round, or, seen from one side, the runs along
     // the cable where the strand is not under the others (cut at gaps of 5 cm along x; runs under
     // 2% of the strand's points are dropped). Found when each run is (IoU >= 0.8).
@@ -290,21 +297,24 @@ Score score(const Method& m, const PointCloud& cloud, bool print) {
     for (const Index i : d.points) onPlanes += pipe[i] < 0;
     if (2 * onPlanes <= d.points.size()) continue;
     ++s.falseCylinders;
+    s.falsePersistence = std::max(s.falsePersistence, d.persistence);
     if (print) {
       Vec3 centre = Vec3::Zero();
       for (const Index i : d.points) centre += cloud.absolutePosition(i);
       centre /= double(d.points.size());
-      std::printf("    false cylinder (%s): %zu points around (%.2f, %.2f, %.2f), radius %.3g\n",
+      std::printf("    false cylinder (%s): %zu points around (%.2f, %.2f, %.2f), radius %.3g",
                   d.where.c_str(), d.points.size(), centre.x(), centre.y(), centre.z(), d.radius);
+      if (d.persistence >= 0) std::printf(", persistence %d", d.persistence);
+      std::printf("\n");
     }
   }
-  (void)planar;
   return s;
 }
 
 // What a user without normals gets: the CLI's estimation and orientation (cli/ensureNormals), a
 // one-sided scan facing its scanner. Prints how many normals face away from the exact ones.
-void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k, bool pca) {
+void estimateSceneNormals(PointCloud& cloud, const std::vector<PipeTruth>& truth,
+                          const Vec3* scanner, std::size_t k, bool pca) {
   const std::vector<Vec3> exact = cloud.normals();
   OrientedNormalsOptions options = pca ? OrientedNormalsOptions{} : cylinderNormalOptions();
   if (k > 0) options.estimation.k = options.estimation.maxK = k;
@@ -330,7 +340,6 @@ void estimateSceneNormals(PointCloud& cloud, const Vec3* scanner, std::size_t k,
     a += exact[i].dot(estimated.normals[i]) < 0;
     ++all;
   }
-  const std::vector<PipeTruth> truth = pipeSceneTruth();
   std::printf("   against, per object:");
   for (const auto& [p, counts] : per)
     std::printf(" %s %.1f%%", p < 0 ? "planes" : truth[std::size_t(p)].name.c_str(),
@@ -348,10 +357,18 @@ static int run(int argc, char** argv) {
   std::string only;         // "full" or "one-sided": that scan alone
   CylinderOptions ours;
   std::uint64_t seed = 1;
+  std::string scene = "rack";
+  double onlyNoise = -1;  // every default level
+  bool pointsGiven = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--points" && i + 1 < argc)
-      points = scalespace::bench::countArgument(argv, ++i);
+      points = scalespace::bench::countArgument(argv, ++i), pointsGiven = true;
+    else if (a == "--scene" && i + 1 < argc &&
+             (argv[i + 1] == std::string("rack") || argv[i + 1] == std::string("poles")))
+      scene = argv[++i];
+    else if (a == "--noise" && i + 1 < argc)
+      onlyNoise = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--seed" && i + 1 < argc)
       seed = scalespace::bench::countArgument(argv, ++i);
     else if (a == "--no-peers")
@@ -399,7 +416,8 @@ static int run(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench_cylinders [--points N] [--no-peers] [--clean-only] [--noisy-only] "
+          "usage: bench_cylinders [--scene rack|poles] [--points N] [--noise F] [--no-peers] "
+          "[--clean-only] [--noisy-only] "
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
           "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] "
@@ -410,15 +428,22 @@ static int run(int argc, char** argv) {
       return 2;
     }
   }
-  std::printf("bench_cylinders: pipe rack, %zu points, seed %llu\n", points,
+  const PipeLayout layout = scene == "poles" ? PipeLayout::Poles : PipeLayout::Rack;
+  if (layout == PipeLayout::Poles && !pointsGiven) points = 216000;
+  const std::vector<PipeTruth> truth = pipeSceneTruth(layout);
+  std::printf("bench_cylinders: %s, %zu points, seed %llu\n",
+              layout == PipeLayout::Poles ? "poles" : "pipe rack", points,
               (unsigned long long)seed);
+  std::vector<double> noises{0.0, 1e-3};
+  if (onlyNoise >= 0) noises = {onlyNoise};
   std::map<std::string, std::vector<Score>> totals;
   for (const bool oneSided : {false, true})
-    for (const double noise : {0.0, 1e-3}) {
+    for (const double noise : noises) {
       if ((cleanOnly && noise > 0) || (noisyOnly && noise == 0) ||
           (!only.empty() && only != (oneSided ? "one-sided" : "full")))
         continue;
       PipeSceneOptions options;
+      options.layout = layout;
       options.pointCount = points;
       options.noise = noise;
       options.oneSided = oneSided;
@@ -428,31 +453,44 @@ static int run(int argc, char** argv) {
                   oneSided ? "one-sided" : "full", noise, cloud.size());
       if (estimate) {
         const Vec3 scanner = cloud.viewpoint().value_or(Vec3::Zero()) - cloud.origin();
-        estimateSceneNormals(cloud, cloud.viewpoint() ? &scanner : nullptr, normalK, pcaNormals);
+        estimateSceneNormals(cloud, truth, cloud.viewpoint() ? &scanner : nullptr, normalK,
+                             pcaNormals);
       }
       std::vector<Method> methods{runOurs(cloud, ours)};
       if (peers) {
-        // Mean spacing of an area-uniform sample: sqrt(area / n), the scene's area ~52 m^2.
-        const double spacing = std::sqrt(52.0 / double(cloud.size()));
+        // Mean spacing of an area-uniform sample: sqrt(area / n), the scene's area ~52 m^2 (the
+        // rack), ~77 m^2 (the poles).
+        const double area = layout == PipeLayout::Poles ? 77.0 : 52.0;
+        const double spacing = std::sqrt(area / double(cloud.size()));
         methods.push_back(runRansac(cloud, false, spacing));
         methods.push_back(runRansac(cloud, true, spacing));
       }
       for (const Method& m : methods) {
         std::printf("  %s (%.2f s)\n", m.name.c_str(), m.seconds);
-        const Score s = score(m, cloud, true);
+        const Score s = score(m, cloud, truth, true);
+        std::printf("    => pipes found %d/%zu, ", s.found, truth.size());
+        if (layout == PipeLayout::Rack)
+          std::printf("strands %d/3, cable whole %s, ", s.strandsFound,
+                      s.cableWhole ? "yes" : "no");
         std::printf(
-            "    => pipes found %d/6, strands %d/3, cable whole %s, worst straight radius "
-            "error %.2f%%, axis %.2f deg, false cylinders on planes %d\n",
-            s.found, s.strandsFound, s.cableWhole ? "yes" : "no", s.worstRadiusError, s.worstAngle,
-            s.falseCylinders);
+            "worst straight radius error %.2f%%, axis %.2f deg, false cylinders on planes %d",
+            s.worstRadiusError, s.worstAngle, s.falseCylinders);
+        if (s.falsePersistence >= 0) std::printf(" (most persistent %d)", s.falsePersistence);
+        std::printf("\n");
         totals[m.name].push_back(s);
       }
     }
-  std::printf("\nsummary (per scene: pipes found /6, strands /3, false cylinders)\n");
+  if (layout == PipeLayout::Rack)
+    std::printf("\nsummary (per scene: pipes found /6, strands /3, false cylinders)\n");
+  else
+    std::printf("\nsummary (per scene: poles found /4, false cylinders)\n");
   for (const auto& [name, scores] : totals) {
     std::printf("  %-16s", name.c_str());
-    for (const Score& s : scores)
-      std::printf("  %d/6 %d/3 %d", s.found, s.strandsFound, s.falseCylinders);
+    for (const Score& s : scores) {
+      std::printf("  %d/%zu", s.found, truth.size());
+      if (layout == PipeLayout::Rack) std::printf(" %d/3", s.strandsFound);
+      std::printf(" %d", s.falseCylinders);
+    }
     std::printf("\n");
   }
   return 0;

@@ -189,9 +189,46 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   EXPECT_NE(r.err.find("8 points"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("read as its 8 vertices: --sample N"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("o5")));
-  // --one-sided belongs to the pipes scene.
+  // --one-sided belongs to the pipes and poles scenes.
   r = run("generate box --one-sided -q -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);
+}
+
+// The poles of `generate poles` from positions alone under noise: each pole one component of its
+// radius, and the box standing on the floor, whose edges a coarse scale rounds, no persistent one.
+TEST_F(Cli, CylindersFindThePolesWithoutNormalsAndNotTheBox) {
+  ASSERT_EQ(run("generate poles -n 120000 --noise 5e-4 --seed 3 -q -o " + path("p.ply")).code, 0);
+  PointCloud bare = readCloud(path("p.ply"));
+  bare.setNormals({});
+  writeCloud(bare, path("bare.ply"));
+  auto r = run("cylinders " + path("bare.ply") + " -q -o " + path("out"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json result = readJson(path("out/components.json"));
+  const PointCloud cloud = readCloud(path("out/cloud.ply"));
+  const auto& id = cloud.findAttribute("cylinder_id")->values;
+  const auto& gt = cloud.findAttribute("gt_pipe")->values;
+  std::map<int, std::map<int, std::size_t>>
+      votes;  // component -> gt pole (-1: box, floor) -> points
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (id[i] >= 0) ++votes[int(id[i])][int(gt[i])];
+  std::map<int, int> found;  // gt pole -> component holding most of it
+  for (const auto& [component, counts] : votes) {
+    const auto holder = std::max_element(counts.begin(), counts.end(),
+                                         [](auto& a, auto& b) { return a.second < b.second; });
+    const int persistence = result["components"][std::size_t(component)]["persistence"];
+    if (holder->first < 0)
+      EXPECT_LT(persistence, 2) << "component " << component << " on the box or floor";
+    else
+      found[holder->first] = component;
+  }
+  for (const PipeTruth& pole : pipeSceneTruth(PipeLayout::Poles)) {
+    SCOPED_TRACE(pole.name);
+    ASSERT_EQ(found.count(pole.id), 1u);
+    const nlohmann::json& component = result["components"][std::size_t(found[pole.id])];
+    EXPECT_NEAR(component["radius"].get<double>(), pole.radius, 0.02 * pole.radius);
+    EXPECT_TRUE(component["straight"].get<bool>());
+    EXPECT_GE(component["persistence"].get<int>(), 1);
+  }
 }
 
 // A cloud without normals gets cylinderNormalOptions(): sheet normals with the PCA normals' signs,

@@ -107,11 +107,12 @@ void addGenerateCommand(CLI::App& app) {
       "generate",
       "sample an analytic surface (exact normals and curvatures as columns) or a "
       "piecewise-planar scene (Table 2.1's, or house / yard in metres; face labels as gt_face, "
-      "house / yard also group labels as gt_group), or the pipe rack of the cylinders (pipe labels "
-      "as gt_pipe, elbow parts and cable strands as gt_part)");
+      "house / yard also group labels as gt_group), or the pipe rack or the poles of the cylinders "
+      "(pipe labels as gt_pipe, elbow parts and cable strands as gt_part)");
   static const char* const kShapes =
       "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | house | yard "
-      "| pipes | bumpy-disk | hemisphere | relief | holed-sheet | partial-sphere | triaxial | blob "
+      "| pipes | poles | bumpy-disk | hemisphere | relief | holed-sheet | partial-sphere | "
+      "triaxial | blob "
       "| rounded-cube | tube | ring";
   cmd->add_option("shape", args->shape, std::string(kShapes) + " (the shapes of `parametrize`)")
       ->required();
@@ -124,7 +125,7 @@ void addGenerateCommand(CLI::App& app) {
                   "analytic shapes: normal rotation noise sigma in degrees (Sec. 1.4.3)");
   cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
   cmd->add_flag("--one-sided", args->oneSided,
-                "pipes: keep what a scanner above the rack sees (each pipe a half-pipe)");
+                "pipes, poles: keep what a scanner above the scene sees (each pipe a half-pipe)");
   cmd->add_option("-o,--output", args->output,
                   "output cloud (.ply .xyz .pcd .las; .pwn: positions and normals only)")
       ->required();
@@ -139,11 +140,13 @@ void addGenerateCommand(CLI::App& app) {
                         std::to_string(args->options.pointCount));
     if (!(args->options.noise >= 0)) throw OptionError("--noise must be >= 0");
     checkOutput(args->output, OutputKind::PointsWithNormals, {});
-    if (args->oneSided && args->shape != "pipes")
-      throw OptionError("--one-sided applies to the pipes scene only");
+    const bool pipeScene = args->shape == "pipes" || args->shape == "poles";
+    if (args->oneSided && !pipeScene)
+      throw OptionError("--one-sided applies to the pipes and poles scenes only");
     PointCloud cloud;
-    if (args->shape == "pipes") {
+    if (pipeScene) {
       PipeSceneOptions o;
+      o.layout = args->shape == "poles" ? PipeLayout::Poles : PipeLayout::Rack;
       o.pointCount = args->options.pointCount;
       o.noise = args->options.noise;
       o.seed = args->options.seed;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
 
@@ -23,6 +24,7 @@ const Vec3 kBoxLo{1.2, 1.1, 0.0}, kBoxHi{2.0, 1.7, 0.5};
 // A parametric surface patch over (u, v) in [0, 1]^2: position and unit outward normal.
 struct Patch {
   int pipe = -1, part = -1;
+  bool floor = false;  // points under what stands on it are not sampled
   std::function<void(double, double, Vec3&, Vec3&)> eval;
   double area = 0, maxJacobian = 0;
 };
@@ -150,18 +152,24 @@ bool hiddenByOtherStrands(const Vec3& start, int k, const Vec3& p, const Vec3& n
 
 const Vec3 kCableStart{-2.0, -0.9, 0.6};
 
-std::vector<Patch> scenePatches() {
+// The five faces of a box standing on the floor (lo.z() = 0: its bottom is not seen).
+void addStandingBox(std::vector<Patch>& patches, const Vec3& lo, const Vec3& hi) {
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ(), size = hi - lo;
+  patches.push_back(rectangle({lo.x(), lo.y(), hi.z()}, size.x() * x, size.y() * y, z));
+  patches.push_back(rectangle(lo, size.x() * x, size.z() * z, -y));
+  patches.push_back(rectangle({lo.x(), hi.y(), 0}, size.x() * x, size.z() * z, y));
+  patches.push_back(rectangle(lo, size.y() * y, size.z() * z, -x));
+  patches.push_back(rectangle({hi.x(), lo.y(), 0}, size.y() * y, size.z() * z, x));
+}
+
+std::vector<Patch> rackPatches() {
   std::vector<Patch> patches;
   const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
   // Not cylinders: floor, wall, box (its bottom lies on the floor).
   patches.push_back(rectangle({-2.5, -2.2, 0}, 5 * x, 4.2 * y, z));
+  patches.back().floor = true;
   patches.push_back(rectangle({-2.5, 2.0, 0}, 5 * x, 1.8 * z, -y));
-  const Vec3 size = kBoxHi - kBoxLo;
-  patches.push_back(rectangle({kBoxLo.x(), kBoxLo.y(), kBoxHi.z()}, size.x() * x, size.y() * y, z));
-  patches.push_back(rectangle(kBoxLo, size.x() * x, size.z() * z, -y));
-  patches.push_back(rectangle({kBoxLo.x(), kBoxHi.y(), 0}, size.x() * x, size.z() * z, y));
-  patches.push_back(rectangle(kBoxLo, size.y() * y, size.z() * z, -x));
-  patches.push_back(rectangle({kBoxHi.x(), kBoxLo.y(), 0}, size.y() * y, size.z() * z, x));
+  addStandingBox(patches, kBoxLo, kBoxHi);
   // Straight pipes.
   patches.push_back(tube(0, -1, {-2, -1.75, 0.4}, x, 4, kThinRadius, kThinRadius));
   patches.push_back(tube(1, -1, {-2, -1.3, 0.5}, x, 4, kMediumRadius, kMediumRadius));
@@ -185,13 +193,102 @@ std::vector<Patch> scenePatches() {
   patches.push_back(tube(4, -1, {0.6, 0.8, 0.45}, x, 1.7, kTaperStart, kTaperEnd));
   // Cable.
   for (int k = 0; k < 3; ++k) patches.push_back(strand(5, k, kCableStart, 4));
+  return patches;
+}
+
+// The poles layout: vertical poles standing on a floor, the box taller than the thin poles are
+// wide, so that a scale rounds its edges into tubes. Azimuths are measured from +x towards +y.
+struct Pole {
+  Vec3 foot;
+  double radius, height;
+  double seenFrom, seenArc;  // the azimuths a scan has: seenArc radians from seenFrom
+};
+// The half pole is seen over the 4 rad centred on the south (-y), where the one-sided scan's
+// tripod stands.
+constexpr double kHalfArc = 4.0, kHalfFrom = 1.5 * kPi - kHalfArc / 2;
+const Pole kPoles[] = {{{-2.0, -2.0, 0}, 0.05, 2.0, 0, 2 * kPi},
+                       {{0.0, 1.5, 0}, 0.2, 3.0, 0, 2 * kPi},
+                       {{2.0, -1.0, 0}, 0.5, 2.5, kHalfFrom, kHalfArc},
+                       {{-2.5, 2.5, 0}, 0.12, 1.5, 0, 2 * kPi}};
+const Vec3 kRackScanner{1.3, -2.2, 4.8}, kPoleScanner{0, -5, 1.6};
+const Vec3 kPoleBoxLo{1.0, 2.2, 0.0}, kPoleBoxHi{2.0, 2.8, 0.8};
+constexpr double kPoleFloorHalf = 4.0;
+// The band every pole lacks (a scanner's shadow): heights and azimuths.
+constexpr double kBandLow = 0.8, kBandHigh = 1.0, kBandArc = 2.0;
+
+double azimuthAbout(const Vec3& p, const Vec3& foot) {
+  const double a = std::atan2(p.y() - foot.y(), p.x() - foot.x());
+  return a < 0 ? a + 2 * kPi : a;
+}
+
+std::vector<Patch> polePatches() {
+  std::vector<Patch> patches;
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  patches.push_back(rectangle({-kPoleFloorHalf, -kPoleFloorHalf, 0}, 2 * kPoleFloorHalf * x,
+                              2 * kPoleFloorHalf * y, z));
+  patches.back().floor = true;
+  addStandingBox(patches, kPoleBoxLo, kPoleBoxHi);
+  for (int i = 0; i < 4; ++i) {
+    const Pole& pole = kPoles[i];
+    patches.push_back(tube(i, -1, pole.foot, z, pole.height, pole.radius, pole.radius));
+  }
+  return patches;
+}
+
+// What a scan of the layout does not have, at a point of `patch` (outward `normal`): the floor
+// under the box (and, for the poles, inside them), the cable's points that its other strands
+// hide, the poles' band and unseen side.
+bool missing(PipeLayout layout, const Patch& patch, const Vec3& p, const Vec3& normal,
+             const Vec3* scanner) {
+  auto inBox = [&](const Vec3& lo, const Vec3& hi) {
+    return p.x() > lo.x() && p.x() < hi.x() && p.y() > lo.y() && p.y() < hi.y();
+  };
+  if (layout == PipeLayout::Rack) {
+    if (patch.floor) return inBox(kBoxLo, kBoxHi);
+    return patch.pipe == 5 && (insideOtherStrand(kCableStart, patch.part, p) ||
+                               hiddenByOtherStrands(kCableStart, patch.part, p, normal, scanner));
+  }
+  if (patch.floor) {
+    if (inBox(kPoleBoxLo, kPoleBoxHi)) return true;
+    for (const Pole& pole : kPoles)
+      if (std::hypot(p.x() - pole.foot.x(), p.y() - pole.foot.y()) < pole.radius) return true;
+    return false;
+  }
+  if (patch.pipe < 0) return false;
+  const Pole& pole = kPoles[patch.pipe];
+  const double azimuth = azimuthAbout(p, pole.foot);
+  double fromSeen = azimuth - pole.seenFrom;
+  if (fromSeen < 0) fromSeen += 2 * kPi;
+  return fromSeen > pole.seenArc || (p.z() > kBandLow && p.z() < kBandHigh && azimuth < kBandArc);
+}
+
+std::vector<Patch> scenePatches(PipeLayout layout) {
+  std::vector<Patch> patches = layout == PipeLayout::Rack ? rackPatches() : polePatches();
   for (Patch& patch : patches) measure(patch);
   return patches;
 }
 
 }  // namespace
 
-std::vector<PipeTruth> pipeSceneTruth() {
+std::vector<PipeTruth> pipeSceneTruth(PipeLayout layout) {
+  if (layout == PipeLayout::Poles) {
+    std::vector<PipeTruth> truth;
+    for (int i = 0; i < 4; ++i) {
+      const Pole& pole = kPoles[i];
+      PipeTruth t;
+      t.id = i;
+      char name[32];
+      std::snprintf(name, sizeof name, "%spole r %.2g", pole.seenArc < 2 * kPi ? "half " : "",
+                    pole.radius);
+      t.name = name;
+      t.radius = t.radiusEnd = pole.radius;
+      t.axisPoint = pole.foot;
+      t.axisDirection = Vec3::UnitZ();
+      t.length = pole.height;
+      truth.push_back(t);
+    }
+    return truth;
+  }
   std::vector<PipeTruth> truth(6);
   auto straight = [](int id, const char* name, double r, const Vec3& a) {
     PipeTruth t;
@@ -228,7 +325,9 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
   if (options.pointCount == 0) throw OptionError("pointCount must be >= 1");
   if (!(options.noise >= 0) || !std::isfinite(options.noise))
     throw OptionError("noise must be finite and >= 0");
-  const std::vector<Patch> patches = scenePatches();
+  const std::vector<Patch> patches = scenePatches(options.layout);
+  const Vec3 scanner = options.oneSidedScanner.value_or(
+      options.layout == PipeLayout::Rack ? kRackScanner : kPoleScanner);
   std::vector<double> cumulative;
   double total = 0;
   for (const Patch& patch : patches) cumulative.push_back(total += patch.area);
@@ -248,15 +347,8 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
     if (uniform(rng) * patch.maxJacobian > jacobian(patch, u, v)) continue;
     Vec3 p, normal;
     patch.eval(u, v, p, normal);
-    if (options.oneSided && normal.dot(options.oneSidedScanner - p) <= 0) continue;
-    if (k == 0 && p.x() > kBoxLo.x() && p.x() < kBoxHi.x() && p.y() > kBoxLo.y() &&
-        p.y() < kBoxHi.y())
-      continue;  // floor under the box
-    if (patch.pipe == 5 &&
-        (insideOtherStrand(kCableStart, patch.part, p) ||
-         hiddenByOtherStrands(kCableStart, patch.part, p, normal,
-                              options.oneSided ? &options.oneSidedScanner : nullptr)))
-      continue;
+    if (options.oneSided && normal.dot(scanner - p) <= 0) continue;
+    if (missing(options.layout, patch, p, normal, options.oneSided ? &scanner : nullptr)) continue;
     positions[i] = p;
     normals[i] = normal;
     pipe[i] = patch.pipe;
@@ -277,7 +369,7 @@ PointCloud generatePipeScene(const PipeSceneOptions& options) {
   cloud.setNormals(std::move(normals));
   cloud.addAttribute("gt_pipe", ScalarType::Int32).values = std::move(pipe);
   cloud.addAttribute("gt_part", ScalarType::Int32).values = std::move(part);
-  if (options.oneSided) cloud.setViewpoint(options.oneSidedScanner);
+  if (options.oneSided) cloud.setViewpoint(scanner);
   return cloud;
 }
 

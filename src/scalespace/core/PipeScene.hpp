@@ -12,6 +12,7 @@
 // for the bent pipe 0 / 1 / 2 = first straight / elbow / second straight, for the cable the strand
 // 0..2, else -1).
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,17 +20,27 @@
 
 namespace scalespace {
 
+/// Rack: the pipe rack above. Poles: four vertical poles standing on an 8 x 8 m floor (radius
+/// 0.05, 0.2, 0.5 and 0.12 m, 1.5-3 m tall; the 0.5 m one seen over 4 rad of azimuth only, its
+/// south side, a half pole; each lacking a band 0.8-1 m high over 2 rad, a scanner's shadow) and a
+/// box 1 x 0.6 x 0.8 m, whose edges a coarse scale rounds into tubes that must not be taken for
+/// cylinders.
+enum class PipeLayout { Rack, Poles };
+
 struct PipeSceneOptions {
+  PipeLayout layout = PipeLayout::Rack;
   std::size_t pointCount = 200000;
   /// Standard deviation of the isotropic Gaussian positional noise as a fraction of the
-  /// bounding-box diagonal (about 6.7 m).
+  /// bounding-box diagonal (about 6.7 m for the rack, 12 m for the poles).
   double noise = 0.0;
   std::uint64_t seed = 1;
-  /// Keep only what a scanner above and in front of the rack sees (normals facing
-  /// oneSidedScanner, which the cloud's viewpoint() holds): every pipe is seen from one side, a
-  /// half-pipe (the other pipes do not hide each other; the cable's strands do).
+  /// Keep only what a scanner sees (normals facing oneSidedScanner, which the cloud's viewpoint()
+  /// holds): every pipe is seen from one side, a half-pipe (the other pipes do not hide each
+  /// other; the cable's strands do).
   bool oneSided = false;
-  Vec3 oneSidedScanner{1.3, -2.2, 4.8};
+  /// Unset: the layout's own, above and in front of the rack (1.3, -2.2, 4.8), or a tripod south
+  /// of the poles' floor (0, -5, 1.6), facing the half pole's seen side.
+  std::optional<Vec3> oneSidedScanner;
 };
 
 enum class PipeKind { Straight, Bent, Tapering, Cable };
@@ -47,7 +58,7 @@ struct PipeTruth {
 };
 
 /// The pipes of the scene, by id.
-std::vector<PipeTruth> pipeSceneTruth();
+std::vector<PipeTruth> pipeSceneTruth(PipeLayout layout = PipeLayout::Rack);
 
 /// Throws OptionError for a zero point count or negative noise.
 PointCloud generatePipeScene(const PipeSceneOptions& options = {});
