@@ -537,3 +537,32 @@ TEST(NormalOrientation, DeterministicAcrossThreadsAndCancellable) {
   std::vector<Vec3> wrongSize(3);
   EXPECT_THROW(orientNormals(points, wrongSize), OptionError);
 }
+
+// A floor (z = 0) and a wall (y = 0, up to 1) joined by a quarter-round fillet of radius 0.1: one
+// surface, whose consistent orientations are floor up with wall facing -y, or both the other way.
+// The highest points are the wall's rim, whose flat normals say nothing of up; given facing +y,
+// Hoppe's seed rule kept them and turned the floor down. What is seen from above decides instead.
+TEST(NormalOrientation, AWallsRimDoesNotTurnTheFloorItStandsOnDown) {
+  const double r = 0.1, step = 0.02;
+  std::vector<Vec3> points, normals;
+  for (double x = 0; x <= 1.0; x += step) {
+    for (double y = -1.0; y <= -r; y += step)
+      points.emplace_back(x, y, 0), normals.emplace_back(0, 0, -1);
+    for (double a = step / r; a < kPi / 2; a += step / r) {  // centre (y, z) = (-r, r)
+      points.emplace_back(x, -r + r * std::sin(a), r - r * std::cos(a));
+      normals.emplace_back(0, -std::sin(a), std::cos(a));
+    }
+    for (double z = r; z <= 1.0 + 1e-9; z += step)
+      points.emplace_back(x, 0, z), normals.emplace_back(0, 1, 0);
+  }
+  NormalOrientationOptions options;
+  options.visibility = false;
+  orientNormals(points, normals, options);
+  std::size_t floorUp = 0, floorCount = 0, wallOut = 0, wallCount = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].z() == 0) ++floorCount, floorUp += normals[i].z() > 0.99;
+    if (points[i].y() == 0) ++wallCount, wallOut += normals[i].y() < -0.99;
+  }
+  EXPECT_EQ(floorUp, floorCount);
+  EXPECT_EQ(wallOut, wallCount);
+}

@@ -516,6 +516,49 @@ void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
   }
 }
 
+// Hoppe's seed, the highest point, faces +z: right where the top of a scene is a surface facing
+// up, a guess where it is the rim of a wall or of a vertical pole, whose normal lies flat (the
+// rack and the poles of `generate pipes|poles` turned over as a whole: 66-100% of the normals
+// facing down and in), or a noisy point. The component's sign is instead what is seen from above:
+// over a 64 x 64 grid of its footprint, the highest point of each column votes with the sign of its
+// normal's z where that normal is within 45 degrees of vertical (a floor, a table top, a roof, the
+// top of a closed object); the majority turns the whole component (the tree's relative signs are
+// kept). Without votes, or on a tie, the seed's sign stays.
+void turnToFaceUp(const std::vector<Index>& component, const std::vector<Vec3>& points,
+                  std::vector<Vec3>& oriented, std::vector<std::uint8_t>& flipped) {
+  constexpr int kColumns = 64;
+  constexpr double kNearVertical = 0.70710678118654752;  // cos 45 degrees
+  double loX = std::numeric_limits<double>::max(), loY = loX, hiX = -loX, hiY = -loX;
+  for (const Index i : component) {
+    loX = std::min(loX, points[i].x()), hiX = std::max(hiX, points[i].x());
+    loY = std::min(loY, points[i].y()), hiY = std::max(hiY, points[i].y());
+  }
+  const double size = std::max(hiX - loX, hiY - loY) / kColumns;
+  if (!(size > 0)) return;
+  auto column = [&](double v, double lo) {
+    return std::min(kColumns - 1, std::max(0, int((v - lo) / size)));
+  };
+  std::vector<Index> top(std::size_t(kColumns) * kColumns, kNone);
+  for (const Index i : component) {
+    Index& t = top[std::size_t(column(points[i].x(), loX)) * kColumns +
+                   std::size_t(column(points[i].y(), loY))];
+    if (t == kNone || points[i].z() > points[t].z() || (points[i].z() == points[t].z() && i < t))
+      t = i;
+  }
+  long vote = 0;
+  for (const Index t : top) {
+    if (t == kNone) continue;
+    const double norm = oriented[t].norm();
+    if (norm > 0 && std::abs(oriented[t].z()) >= kNearVertical * norm)
+      vote += oriented[t].z() > 0 ? 1 : -1;
+  }
+  if (vote >= 0) return;
+  for (const Index i : component) {
+    oriented[i] = -oriented[i];
+    flipped[i] ^= 1;
+  }
+}
+
 void checkCancel(const ProgressCallback& progress, double fraction, const char* stage) {
   if (progress && !progress(fraction, stage)) throw Cancelled();
 }
@@ -652,7 +695,8 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   std::vector<Edge>().swap(edges);
   checkCancel(progress, 0.5, "orientation tree");
 
-  // 3. Tree adjacency (CSR) and one seed per component: the highest point (largest z).
+  // 3. Tree adjacency (CSR) and one seed per component: the highest point (largest z), where the
+  //    propagation starts; the component's sign is then turnToFaceUp's.
   std::vector<std::size_t> start(n + 1, 0);
   for (std::size_t e = 0; e < treeA.size(); ++e) {
     ++start[treeA[e] + 1];
@@ -711,6 +755,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
         queue.push_back(c);
       }
     }
+    turnToFaceUp(queue, points, oriented, flipped);
     treeOrder.insert(treeOrder.end(), queue.begin(), queue.end());
   }
   checkCancel(progress, 1.0, "orientation tree");

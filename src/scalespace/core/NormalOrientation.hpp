@@ -9,7 +9,11 @@
 // connected component the seed is the point with the largest z (ties: smaller index), whose normal
 // is oriented towards +z (the top of a scanned scene or of a closed object faces up and out); the
 // orientation is then propagated from the seed along the tree, flipping a child when
-// n_child . n_parent < 0.
+// n_child . n_parent < 0. Not in Hoppe's paper: the component is then turned as a whole so that
+// what is seen from above faces up: the highest point of each column of a 64 x 64 grid over its
+// footprint votes with its normal's z where that normal is within 45 degrees of vertical (the
+// highest point alone may be the rim of a wall or a pole, whose flat normal says nothing, or a
+// noisy point).
 //
 // Reliability (result.reliable[i] == 0) is documented per method:
 //  - both: the input normal was flagged invalid (`valid` argument) or is not a finite non-zero
