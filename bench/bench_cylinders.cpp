@@ -35,10 +35,9 @@
 //     poles): the best IoU with one detected set
 //     (ours: a component's points at one scale, any scale; RANSAC: one cylinder's points); found
 //     when >= 0.8;
-//   - the rack's cable read both ways: each strand found (IoU >= 0.8; seen from one side, a strand
-//   is
-//     the runs along the cable where the others do not hide it, each to be found) and the whole
-//     cable found;
+//   - the rack's cable read both ways: each strand found (IoU >= 0.8; seen from one side, a
+//     strand is the runs along the cable where the others do not hide it, each to be found) and
+//     the whole cable found;
 //   - on the straight pipes, the radius error (%) and axis angle (degrees) of the best match;
 //   - false cylinders: detected sets whose points lie mostly (> 50%) on the floor, wall and box
 //     (their persistence, ours, where a component holds the set).

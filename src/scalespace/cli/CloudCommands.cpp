@@ -111,9 +111,8 @@ void addGenerateCommand(CLI::App& app) {
       "(pipe labels as gt_pipe, elbow parts and cable strands as gt_part)");
   static const char* const kShapes =
       "sphere | cylinder | saddle | torus | ellipsoid | tri | stairs | cubes | box | house | yard "
-      "| pipes | poles | bumpy-disk | hemisphere | relief | holed-sheet | partial-sphere | "
-      "triaxial | blob "
-      "| rounded-cube | tube | ring";
+      "| pipes | poles | bumpy-disk | hemisphere | relief | holed-sheet | partial-sphere "
+      "| triaxial | blob | rounded-cube | tube | ring";
   cmd->add_option("shape", args->shape, std::string(kShapes) + " (the shapes of `parametrize`)")
       ->required();
   cmd->add_option("-n,--points", args->options.pointCount, "number of points")
@@ -125,7 +124,8 @@ void addGenerateCommand(CLI::App& app) {
                   "analytic shapes: normal rotation noise sigma in degrees (Sec. 1.4.3)");
   cmd->add_option("--seed", args->options.seed, "random seed")->capture_default_str();
   cmd->add_flag("--one-sided", args->oneSided,
-                "pipes, poles: keep what a scanner above the scene sees (each pipe a half-pipe)");
+                "pipes, poles: keep what one scanner sees, above the rack or on a tripod south of "
+                "the poles (each pipe a half-pipe)");
   cmd->add_option("-o,--output", args->output,
                   "output cloud (.ply .xyz .pcd .las; .pwn: positions and normals only)")
       ->required();

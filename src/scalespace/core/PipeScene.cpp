@@ -196,8 +196,8 @@ std::vector<Patch> rackPatches() {
   return patches;
 }
 
-// The poles layout: vertical poles standing on a floor, the box taller than the thin poles are
-// wide, so that a scale rounds its edges into tubes. Azimuths are measured from +x towards +y.
+// The poles layout: vertical poles of radius 0.05-0.5 m standing on a floor beside a box, whose
+// edges a coarse scale rounds into tubes. Azimuths are measured from +x towards +y.
 struct Pole {
   Vec3 foot;
   double radius, height;
