@@ -523,13 +523,21 @@ void turnPiecesToFace(const std::vector<Vec3>& points, const Vec3& viewpoint,
 // over a 64 x 64 grid of its footprint, the highest point of each column votes with the sign of its
 // normal's z where that normal is within 45 degrees of vertical (a floor, a table top, a roof, the
 // top of a closed object); the majority turns the whole component (the tree's relative signs are
-// kept). Without votes, or on a tie, the seed's sign stays.
-void turnToFaceUp(const std::vector<Index>& component, const std::vector<Vec3>& points,
-                  std::vector<Vec3>& oriented, std::vector<std::uint8_t>& flipped) {
+// kept). Without votes, or on a tie, the seed's sign stays. Not on a component a viewpoint
+// decided (faceViewpoint): a scan's line of sight is better evidence, and a scan in its sensor's
+// frame need not have z up (the table scan of python3-pcl: the vote changed only its grazing
+// pieces, 6.45% of its normals, 44.8% of them facing the scanner before and 55.2% after).
+// `component`: the points order[begin, end).
+void turnToFaceUp(const std::vector<Index>& order, std::size_t begin, std::size_t end,
+                  const std::vector<Vec3>& points, std::vector<Vec3>& oriented,
+                  std::vector<std::uint8_t>& flipped) {
+  const auto first = order.begin() + std::ptrdiff_t(begin),
+             last = order.begin() + std::ptrdiff_t(end);
   constexpr int kColumns = 64;
   constexpr double kNearVertical = 0.70710678118654752;  // cos 45 degrees
   double loX = std::numeric_limits<double>::max(), loY = loX, hiX = -loX, hiY = -loX;
-  for (const Index i : component) {
+  for (auto it = first; it != last; ++it) {
+    const Index i = *it;
     loX = std::min(loX, points[i].x()), hiX = std::max(hiX, points[i].x());
     loY = std::min(loY, points[i].y()), hiY = std::max(hiY, points[i].y());
   }
@@ -539,7 +547,8 @@ void turnToFaceUp(const std::vector<Index>& component, const std::vector<Vec3>& 
     return std::min(kColumns - 1, std::max(0, int((v - lo) / size)));
   };
   std::vector<Index> top(std::size_t(kColumns) * kColumns, kNone);
-  for (const Index i : component) {
+  for (auto it = first; it != last; ++it) {
+    const Index i = *it;
     Index& t = top[std::size_t(column(points[i].x(), loX)) * kColumns +
                    std::size_t(column(points[i].y(), loY))];
     if (t == kNone || points[i].z() > points[t].z() || (points[i].z() == points[t].z() && i < t))
@@ -553,7 +562,8 @@ void turnToFaceUp(const std::vector<Index>& component, const std::vector<Vec3>& 
       vote += oriented[t].z() > 0 ? 1 : -1;
   }
   if (vote >= 0) return;
-  for (const Index i : component) {
+  for (auto it = first; it != last; ++it) {
+    const Index i = *it;
     oriented[i] = -oriented[i];
     flipped[i] ^= 1;
   }
@@ -696,7 +706,7 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   checkCancel(progress, 0.5, "orientation tree");
 
   // 3. Tree adjacency (CSR) and one seed per component: the highest point (largest z), where the
-  //    propagation starts; the component's sign is then turnToFaceUp's.
+  //    propagation starts; the component's sign is then the viewpoint's or turnToFaceUp's.
   std::vector<std::size_t> start(n + 1, 0);
   for (std::size_t e = 0; e < treeA.size(); ++e) {
     ++start[treeA[e] + 1];
@@ -755,7 +765,6 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
         queue.push_back(c);
       }
     }
-    turnToFaceUp(queue, points, oriented, flipped);
     treeOrder.insert(treeOrder.end(), queue.begin(), queue.end());
   }
   checkCancel(progress, 1.0, "orientation tree");
@@ -767,6 +776,13 @@ NormalOrientationResult orientByMst(const std::vector<Vec3>& points, std::vector
   if (options.faceViewpoint)
     turnPiecesToFace(points, options.viewpoint, inGraph, sets, piece, pieces, oriented, flipped,
                      settled);
+  // Where no viewpoint decided, what is seen from above does (each component is a run of
+  // treeOrder starting at its seed, the one point without a parent).
+  for (std::size_t begin = 0, end = 0; begin < treeOrder.size(); begin = end) {
+    end = begin + 1;
+    while (end < treeOrder.size() && parent[treeOrder[end]] != kNone) ++end;
+    if (!settled[treeOrder[begin]]) turnToFaceUp(treeOrder, begin, end, points, oriented, flipped);
+  }
 
   if (options.visibility)
     correctByVisibility(points, oriented, index, inGraph, settled, kthDistance, parent, treeOrder,

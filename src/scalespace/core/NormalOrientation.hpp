@@ -13,7 +13,7 @@
 // what is seen from above faces up: the highest point of each column of a 64 x 64 grid over its
 // footprint votes with its normal's z where that normal is within 45 degrees of vertical (the
 // highest point alone may be the rim of a wall or a pole, whose flat normal says nothing, or a
-// noisy point).
+// noisy point); not where a viewpoint decides (faceViewpoint).
 //
 // Reliability (result.reliable[i] == 0) is documented per method:
 //  - both: the input normal was flagged invalid (`valid` argument) or is not a finite non-zero

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iterator>
 #include <random>
 
 #include "scalespace/core/Error.hpp"
@@ -228,7 +229,7 @@ std::vector<Patch> polePatches() {
                               2 * kPoleFloorHalf * y, z));
   patches.back().floor = true;
   addStandingBox(patches, kPoleBoxLo, kPoleBoxHi);
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < int(std::size(kPoles)); ++i) {
     const Pole& pole = kPoles[i];
     patches.push_back(tube(i, -1, pole.foot, z, pole.height, pole.radius, pole.radius));
   }
@@ -273,7 +274,7 @@ std::vector<Patch> scenePatches(PipeLayout layout) {
 std::vector<PipeTruth> pipeSceneTruth(PipeLayout layout) {
   if (layout == PipeLayout::Poles) {
     std::vector<PipeTruth> truth;
-    for (int i = 0; i < 4; ++i) {
+    for (int i = 0; i < int(std::size(kPoles)); ++i) {
       const Pole& pole = kPoles[i];
       PipeTruth t;
       t.id = i;
