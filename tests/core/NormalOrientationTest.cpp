@@ -35,13 +35,14 @@ std::vector<Vec3> noisyTerrain(std::size_t n, std::uint64_t seed) {
 }
 
 // A closed plate 1 x 0.5 x 0.02 at `corner`, `count` points on its six faces by area with
-// Gaussian noise 0.0014, and their outward normals.
+// Gaussian noise `sigma`, and their outward normals.
 void addNoisyClosedPlate(const Vec3& corner, int count, std::uint64_t seed,
-                         std::vector<Vec3>& points, std::vector<Vec3>& truth) {
+                         std::vector<Vec3>& points, std::vector<Vec3>& truth,
+                         double sigma = 0.0014) {
   const Vec3 size(1.0, 0.5, 0.02);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::normal_distribution<double> noise(0.0, 0.0014);
+  std::normal_distribution<double> noise(0.0, sigma);
   const double area = 2 * (size.x() * size.y() + size.y() * size.z() + size.x() * size.z());
   for (int axis = 0; axis < 3; ++axis) {
     const double faceArea = size.prod() / size(axis);
@@ -565,4 +566,30 @@ TEST(NormalOrientation, AWallsRimDoesNotTurnTheFloorItStandsOnDown) {
   }
   EXPECT_EQ(floorUp, floorCount);
   EXPECT_EQ(wallOut, wallCount);
+}
+
+// A rack of three clean closed plates over a clean ground hides 38% of it from the sky (more with
+// the tilted rays' shadow): there the ground's rays escape only below it, which also reads as the
+// inside of a closed surface, and a quarter of a piece voting so turned the whole ground over. Most
+// of the ground sees out on both sides, which no inside does: those points now outweigh the votes
+// against (the pipe rack of `generate pipes` without normals: 61% of the normals against the exact
+// ones, the floor and the wall turned down; 0.3% with this).
+TEST(NormalOrientation, AGroundHalfHiddenByARackStaysUp) {
+  std::mt19937_64 rng(61);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> points, truth;
+  for (int i = 0; i < 40000; ++i) {
+    points.push_back(Vec3(-0.5 + 2 * u(rng), -0.75 + 2 * u(rng), 0));
+    truth.push_back(Vec3::UnitZ());
+  }
+  for (int plate = 0; plate < 3; ++plate)
+    addNoisyClosedPlate(Vec3(0, -0.6 + 0.6 * plate, 0.3), 20000, 70 + plate, points, truth, 0);
+  const auto estimate = estimateNormals(points);
+  const OrientedOn one = orientOn(1, points, estimate), two = orientOn(2, points, estimate);
+  std::size_t platesOut = 0, groundUp = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    (i < 40000 ? groundUp : platesOut) += one.normals[i].dot(truth[i]) > 0 ? 1 : 0;
+  EXPECT_GT(double(groundUp) / 40000.0, 0.99);
+  EXPECT_GT(double(platesOut) / double(points.size() - 40000), 0.98);
+  EXPECT_EQ(one.normals, two.normals);
 }

@@ -27,9 +27,11 @@
 //    both normals), and each piece is flipped when rays cast from its points (core/OccupancyGrid)
 //    leave the cloud on the side its normals point away from and are stopped on the other: the
 //    inside of a closed surface, unless the graph edges that join it to the rest along one
-//    surface agree with its sign (each counts as two of the rays' votes). Where both sides are open
-//    (a single scan of a scene, an open sheet) or both closed (the inside of a room), the rays have
-//    no say and the tree's sign stays. On a closed surface (a component of the graph where at most
+//    surface agree with its sign (each counts as two of the rays' votes), or, on an open surface,
+//    unless as many of its points see out on both sides as say it faces in (a floor a third
+//    hidden by a pipe rack above it). Where both sides are open (a single scan of a scene, an
+//    open sheet) or both closed (the inside of a room), the rays have no say and the tree's sign
+//    stays. On a closed surface (a component of the graph where at most
 //    5% of the points that cast rays see out on both sides: a CAD part, an object scanned all
 //    round, a pipe floating above an open floor) the rays are trusted more: offsets along the
 //    normals within the noise do not cut the tree, a piece whose rays disagree is split where they
