@@ -20,6 +20,9 @@
 //                   tree, as `cylinders` did before 2026-11-30)
 //                   [--normal-k K] (with --estimate-normals: K neighbours, fixed; default: 10,
 //                   doubled under heavy noise as the CLI does, NormalEstimationOptions::maxK)
+//                   [--min-line-length F] [--max-line-curvature F] [--max-line-variation F]
+//                   (ours: LineFilterOptions::minLengthFactor, maxCurvatureFactor,
+//                   maxMeanVariation)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
 //                   [--max-section-shape S] (ours: TubeFitOptions::maxSectionShapeShare; 1: off)
 //                   [--max-face-sectors N] (ours: TubeFitOptions::maxFaceSectors; 36: off)
@@ -402,6 +405,12 @@ static int run(int argc, char** argv) {
       estimate = true;
     else if (a == "--pca-normals")
       pcaNormals = true;
+    else if (a == "--max-line-variation" && i + 1 < argc)
+      ours.filter.maxMeanVariation = scalespace::bench::numberArgument(argv, ++i);
+    else if (a == "--max-line-curvature" && i + 1 < argc)
+      ours.filter.maxCurvatureFactor = scalespace::bench::numberArgument(argv, ++i);
+    else if (a == "--min-line-length" && i + 1 < argc)
+      ours.filter.minLengthFactor = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--min-arc" && i + 1 < argc)
       ours.tube.minArcDegrees = scalespace::bench::numberArgument(argv, ++i);
     else if (a == "--max-face-sectors" && i + 1 < argc)
@@ -419,6 +428,7 @@ static int run(int argc, char** argv) {
           "[--clean-only] [--noisy-only] "
           "[--scan full|one-sided] [--scales M] [--tmin T] [--seed S] "
           "[--curved-seeds-first] [--one-curvature-sign] [--estimate-normals] "
+          "[--min-line-length F] [--max-line-curvature F] [--max-line-variation F] "
           "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] "
           "[--max-face-sectors N] "
           "[--max-gap LEVELS] "

@@ -152,7 +152,8 @@ def release_buffers() -> int:
 def cylinders(points: ArrayLike, normals: Optional[ArrayLike] = ..., *,
               viewpoint: Optional[Sequence[float]] = ...,
               scales: Optional[Sequence[float]] = ..., scale_count: int = ..., tmin: float = ...,
-              tmax: float = ..., epsilon: float = ..., min_anisotropy: float = ...,
+              tmax: float = ..., min_line_length: float = ..., max_line_curvature: float = ...,
+              max_line_variation: float = ..., epsilon: float = ..., min_anisotropy: float = ...,
               min_arc: float = ..., max_rms: float = ..., one_curvature_sign: bool = ...,
               max_gap: int = ..., threads: Optional[int] = ...,
               progress: Progress = ...) -> Cylinders: ...

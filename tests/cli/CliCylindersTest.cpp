@@ -140,7 +140,8 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
     EXPECT_NE(r.err.find(flag), std::string::npos) << r.err;
   }
   for (const char* flag : {"--narrow-min-arc", "--narrow-min-persistence", "--narrow-radius-spread",
-                           "--trim-keep-fraction", "--trim-min-radius", "--trim-against-share"}) {
+                           "--trim-keep-fraction", "--trim-min-radius", "--trim-against-share",
+                           "--min-line-length", "--max-line-curvature", "--max-line-variation"}) {
     r = run("cylinders " + path("c.ply") + " " + flag + " -1 -q -o " + path("o"));
     EXPECT_EQ(r.code, 2) << flag;
     EXPECT_NE(r.err.find(flag), std::string::npos) << r.err;
@@ -192,6 +193,30 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   // --one-sided belongs to the pipes and poles scenes.
   r = run("generate box --one-sided -q -o " + path("x.ply"));
   EXPECT_EQ(r.code, 2);
+}
+
+// The thresholds of Eq. 3.5-3.7 are options: recorded in the result, and lines no longer than the
+// cylinder itself leave no regular line and so no cylinder, where the defaults find it.
+TEST_F(Cli, CylindersTakeTheLineFilterThresholds) {
+  ASSERT_EQ(run("generate cylinder -n 20000 -q -o " + path("c.ply")).code, 0);
+  auto r = run("cylinders " + path("c.ply") + " --scales 3 -q -o " + path("d"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(readJson(path("d/components.json"))["components"].empty());
+  r = run("cylinders " + path("c.ply") +
+          " --scales 3 --min-line-length 1000 --max-line-curvature 2 --max-line-variation 0.7 -q "
+          "-o " +
+          path("f"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json result = readJson(path("f/components.json"));
+  EXPECT_EQ(result["parameters"]["min_length_factor"], 1000.0);
+  EXPECT_EQ(result["parameters"]["max_curvature_factor"], 2.0);
+  EXPECT_EQ(result["parameters"]["max_mean_variation"], 0.7);
+  ASSERT_EQ(result["levels"].size(), 3u);
+  for (const auto& level : result["levels"]) {
+    EXPECT_GT(level["lines"].get<int>(), 0);
+    EXPECT_EQ(level["regular_lines"], 0);
+  }
+  EXPECT_TRUE(result["components"].empty());
 }
 
 // The poles of `generate poles` from positions alone under noise: each pole one component of its

@@ -553,6 +553,25 @@ def test_cylinders_narrow_tubes_equal_the_cli(tmp_path):
         assert len(json.loads((out / "components.json").read_text())["components"]) == count
 
 
+def test_cylinders_line_filter_equals_the_cli(tmp_path):
+    # The thresholds of Eq. 3.5-3.7: lines a thousand scales long leave no regular line and no
+    # cylinder, where the defaults find the tube; the CLI's flags do the same.
+    rng = np.random.default_rng(3)
+    theta = rng.uniform(0, 2 * np.pi, 8000)
+    normals = np.stack([np.cos(theta), np.sin(theta), np.zeros_like(theta)], axis=1)
+    points = normals + np.stack([np.zeros_like(theta)] * 2 + [rng.uniform(0, 6, 8000)], axis=1)
+    assert len(ss.cylinders(points, normals, scales=[0.3])) == 1
+    none = ss.cylinders(points, normals, scales=[0.3], min_line_length=1000)
+    assert len(none) == 0 and none.levels[0]["regular_lines"] == 0 < none.levels[0]["lines"]
+    assert len(ss.cylinders(points, normals, scales=[0.3], max_line_variation=0.7)) == 1
+    ss.write(str(tmp_path / "tube.ply"), points, normals)
+    for flags, count in (((), 1), (("--min-line-length", 1000), 0)):
+        out = tmp_path / ("c%d" % count)
+        cli("cylinders", tmp_path / "tube.ply", "-o", out, "--scales", 1, "--tmin", 0.3, "--tmax",
+            0.31, *flags)
+        assert len(json.loads((out / "components.json").read_text())["components"]) == count
+
+
 def test_cylinders_nested_links_equal_the_cli(tmp_path):
     # A unit tube whose two seams along the axis are rough: two half tubes at t = 0.1, the whole
     # at 0.9. A half and the whole fail J > 0.5, but the half lies on the whole's tube
@@ -594,6 +613,9 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"trim_keep_fraction": 2}, "trim_keep_fraction"),
                          ({"trim_min_radius": -1}, "trim_min_radius"),
                          ({"trim_against_share": 2}, "trim_against_share"),
+                         ({"min_line_length": -1}, "min_line_length"),
+                         ({"max_line_curvature": float("inf")}, "max_line_curvature"),
+                         ({"max_line_variation": -1}, "max_line_variation"),
                          ({"scales": [0.2, 0.1]}, "scales")]:
         with pytest.raises(ss.OptionError, match=name) as e:
             ss.cylinders(p, **kwargs)

@@ -146,6 +146,18 @@ void addCylindersCommand(CLI::App& app) {
   cmd->add_option("--epsilon", args->cylinders.epsilon,
                   "region growing tolerance of Eq. 3.10 on anisotropy, directions and normals")
       ->capture_default_str();
+  cmd->add_option("--min-line-length", args->cylinders.filter.minLengthFactor,
+                  "keep the minimal-curvature lines at least this many times the scale t long "
+                  "(L of Eq. 3.5)")
+      ->capture_default_str();
+  cmd->add_option("--max-line-curvature", args->cylinders.filter.maxCurvatureFactor,
+                  "keep the lines whose total curvature (K of Eq. 3.6, radians) is at most this "
+                  "x their length / t")
+      ->capture_default_str();
+  cmd->add_option("--max-line-variation", args->cylinders.filter.maxMeanVariation,
+                  "keep the lines whose total geometric variation (V of Eq. 3.7) is at most this "
+                  "x their vertex count: the mean tanh(nu) over the line")
+      ->capture_default_str();
   cmd->add_option("--min-anisotropy", args->cylinders.minAnisotropy,
                   "points join regions only with at least this line anisotropy")
       ->capture_default_str();

@@ -149,10 +149,11 @@ class Cylinders {
 std::unique_ptr<Cylinders> cylindersPy(
     const py::handle& points, const py::handle& normals, const py::handle& viewpoint,
     const std::optional<std::vector<double>>& scales, int scaleCount, double tmin, double tmax,
-    double epsilon, double minAnisotropy, double minArc, double minSectorFill,
-    double maxSectionShape, double maxSectionShapeRms, int maxFaceSectors, double minFaceLean,
-    double maxRms, bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes,
-    int maxGap, double nestedLinkTolerance, double trimKeepFraction, double trimMinRadius,
+    double minLineLength, double maxLineCurvature, double maxLineVariation, double epsilon,
+    double minAnisotropy, double minArc, double minSectorFill, double maxSectionShape,
+    double maxSectionShapeRms, int maxFaceSectors, double minFaceLean, double maxRms,
+    bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap,
+    double nestedLinkTolerance, double trimKeepFraction, double trimMinRadius,
     double trimAgainstShare, double narrowMinArc, int narrowMinPersistence,
     double narrowRadiusSpread, std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
@@ -161,6 +162,9 @@ std::unique_ptr<Cylinders> cylindersPy(
   options.scaleCount = scaleCount;
   options.tMin = tmin;
   options.tMax = tmax;
+  options.filter.minLengthFactor = minLineLength;
+  options.filter.maxCurvatureFactor = maxLineCurvature;
+  options.filter.maxMeanVariation = maxLineVariation;
   options.epsilon = epsilon;
   options.minAnisotropy = minAnisotropy;
   options.tube.minArcDegrees = minArc;
@@ -245,8 +249,10 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
       });
   m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
         "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
-        "tmax"_a = 0.0, "epsilon"_a = 0.1, "min_anisotropy"_a = 0.5,
-        "min_arc"_a = TubeFitOptions{}.minArcDegrees,
+        "tmax"_a = 0.0, "min_line_length"_a = LineFilterOptions{}.minLengthFactor,
+        "max_line_curvature"_a = LineFilterOptions{}.maxCurvatureFactor,
+        "max_line_variation"_a = LineFilterOptions{}.maxMeanVariation, "epsilon"_a = 0.1,
+        "min_anisotropy"_a = 0.5, "min_arc"_a = TubeFitOptions{}.minArcDegrees,
         "min_sector_fill"_a = TubeFitOptions{}.minSectorFill,
         "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare,
         "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms,
@@ -270,7 +276,10 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
 Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube fitted to each
 (curved axis, radius profile), linked across scales into persistent components. scales: the
 scales themselves (increasing), else scale_count log-spaced ones in [tmin, tmax] (0: twice the
-median distance to the 10th neighbour, a tenth of the diagonal). epsilon: the region growing
+median distance to the 10th neighbour, a tenth of the diagonal). The regular lines (Eq.
+3.5-3.7): at least min_line_length t long, total curvature at most max_line_curvature x length / t
+radians, total geometric variation at most max_line_variation x their vertex count (the mean
+tanh(nu)). epsilon: the region growing
 tolerance of Eq. 3.10; min_anisotropy: the least sigma of a region's points; min_arc: degrees
 the points' normals must turn around the axis; min_sector_fill: the share of the 10-degree
 sectors of that arc the normals must fill (a box edge rounded into a tube fills about half);
