@@ -195,8 +195,8 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
   EXPECT_EQ(r.code, 2);
 }
 
-// The thresholds of Eq. 3.5-3.7 are options: recorded in the result, and lines no longer than the
-// cylinder itself leave no regular line and so no cylinder, where the defaults find it.
+// The thresholds of Eq. 3.5-3.7 are options: recorded in the result, and a minimum length of a
+// thousand scales leaves no regular line and so no cylinder, where the defaults find it.
 TEST_F(Cli, CylindersTakeTheLineFilterThresholds) {
   ASSERT_EQ(run("generate cylinder -n 20000 -q -o " + path("c.ply")).code, 0);
   auto r = run("cylinders " + path("c.ply") + " --scales 3 -q -o " + path("d"));

@@ -554,16 +554,17 @@ def test_cylinders_narrow_tubes_equal_the_cli(tmp_path):
 
 
 def test_cylinders_line_filter_equals_the_cli(tmp_path):
-    # The thresholds of Eq. 3.5-3.7: lines a thousand scales long leave no regular line and no
-    # cylinder, where the defaults find the tube; the CLI's flags do the same.
+    # The thresholds of Eq. 3.5-3.7: lines a thousand scales long, or none turning or varying at
+    # all (every line of the sampled tube does a little), leave no regular line and no cylinder,
+    # where the defaults find the tube; the CLI's flags do the same.
     rng = np.random.default_rng(3)
     theta = rng.uniform(0, 2 * np.pi, 8000)
     normals = np.stack([np.cos(theta), np.sin(theta), np.zeros_like(theta)], axis=1)
     points = normals + np.stack([np.zeros_like(theta)] * 2 + [rng.uniform(0, 6, 8000)], axis=1)
     assert len(ss.cylinders(points, normals, scales=[0.3])) == 1
-    none = ss.cylinders(points, normals, scales=[0.3], min_line_length=1000)
-    assert len(none) == 0 and none.levels[0]["regular_lines"] == 0 < none.levels[0]["lines"]
-    assert len(ss.cylinders(points, normals, scales=[0.3], max_line_variation=0.7)) == 1
+    for kwargs in ({"min_line_length": 1000}, {"max_line_curvature": 0}, {"max_line_variation": 0}):
+        none = ss.cylinders(points, normals, scales=[0.3], **kwargs)
+        assert len(none) == 0 and none.levels[0]["regular_lines"] == 0 < none.levels[0]["lines"]
     ss.write(str(tmp_path / "tube.ply"), points, normals)
     for flags, count in (((), 1), (("--min-line-length", 1000), 0)):
         out = tmp_path / ("c%d" % count)
