@@ -23,6 +23,9 @@
 //                   [--min-line-length F] [--max-line-curvature F] [--max-line-variation F]
 //                   (ours: LineFilterOptions::minLengthFactor, maxCurvatureFactor,
 //                   maxMeanVariation)
+//                   [--min-persistence P] (ours: only the regions of components living at
+//                   least P scale steps are scored, as `cylinders --min-persistence P` labels;
+//                   default 0, every region)
 //                   [--min-arc DEGREES] (ours: TubeFitOptions::minArcDegrees)
 //                   [--max-section-shape S] (ours: TubeFitOptions::maxSectionShapeShare; 1: off)
 //                   [--max-face-sectors N] (ours: TubeFitOptions::maxFaceSectors; 36: off)
@@ -101,7 +104,7 @@ double iou(const std::vector<Index>& a, const std::vector<Index>& b) {
   return double(both) / double(a.size() + b.size() - both);
 }
 
-Method runOurs(const PointCloud& cloud, const CylinderOptions& options) {
+Method runOurs(const PointCloud& cloud, const CylinderOptions& options, int minPersistence) {
   Method m;
   m.name = "scalespace";
   const auto start = std::chrono::steady_clock::now();
@@ -114,12 +117,17 @@ Method runOurs(const PointCloud& cloud, const CylinderOptions& options) {
       char where[32];
       std::snprintf(where, sizeof where, "t=%.3g", d.levels[std::size_t(level)].scale);
       const int component = d.graph.componentOf[std::size_t(level)][r];
+      if (d.components[std::size_t(component)].persistence < minPersistence) continue;
       m.sets.push_back({regions[r], tube.straight, tube.direction, tube.radius, where,
                         d.components[std::size_t(component)].persistence});
     }
   }
-  std::printf("  scalespace: %zu components over %d scales (%zu regions)\n", d.components.size(),
-              d.scaleCount(), m.sets.size());
+  std::printf(
+      "  scalespace: %zu components over %d scales (%zu regions%s)\n", d.components.size(),
+      d.scaleCount(), m.sets.size(),
+      minPersistence > 0
+          ? (", of components living " + std::to_string(minPersistence) + " steps or more").c_str()
+          : "");
   return m;
 }
 
@@ -356,6 +364,7 @@ static int run(int argc, char** argv) {
   std::size_t points = 1000000;
   bool peers = true, cleanOnly = false, noisyOnly = false, estimate = false, pcaNormals = false;
   std::size_t normalK = 0;  // NormalEstimationOptions' defaults
+  int minPersistence = 0;   // ours: score every region
   std::string only;         // "full" or "one-sided": that scan alone
   CylinderOptions ours;
   std::uint64_t seed = 1;
@@ -417,6 +426,8 @@ static int run(int argc, char** argv) {
       ours.tube.maxFaceSectors = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--max-section-shape" && i + 1 < argc)
       ours.tube.maxSectionShapeShare = scalespace::bench::numberArgument(argv, ++i);
+    else if (a == "--min-persistence" && i + 1 < argc)
+      minPersistence = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--max-gap" && i + 1 < argc)
       ours.maxGapLevels = scalespace::bench::integerArgument(argv, ++i);
     else if (a == "--normal-k" && i + 1 < argc)
@@ -431,7 +442,7 @@ static int run(int argc, char** argv) {
           "[--min-line-length F] [--max-line-curvature F] [--max-line-variation F] "
           "[--pca-normals] [--normal-k K] [--min-arc DEGREES] [--max-section-shape S] "
           "[--max-face-sectors N] "
-          "[--max-gap LEVELS] "
+          "[--max-gap LEVELS] [--min-persistence P] "
           "[--no-split] [--split-cell F] [--split-density F] [--split-steps N] [--split-link F] "
           "[--no-junction-trim]\n");
       return 2;
@@ -465,7 +476,7 @@ static int run(int argc, char** argv) {
         estimateSceneNormals(cloud, truth, cloud.viewpoint() ? &scanner : nullptr, normalK,
                              pcaNormals);
       }
-      std::vector<Method> methods{runOurs(cloud, ours)};
+      std::vector<Method> methods{runOurs(cloud, ours, minPersistence)};
       if (peers) {
         // Mean spacing of an area-uniform sample: sqrt(area / n), the scene's area ~52 m^2 (the
         // rack), ~77 m^2 (the poles).
