@@ -22,7 +22,7 @@
 //                  [--mesh-normals] (the clean and noisy clouds take the mesh's interpolated
 //                  normals)
 //                  [--fold-borders auto|on|off] [--fold-share X] [--fold-reach X]
-//                  (FeatureCurveOptions::foldBorders, auto: where the rays found the cloud closed,
+//                  (FeatureCurveOptions::foldBorders, auto: chooseFoldBorders,
 //                  as `features`; foldBorderShare, foldReach)
 //                  [--centreline-reach X]
 //                  [--band-half-width X] [--centreline-linearity X]
@@ -493,14 +493,14 @@ bool reflect = featureNormalOptions().orientation.reflectAcrossBisector;
 SheetSign sheetSign = featureNormalOptions().sheetSign;
 
 bool printPerCurve = false;  // --per-curve
-// --fold-borders auto|on|off (FeatureCurveOptions::foldBorders; auto: as `features`, where the
-// rays found the cloud closed).
+// --fold-borders auto|on|off (FeatureCurveOptions::foldBorders; auto: as `features`,
+// chooseFoldBorders).
 enum class FoldBorders { Auto, On, Off };
 FoldBorders foldBorders = FoldBorders::Auto;
 
 // As the CLI does for an input without normals (cli/CliCommon.cpp, ensureNormals); returns
-// whether the rays found the surface closed (NormalOrientationResult::closedSurface).
-bool estimateSceneNormals(PointCloud& cloud) {
+// what the orientation's rays found (closed, open share), for `auto`'s fold borders.
+NormalOrientationResult estimateSceneNormals(PointCloud& cloud) {
   auto index = makeSpatialIndex(cloud.positions());
   OrientedNormalsOptions options = featureNormalOptions(sheetNormals);
   options.orientation.acrossWeight = acrossWeight;
@@ -522,7 +522,7 @@ bool estimateSceneNormals(PointCloud& cloud) {
         normals.orientation.closedComponents, normals.orientation.closedSurface ? "yes" : "no",
         normals.orientation.openShare);
   cloud.setNormals(std::move(normals.normals));
-  return normals.orientation.closedSurface;
+  return normals.orientation;
 }
 
 PointCloud noisyCopy(const PointCloud& clean, double sigma) {
@@ -545,11 +545,11 @@ const PointCloud* lastCloud = nullptr;  // the cloud ours ran on
 struct Model {
   std::string name;
   TriangleMesh mesh;
-  bool cleanClosed = false;       // the rays found the clean cloud's surface closed
-  PointCloud clean;               // with estimated normals
-  std::vector<Vec3> meshNormals;  // of the samples, interpolated from the mesh
-  std::vector<int> gt;            // per point: ground-truth curve or -1
-  std::vector<int> gtEdge;        // per point: ground-truth edge or -1 (where gt is not)
+  NormalOrientationResult cleanRays;  // what the rays found on the clean cloud
+  PointCloud clean;                   // with estimated normals
+  std::vector<Vec3> meshNormals;      // of the samples, interpolated from the mesh
+  std::vector<int> gt;                // per point: ground-truth curve or -1
+  std::vector<int> gtEdge;            // per point: ground-truth edge or -1 (where gt is not)
   std::vector<int> gt2,
       gt3;               // the same within 2 e and 3 e (--per-curve: where false positives lie)
   int gtCurves = 0;      // curves with at least one point
@@ -600,7 +600,7 @@ Model prepareModel(std::string name, TriangleMesh mesh, std::size_t points, doub
   m.clean = sampleMesh(m.mesh, points, kSampleSeed);
   const std::vector<Vec3> truth = m.clean.normals();
   m.clean.setNormals({});  // drop the mesh's normals: the methods see a raw scan
-  m.cleanClosed = estimateSceneNormals(m.clean);
+  m.cleanRays = estimateSceneNormals(m.clean);
   const std::vector<Vec3> estimated = m.clean.normals();
   m.meshNormals = truth;
   if (meshNormals) m.clean.setNormals(truth);  // a diagnostic: the orientation out of the way
@@ -1096,14 +1096,17 @@ struct Detection {
 // Ours with the library's defaults unless --salient / --vote-threshold / --min-curvature /
 // --vote-radius say otherwise (to measure a setting against the same ground truth).
 
-Detection runOurs(const PointCloud& cloud, bool closed) {
+Detection runOurs(const PointCloud& cloud, const NormalOrientationResult& rays) {
   FeatureCurveOptions options = ourOptions;
-  // As `features` does for a cloud whose estimated normals' rays found it closed.
-  options.foldBorders = foldBorders == FoldBorders::Auto ? closed : foldBorders == FoldBorders::On;
+  // As `features` does for a cloud whose normals it estimated.
+  if (foldBorders == FoldBorders::Auto)
+    chooseFoldBorders(options, rays);
+  else
+    options.foldBorders = foldBorders == FoldBorders::On;
   FeatureCurveResult result = detectFeatureCurves(cloud, options);
   if (printPerCurve)
-    std::printf("# fold borders %s: %zu points\n", options.foldBorders ? "on" : "off",
-                result.foldPoints);
+    std::printf("# fold borders %s: %zu points (seeing out on both sides: %.2f)\n",
+                result.foldsApplied ? "on" : "off", result.foldPoints, result.foldSeeThrough);
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);
@@ -1265,8 +1268,8 @@ bool makeMesh(const std::string& name, const std::string& dir, std::size_t point
 }
 
 // Every method on one cloud (clean or noisy) of a model.
-void runMethods(const Model& m, const PointCloud& cloud, bool closed, bool peers,
-                std::vector<Row>& rows) {
+void runMethods(const Model& m, const PointCloud& cloud, const NormalOrientationResult& rays,
+                bool peers, std::vector<Row>& rows) {
   const auto add = [&](const std::string& method, const Detection& d, double seconds) {
     Row row{method, d.edge.empty() ? score(m, d.curve, d.count, d.curve, d.count)
                                    : score(m, d.curve, d.count, d.edge, d.edgeCount)};
@@ -1275,7 +1278,7 @@ void runMethods(const Model& m, const PointCloud& cloud, bool closed, bool peers
     rows.push_back(row);
   };
   Clock::time_point start = Clock::now();
-  const Detection ours = runOurs(cloud, closed);
+  const Detection ours = runOurs(cloud, rays);
   add("ours", ours, secondsSince(start));
   if (printPerCurve && lastOurs) {
     // How far ours' salient vertices lie from the sharp edges, per scale, in units of e: the APSS
@@ -1471,13 +1474,13 @@ static int run(int argc, char** argv) {
         printModel(
             m, std::size_t(std::count_if(m.gt.begin(), m.gt.end(), [](int c) { return c >= 0; })));
         if (noise == 0) {
-          runMethods(m, m.clean, m.cleanClosed, peers, rows);
+          runMethods(m, m.clean, m.cleanRays, peers, rows);
         } else {
           PointCloud cloud = noisyCopy(m.clean, noise * m.diagonal);
-          const bool closed = estimateSceneNormals(cloud);
+          const NormalOrientationResult rays = estimateSceneNormals(cloud);
           if (printPerCurve) printOrientation(m, cloud.normals(), "noisy");
           if (meshNormals) cloud.setNormals(m.meshNormals);
-          runMethods(m, cloud, closed, peers, rows);
+          runMethods(m, cloud, rays, peers, rows);
         }
       } catch (const Error& error) {
         std::printf("# %s: skipped (%s)\n", name.c_str(), error.what());

@@ -28,6 +28,28 @@ TEST(OccupancyGrid, RaysLeaveAClosedSphereOutwardAndAreStoppedInward) {
   EXPECT_FALSE(grid.escapes(centre + Vec3(0, 0, 1), Vec3(1, 0, 0), 3));
 }
 
+// Five rays a side: a closed sphere's points see out on their outer side only, a flat sheet's
+// on both.
+TEST(OccupancyGrid, ASheetSeesOutOnBothSidesAClosedSurfaceOnOne) {
+  const Vec3 centre(0.3, -0.2, 0.1);
+  const auto sphere = testclouds::sphere(20000, 1.0, 7, centre);
+  const OccupancyGrid closed(sphere, 0.05, std::size_t(1) << 24);
+  std::size_t outward = 0, both = 0;
+  for (std::size_t i = 0; i < sphere.size(); i += 20) {
+    const Vec3 radial = (sphere[i] - centre).normalized();
+    outward += closed.escapingRays(sphere[i], radial) >= 3 ? 1 : 0;
+    both += closed.seesOutBothSides(sphere[i], radial) ? 1 : 0;
+  }
+  EXPECT_GT(outward, 990u);
+  EXPECT_LT(both, 10u);
+  std::vector<Vec3> sheet;
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j) sheet.emplace_back(0.01 * i, 0.01 * j, 0.0);
+  const OccupancyGrid open(sheet, 0.02, std::size_t(1) << 24);
+  EXPECT_TRUE(open.seesOutBothSides(Vec3(0.5, 0.5, 0), Vec3::UnitZ()));
+  EXPECT_EQ(open.escapingRays(Vec3(0.5, 0.5, 0), -Vec3::UnitZ()), 5);
+}
+
 TEST(OccupancyGrid, CellsGrowToStayWithinTheLimitAndBadInputIsRefused) {
   const auto points = testclouds::sphere(2000, 1.0, 8);
   const OccupancyGrid grid(points, 0.001, 1000);

@@ -459,6 +459,69 @@ TEST(FeatureCurves, MeshVerticesAreLabelledOnTheMeshEdges) {
   EXPECT_THROW(buildMeshEdgeGraph(3, {{0, 1, 5}}), OptionError);
 }
 
+// On a nearly closed cloud `auto` keeps the borders as folds only when they see out on both
+// sides: the rim of a part thinner than the noise does (a noisy sheet's border), the edge of an
+// opening in a closed surface has the surface behind it (a box with a square hole in its top).
+TEST(FeatureCurves, FoldsAreKeptWhereTheBordersSeeOutOnBothSides) {
+  FeatureCurveOptions options;
+  options.foldBorders = true;
+  options.foldSeeThroughShare = kFoldSeeThroughShare;
+
+  RectangleSampler sheet;
+  sheet.add(Vec3(0, 0, 0), Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), 8000);
+  std::normal_distribution<double> noise(0, 0.002);
+  for (Vec3& p : sheet.positions) p.z() += noise(sheet.random);
+  const FeatureCurveResult thin = detectFeatureCurves(sheet.cloud(), options);
+  EXPECT_TRUE(thin.foldsApplied);
+  EXPECT_GT(thin.foldSeeThrough, 0.9);
+  EXPECT_GT(thin.foldPoints, 0u);
+
+  RectangleSampler holed;
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  holed.add(Vec3(0, 0, 1), x, y, z, 6000, [](const Vec3& p) {
+    return std::abs(p.x() - 0.5) > 0.4 || std::abs(p.y() - 0.5) > 0.4;
+  });
+  holed.add(Vec3(0, 0, 0), x, y, -z, 6000);
+  holed.add(Vec3(0, 0, 0), x, z, -y, 6000);
+  holed.add(Vec3(0, 1, 0), x, z, y, 6000);
+  holed.add(Vec3(0, 0, 0), y, z, -x, 6000);
+  holed.add(Vec3(1, 0, 0), y, z, x, 6000);
+  const PointCloud box = holed.cloud();
+  const FeatureCurveResult opening = detectFeatureCurves(box, options);
+  EXPECT_FALSE(opening.foldsApplied);
+  EXPECT_GE(opening.foldSeeThrough, 0.0);
+  EXPECT_LT(opening.foldSeeThrough, 0.1);
+  EXPECT_EQ(opening.foldPoints, 0u);
+  // Without the test the hole's rim is taken as a fold: the test is what leaves it out.
+  options.foldSeeThroughShare = 0;
+  const FeatureCurveResult taken = detectFeatureCurves(box, options);
+  EXPECT_TRUE(taken.foldsApplied);
+  EXPECT_GT(taken.foldPoints, 100u);
+  EXPECT_EQ(taken.foldSeeThrough, -1);
+
+  // `auto`: closed, nearly closed (with the test) and open; the hint only where the test left
+  // the borders out.
+  NormalOrientationResult rays;
+  rays.closedSurface = true;
+  FeatureCurveOptions chosen;
+  chooseFoldBorders(chosen, rays);
+  EXPECT_TRUE(chosen.foldBorders);
+  EXPECT_EQ(chosen.foldSeeThroughShare, 0);
+  rays.closedSurface = false;
+  rays.openShare = 0.1;
+  chooseFoldBorders(chosen, rays);
+  EXPECT_TRUE(chosen.foldBorders);
+  EXPECT_EQ(chosen.foldSeeThroughShare, kFoldSeeThroughShare);
+  EXPECT_EQ(foldBordersHint(rays, thin, "on"), "");
+  const std::string hint = foldBordersHint(rays, opening, "on");
+  EXPECT_NE(hint.find("open at 10.0%"), std::string::npos) << hint;
+  EXPECT_NE(hint.find("on makes them convex curves"), std::string::npos) << hint;
+  rays.openShare = 0.3;
+  chooseFoldBorders(chosen, rays);
+  EXPECT_FALSE(chosen.foldBorders);
+  EXPECT_EQ(foldBordersHint(rays, opening, "on"), "");
+}
+
 TEST(FeatureCurves, InvalidOptionsAreRefused) {
   RectangleSampler s;
   addBox(s, 500, true);
@@ -646,5 +709,11 @@ TEST(FeatureCurves, TheBordersOfASheetAreFoldsOnlyWhenAsked) {
   EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
   folds.foldReach = 3;
   folds.foldBorderShare = 1.5;
+  EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
+  folds.foldBorderShare = 0.25;
+  folds.foldSeeThroughShare = 1.5;
+  EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
+  folds.foldSeeThroughShare = 0.5;
+  folds.foldRayCell = 0;
   EXPECT_THROW(detectFeatureCurves(cloud, folds), OptionError);
 }

@@ -1005,10 +1005,11 @@ def test_parametrize_a_sphere_and_bad_arguments():
 
 def test_a_nearly_closed_surface_gets_the_fold_hint(tmp_path):
     # A unit box whose top has a square hole 0.8 wide: the rays leak through it at about 11% of
-    # the points, over the 5% of a closed surface and under most open scans. 'auto' leaves the
-    # folds off and says that 'on' would look for them (a thin part's rim leaks the same way);
-    # with a hole 0.5 wide the rays find it closed and nothing is said; an open sheet reads open
-    # at most of its points and nothing is said either.
+    # the points, over the 5% of a closed surface and under most open scans. 'auto' looks for
+    # folds there (a thin part's rim leaks the same way), finds the hole's rim, which has the box
+    # behind it (none of its points sees out on both sides), leaves it out and says that 'on'
+    # would take it; with a hole 0.5 wide the rays find it closed and nothing is said; an open
+    # sheet reads open at most of its points and nothing is said either.
     def box_with_hole(hole, n=20000, seed=5):
         rng = np.random.default_rng(seed)
         points = rng.uniform(-0.5, 0.5, (n, 3))
@@ -1025,7 +1026,8 @@ def test_a_nearly_closed_surface_gets_the_fold_hint(tmp_path):
         return result, [str(w.message) for w in caught if "fold_borders='on'" in str(w.message)]
 
     result, said = hints(box_with_hole(0.8))
-    assert result["fold_borders"] is False and len(said) == 1
+    assert result["fold_borders"] is False and len(said) == 1 and result["fold_points"] == 0
+    assert 0 <= result["fold_see_through"] < 0.1 and "edges of an opening" in said[0]
     share = float(said[0].split("open at ")[1].split("%")[0])
     assert 5 < share < 15 and abs(100 * result["rays_open_share"] - share) <= 0.05
     np.savetxt(tmp_path / "holed.xyz", box_with_hole(0.8))
@@ -1034,11 +1036,14 @@ def test_a_nearly_closed_surface_gets_the_fold_hint(tmp_path):
     assert run.returncode == 0 and "--fold-borders on" in run.stderr
     summary = json.loads((tmp_path / "holed.json").read_text())
     assert summary["rays_open_share"] == pytest.approx(result["rays_open_share"])
+    assert summary["fold_see_through"] == pytest.approx(result["fold_see_through"])
+    assert summary["parameters"]["fold_borders"] is False
     # Given normals, nothing was measured: null, None.
     assert ss.features(box_with_hole(0.8), normals=np.tile([0.0, 0.0, 1.0], (1, 1)).repeat(
         len(box_with_hole(0.8)), 0))["rays_open_share"] is None
     result, said = hints(box_with_hole(0.5))
     assert result["fold_borders"] is True and said == [] and result["rays_open_share"] <= 0.05
+    assert result["fold_see_through"] is None  # closed: every border is a fold, nothing measured
     rng = np.random.default_rng(4)
     sheet = np.column_stack([rng.random(8000), rng.random(8000), rng.normal(0, 0.002, 8000)])
     result, said = hints(sheet)

@@ -317,7 +317,8 @@ void addFeaturesCommand(CLI::App& app) {
   cmd->add_option("--fold-borders", args->foldBorders,
                   "where the sampled surface is closed, its borders are folds thinner than the "
                   "noise (a thin part's rim) and join the convex curves: auto (a cloud whose "
-                  "estimated normals' rays find it closed), on, off (meshes: auto is off)")
+                  "estimated normals' rays find it closed, or nearly closed with at least half "
+                  "of the borders found seeing out on both sides), on, off (meshes: auto is off)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
   cmd->add_option("--fold-reach", args->features.foldReach,
@@ -379,16 +380,19 @@ void addFeaturesCommand(CLI::App& app) {
       const NormalOrientationResult orientation =
           ensureNormals(cloud, args->quiet, featureNormalOptions(args->sheetNormals));
       if (estimated) openShare = orientation.openShare;
-      if (args->foldBorders == "auto") options.foldBorders = orientation.closedSurface;
-      const std::string hint = foldBordersHint(orientation, "--fold-borders on");
-      if (!args->quiet && args->foldBorders == "auto" && !hint.empty())
-        std::fprintf(stderr, "features: %s\n", hint.c_str());
+      const bool automatic = args->foldBorders == "auto";
+      if (automatic) chooseFoldBorders(options, orientation);
       result = detectFeatureCurves(cloud, options, progress);
-      if (!args->quiet && options.foldBorders)
-        std::fprintf(
-            stderr, "features: %s; %zu points on its borders (folds) joined the curves\n",
-            args->foldBorders == "auto" ? "the rays found the surface closed" : "--fold-borders on",
-            result.foldPoints);
+      const std::string hint = foldBordersHint(orientation, result, "--fold-borders on");
+      if (!args->quiet && automatic && !hint.empty())
+        std::fprintf(stderr, "features: %s\n", hint.c_str());
+      if (!args->quiet && result.foldsApplied)
+        std::fprintf(stderr, "features: %s; %zu points on its borders (folds) joined the curves\n",
+                     !automatic                  ? "--fold-borders on"
+                     : orientation.closedSurface ? "the rays found the surface closed"
+                                                 : "the rays found the surface nearly closed and "
+                                                   "its borders thin",
+                     result.foldPoints);
     }
     PointCloud& out = mesh ? targets : cloud;
     AttributeColumn& votes = out.addAttribute("feature_votes", ScalarType::Float32);
@@ -439,6 +443,8 @@ void addFeaturesCommand(CLI::App& app) {
                        {"length", result.edges[k].length}});
     const double total = std::chrono::duration<double>(Clock::now() - start).count();
     const nlohmann::json openShareJson = openShare ? nlohmann::json(*openShare) : nullptr;
+    const nlohmann::json seeThroughJson =
+        result.foldSeeThrough >= 0 ? nlohmann::json(result.foldSeeThrough) : nullptr;
     const nlohmann::json json = {{"command", "features"},
                                  {"version", SCALESPACE_VERSION},
                                  {"input", args->input.path},
@@ -453,6 +459,7 @@ void addFeaturesCommand(CLI::App& app) {
                                  {"feature_points", labelled},
                                  {"fold_points", result.foldPoints},
                                  {"rays_open_share", openShareJson},
+                                 {"fold_see_through", seeThroughJson},
                                  {"parameters",
                                   {{"scale_count", options.scaleCount},
                                    {"salient_threshold", options.salientThreshold},
@@ -466,7 +473,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"ridge_only", options.ridgeOnly},
                                    {"min_piece_extent", options.minPieceExtent},
                                    {"min_curve_extent", options.minCurveExtent},
-                                   {"fold_borders", options.foldBorders},
+                                   {"fold_borders", result.foldsApplied},
                                    {"fold_reach", options.foldReach},
                                    {"fold_border_share", options.foldBorderShare},
                                    {"join_gap", options.joinGap},

@@ -234,18 +234,6 @@ void splitMixedPieces(const std::vector<Index>& parent, const std::vector<Index>
 /// 0-0.4%; open scans: the real table scan 38%, hippo1 99%, building 18%, spheres 17%, oni 11%.
 constexpr double kClosedOpenShare = 0.05;
 
-/// The rays of one side of a point: along the normal and four tilted 25 degrees around it.
-int escapingRays(const OccupancyGrid& grid, const Vec3& p, const Vec3& unitNormal) {
-  const Vec3 u = unitNormal.unitOrthogonal();
-  const Vec3 v = unitNormal.cross(u);
-  const double c = std::cos(25.0 * M_PI / 180.0), s = std::sin(25.0 * M_PI / 180.0);
-  const Vec3 rays[5] = {unitNormal, c * unitNormal + s * u, c * unitNormal - s * u,
-                        c * unitNormal + s * v, c * unitNormal - s * v};
-  int count = 0;
-  for (const Vec3& r : rays) count += grid.escapes(p, r, 3) ? 1 : 0;
-  return count;
-}
-
 /// A point's vote on its normal from the rays escaping in front (`out`) and behind (`in`): +1
 /// when at least three more escape in front, -1 the other way round, else 0.
 std::int8_t voteOf(int out, int in) { return out - in >= 3 ? 1 : (in - out >= 3 ? -1 : 0); }
@@ -312,8 +300,8 @@ void correctByVisibility(const std::vector<Vec3>& points, std::vector<Vec3>& ori
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         if (!casts[i] && !probes[i]) continue;
                         const Vec3 nrm = oriented[i].normalized();
-                        const int out = escapingRays(grid, points[i], nrm);
-                        const int in = escapingRays(grid, points[i], -nrm);
+                        const int out = grid.escapingRays(points[i], nrm);
+                        const int in = grid.escapingRays(points[i], -nrm);
                         if (casts[i]) vote[i] = voteOf(out, in);
                         openBoth[i] = out >= 3 && in >= 3 ? 1 : 0;
                       }
@@ -916,7 +904,7 @@ RayComparison compareByRays(const std::vector<Vec3>& points, const std::vector<V
     for (std::size_t s = r.begin(); s != r.end(); ++s) {
       const Vec3& p = points[sample[s]];
       const Vec3 nrm = first[sample[s]].normalized();
-      vote[s] = voteOf(escapingRays(grid, p, nrm), escapingRays(grid, p, -nrm));
+      vote[s] = voteOf(grid.escapingRays(p, nrm), grid.escapingRays(p, -nrm));
     }
   });
   result.sampled = sample.size();

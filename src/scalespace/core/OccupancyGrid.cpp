@@ -1,5 +1,6 @@
 #include "scalespace/core/OccupancyGrid.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -93,6 +94,17 @@ bool OccupancyGrid::escapes(const Vec3& from, const Vec3& direction, int surface
     tMax[a] += tDelta[a];
   }
   return true;
+}
+
+int OccupancyGrid::escapingRays(const Vec3& p, const Vec3& unitNormal) const {
+  const Vec3 u = unitNormal.unitOrthogonal();
+  const Vec3 v = unitNormal.cross(u);
+  const double c = std::cos(25.0 * M_PI / 180.0), s = std::sin(25.0 * M_PI / 180.0);
+  const Vec3 rays[5] = {unitNormal, c * unitNormal + s * u, c * unitNormal - s * u,
+                        c * unitNormal + s * v, c * unitNormal - s * v};
+  int count = 0;
+  for (const Vec3& r : rays) count += escapes(p, r, 3) ? 1 : 0;
+  return count;
 }
 
 }  // namespace scalespace

@@ -25,6 +25,16 @@ class OccupancyGrid {
   /// grid (true: the ray escapes) or enters an occupied cell (false).
   bool escapes(const Vec3& from, const Vec3& direction, int surfaceCells) const;
 
+  /// How many of the five rays of one side of a point escape (3 surface cells): along the unit
+  /// normal and four tilted 25 degrees around it.
+  int escapingRays(const Vec3& p, const Vec3& unitNormal) const;
+
+  /// Whether at least three of the five rays escape on each side of the point: an open sheet, or
+  /// a part thinner than the cells, not a side of a closed surface.
+  bool seesOutBothSides(const Vec3& p, const Vec3& unitNormal) const {
+    return escapingRays(p, unitNormal) >= 3 && escapingRays(p, -unitNormal) >= 3;
+  }
+
  private:
   bool occupiedCell(long x, long y, long z) const;
 

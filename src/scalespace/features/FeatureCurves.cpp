@@ -16,6 +16,7 @@
 
 #include "scalespace/core/DisjointSets.hpp"
 #include "scalespace/core/Error.hpp"
+#include "scalespace/core/OccupancyGrid.hpp"
 #include "scalespace/core/RegionGrower.hpp"
 #include "scalespace/core/SheetBorder.hpp"
 #include "scalespace/core/SpatialIndex.hpp"
@@ -197,10 +198,14 @@ std::vector<Vec3> positionsOf(const std::vector<Vec3>& from, const std::vector<I
 // border at a reach of 3 e). The samples, evenly spread, give a centroid as steady as all the
 // points. Reading it at every point with all of them cost 5-9 s on 1M points, this 1.6 s; the
 // labels of bench_features' models are the same but for 0-3 points.
+//
+// With FeatureCurveOptions::foldSeeThroughShare, they are kept only when enough of them see out on
+// both sides (`seeThrough`, the share, is set; -1 when no point was found). A mesh's vertices take
+// the normal of their nearest sample.
 std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex& cloudIndex,
                                      const std::vector<Vec3>& targets,
                                      const std::vector<std::uint8_t>& eligible, double e,
-                                     const FeatureCurveOptions& options) {
+                                     const FeatureCurveOptions& options, double& seeThrough) {
   constexpr double kFoldMargin = 0.1;
   constexpr std::uint64_t kSampleSeed = 11;
   const bool cloudTargets = &targets == &cloud.positions();
@@ -233,6 +238,26 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
   std::vector<std::uint8_t> fold(targets.size(), 0);
   for (std::size_t i = 0; i < targets.size(); ++i)
     fold[i] = !skip[i] && share[i] >= options.foldBorderShare ? 1 : 0;
+  seeThrough = -1;
+  if (!(options.foldSeeThroughShare > 0) || !cloud.hasNormals()) return fold;
+  const OccupancyGrid grid(cloud.positions(), options.foldRayCell * e, std::size_t(1) << 27);
+  std::size_t found = 0, through = 0;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    if (!fold[i]) continue;
+    Vec3 normal = Vec3::Zero();
+    if (cloudTargets) {
+      normal = cloud.normals()[i];
+    } else {
+      cloudIndex.knnSearch(targets[i], 1, near);
+      if (!near.empty()) normal = cloud.normals()[near.front().index];
+    }
+    ++found;
+    if (normal.allFinite() && normal.squaredNorm() > 0)
+      through += grid.seesOutBothSides(targets[i], normal.normalized()) ? 1 : 0;
+  }
+  if (found == 0) return fold;
+  seeThrough = double(through) / double(found);
+  if (seeThrough < options.foldSeeThroughShare) std::fill(fold.begin(), fold.end(), 0);
   return fold;
 }
 
@@ -285,17 +310,29 @@ std::vector<std::vector<std::size_t>> curvesWithinGap(const std::vector<Vec3>& p
 
 }  // namespace
 
-std::string foldBordersHint(const NormalOrientationResult& orientation, std::string_view turnOn) {
+bool nearlyClosed(const NormalOrientationResult& orientation) {
   constexpr double kNearlyClosedShare = 0.15;
-  if (orientation.closedSurface || !(orientation.openShare > 0) ||
-      !(orientation.openShare < kNearlyClosedShare))
-    return {};
-  char share[32];
-  std::snprintf(share, sizeof share, "%.1f%%", 100 * orientation.openShare);
-  return std::string("the rays found the surface open at ") + share +
-         " of the points (a closed surface: at most 5%); if it is a thin closed part whose rim "
-         "is thinner than the noise, " +
-         std::string(turnOn) + " makes that rim a convex curve";
+  return !orientation.closedSurface && orientation.openShare > 0 &&
+         orientation.openShare < kNearlyClosedShare;
+}
+
+void chooseFoldBorders(FeatureCurveOptions& options, const NormalOrientationResult& orientation) {
+  options.foldBorders = orientation.closedSurface || nearlyClosed(orientation);
+  options.foldSeeThroughShare = nearlyClosed(orientation) ? kFoldSeeThroughShare : 0.0;
+}
+
+std::string foldBordersHint(const NormalOrientationResult& orientation,
+                            const FeatureCurveResult& result, std::string_view turnOn) {
+  if (!nearlyClosed(orientation) || result.foldsApplied || !(result.foldSeeThrough >= 0)) return {};
+  char figures[160];
+  std::snprintf(figures, sizeof figures,
+                "%.1f%% of the points (a closed surface: at most 5%%), and %.0f%% of the borders "
+                "found there see out on both sides",
+                100 * orientation.openShare, 100 * result.foldSeeThrough);
+  return std::string("the rays found the surface open at ") + figures +
+         ": the edges of an opening, not the rim of a part thinner than the noise, so they are "
+         "not taken as folds; " +
+         std::string(turnOn) + " makes them convex curves all the same";
 }
 
 OrientedNormalsOptions featureNormalOptions(double sheetTolerance) {
@@ -365,6 +402,11 @@ void validateFeatureCurveOptions(const FeatureCurveOptions& o) {
           "FeatureCurveOptions::foldReach must be finite and > 0");
   require(std::isfinite(o.foldBorderShare) && o.foldBorderShare > 0 && o.foldBorderShare <= 1,
           "FeatureCurveOptions::foldBorderShare must be in (0, 1]");
+  require(std::isfinite(o.foldSeeThroughShare) && o.foldSeeThroughShare >= 0 &&
+              o.foldSeeThroughShare <= 1,
+          "FeatureCurveOptions::foldSeeThroughShare must be in [0, 1]");
+  require(std::isfinite(o.foldRayCell) && o.foldRayCell > 0,
+          "FeatureCurveOptions::foldRayCell must be finite and > 0");
   require(std::isfinite(o.minCurveExtent) && o.minCurveExtent >= 0,
           "FeatureCurveOptions::minCurveExtent must be finite and >= 0");
   require(std::isfinite(o.minPieceExtent) && o.minPieceExtent >= 0,
@@ -565,7 +607,9 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
   }
   if (options.foldBorders) {
     const std::vector<std::uint8_t> fold =
-        foldPoints(cloud, *cloudIndex, targets, eligible, e, options);
+        foldPoints(cloud, *cloudIndex, targets, eligible, e, options, result.foldSeeThrough);
+    result.foldsApplied =
+        !(result.foldSeeThrough >= 0) || result.foldSeeThrough >= options.foldSeeThroughShare;
     for (std::size_t i = 0; i < n; ++i)
       if (fold[i]) {
         eligible[i] = 1;

@@ -51,14 +51,34 @@ constexpr double kFeatureSheetNormals = 0.05;
 /// -> 1.00).
 OrientedNormalsOptions featureNormalOptions(double sheetTolerance = kFeatureSheetNormals);
 
+struct FeatureCurveOptions;
+struct FeatureCurveResult;
+
+/// The share of a nearly closed cloud's fold points that must see out on both sides for `auto`
+/// to keep them (FeatureCurveOptions::foldSeeThroughShare): the two cases measured there read
+/// 72-85% and 0%.
+constexpr double kFoldSeeThroughShare = 0.5;
+
 /// Whether the orientation of those normals found the cloud open, but only just: its rays see out
 /// on both sides at under 15% of the points of every component (NormalOrientationResult::
 /// openShare). Over the closed parts' 0.5% and under most open scans (libcgal-demo's oni 11%,
 /// spheres 17%, building 18%, the table scan 38%): a thin part whose rim, or an opening, lets a
-/// few rays through (bench_features' blade, open at its root: 8.4-9.5%). `features` then suggests
-/// FeatureCurveOptions::foldBorders, which `auto` leaves off: the message saying so, with
-/// `turnOn` the way to ask for it (a flag, a keyword); empty where the cloud is not nearly closed.
-std::string foldBordersHint(const NormalOrientationResult& orientation, std::string_view turnOn);
+/// few rays through (bench_features' blade, open at its root: 8.4-9.5%; a box with a hole 0.7-0.8
+/// wide in its top: 6.5-11%).
+bool nearlyClosed(const NormalOrientationResult& orientation);
+
+/// `features`' `auto` for FeatureCurveOptions::foldBorders, from the orientation of the normals
+/// it estimated: on where the rays found every component closed; on a nearly closed cloud, on
+/// with foldSeeThroughShare = kFoldSeeThroughShare (the borders found must be the rims of a part
+/// thinner than the noise, not the edges of an opening); else off.
+void chooseFoldBorders(FeatureCurveOptions& options, const NormalOrientationResult& orientation);
+
+/// Where `auto` looked for folds on a nearly closed cloud and the borders it found were the edges
+/// of an opening (FeatureCurveResult::foldSeeThrough under the bound, none kept): the message
+/// saying that `turnOn` (a flag, a keyword) would take them as folds all the same. Empty
+/// elsewhere.
+std::string foldBordersHint(const NormalOrientationResult& orientation,
+                            const FeatureCurveResult& result, std::string_view turnOn);
 
 struct FeatureCurveOptions {
   /// The unit e of the scales and of the vote radius. 0: the mean over the cloud of the distance
@@ -172,7 +192,8 @@ struct FeatureCurveOptions {
   double edgeRejoinAngle = 20;
   /// (Not in the thesis) set when the cloud samples a closed surface, a solid's boundary
   /// (`features` and Python's features() set it where the visibility rays of the normals they
-  /// estimate find every component closed). A closed surface has no border, so a point where its
+  /// estimate find every component closed, and with foldSeeThroughShare where they find the
+  /// cloud nearly closed: chooseFoldBorders). A closed surface has no border, so a point where its
   /// neighbours within foldReach * e fill one side only (core/SheetBorder share >= foldBorderShare)
   /// is on a fold: the rim of a part thinner than the noise, whose two sides the points no longer
   /// tell apart and whose lines then see one open sheet with no crease. Such points join the convex
@@ -187,6 +208,15 @@ struct FeatureCurveOptions {
   /// (core/SheetBorder.hpp): 0.25 keeps the points within about e of the fold, the width the votes
   /// give a crease.
   double foldBorderShare = 0.25;
+  /// (Not in the thesis; 0: off.) With foldBorders, keep the fold points only when at least this
+  /// share of them see out on both sides (of the five rays each way around their normal, three
+  /// escape; core/OccupancyGrid, cells of foldRayCell e). The rim of a part thinner than the
+  /// noise is an open sheet there; the edge of an opening in a closed surface has the surface
+  /// behind it. Measured at 0.8 e: bench_features' blade 85% clean, 72% noisy; a box with a
+  /// square hole 0.7-0.9 wide in its top, 20k and 100k points, clean and noisy: 0 of 92-1,451.
+  /// `auto` sets it on a nearly closed cloud (chooseFoldBorders).
+  double foldSeeThroughShare = 0;
+  double foldRayCell = 0.8;
   /// k of the k-NN graph the regions grow on (point inputs).
   int graphNeighbors = 10;
   /// Also return the salient vertices and, per target point, the scales that voted for it
@@ -243,6 +273,12 @@ struct FeatureCurveResult {
   /// Points labelled as on a fold only (FeatureCurveOptions::foldBorders), before the curves
   /// shorter than minCurveExtent are dropped.
   std::size_t foldPoints = 0;
+  /// With FeatureCurveOptions::foldSeeThroughShare: the share of the fold points found that see
+  /// out on both sides (none kept when under the bound); -1 when not measured or none found.
+  double foldSeeThrough = -1;
+  /// Whether the borders were taken as folds: FeatureCurveOptions::foldBorders, and the
+  /// see-through test passed or was off.
+  bool foldsApplied = false;
   /// The salient line vertices of every scale, for drawing: positions and their scale index.
   std::vector<CurvatureLineSet> lineSets;
   double seconds = 0;

@@ -198,9 +198,11 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
         estimateAndOrient(cloud, featureNormalOptions(sheetNormals), "mst", view, call.progress(),
                           &orientation);
         openShare = orientation.openShare;
-        if (foldBorders == "auto") options.foldBorders = orientation.closedSurface;
-        const std::string hint = foldBordersHint(orientation, "fold_borders='on'");
+        if (foldBorders == "auto") chooseFoldBorders(options, orientation);
+        FeatureCurveResult found = detectFeatureCurves(cloud, options, call.progress());
+        const std::string hint = foldBordersHint(orientation, found, "fold_borders='on'");
         if (foldBorders == "auto" && !hint.empty()) warnings.push_back(hint);
+        return found;
       }
       return detectFeatureCurves(cloud, options, call.progress());
     }
@@ -223,7 +225,9 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   d["max_vote"] = result.maxVote;
   d["noise_rms"] = result.noiseRms;
   d["salient_curvature_floor"] = result.salientCurvatureFloor;
-  d["fold_borders"] = options.foldBorders;
+  d["fold_borders"] = result.foldsApplied;
+  d["fold_see_through"] = result.foldSeeThrough >= 0 ? py::object(py::float_(result.foldSeeThrough))
+                                                     : py::object(py::none());
   d["fold_points"] = result.foldPoints;
   d["rays_open_share"] = openShare ? py::object(py::float_(*openShare)) : py::object(py::none());
   py::list curves;
@@ -333,14 +337,18 @@ sheet_normals times the 10th neighbour's distance (or 8 noise RMS) of, where the
 hold them (one side's plane at a crease; 0: PCA normals), as estimate_normals(sheet=...,
 sign_by_rays=True, reflect=True), and oriented (MST, the sign carried by the reflected agreement;
 each part facing viewpoint=(x, y, z) when given: Cloud.viewpoint of a PCD, as the CLI does).
-fold_borders: 'auto' (a cloud without normals whose estimated normals' rays find it closed; off
-for meshes and clouds with normals), 'on' or 'off': on a closed surface the points at a border
+fold_borders: 'auto' (a cloud without normals whose estimated normals' rays find it closed, or
+nearly closed, under 0.15, with at least half of the borders found seeing out on both sides: the
+rim of a thin part, not the edges of an opening; off for meshes and clouds with normals), 'on'
+or 'off': on a closed surface the points at a border
 of the sheet their neighbours within fold_reach x e sample (the neighbours' centroid off the point
 by fold_share x that radius or more, in their plane) are a fold thinner than the noise (a thin
 part's rim) and join the convex curves; the dict's fold_borders says whether it applied and
-fold_points how many points it added; rays_open_share the share of the points whose
+fold_points how many points it added; fold_see_through the share of the borders found that see
+out on both sides where auto measured it, else None; rays_open_share the share of the points whose
 visibility rays see out on both sides where the normals were estimated here, else None: up to 0.05
-is closed, and between that and 0.15 a warning suggests fold_borders='on'.)doc");
+is closed, and between that and 0.15 a warning says when the borders were left out as the edges
+of an opening.)doc");
   m.def(
       "read_mesh",
       [](const std::string& path) {
