@@ -1105,8 +1105,13 @@ Detection runOurs(const PointCloud& cloud, const NormalOrientationResult& rays) 
     options.foldBorders = foldBorders == FoldBorders::On;
   FeatureCurveResult result = detectFeatureCurves(cloud, options);
   if (printPerCurve)
-    std::printf("# fold borders %s: %zu points (seeing out on both sides: %.2f)\n",
-                result.foldsApplied ? "on" : "off", result.foldPoints, result.foldSeeThrough);
+    std::printf("# fold borders %s: %zu points%s\n", result.foldsApplied ? "on" : "off",
+                result.foldPoints,
+                result.foldSeeThrough >= 0
+                    ? (", " + std::to_string(int(std::lround(100 * result.foldSeeThrough))) +
+                       "% seeing out on both sides")
+                          .c_str()
+                    : "");
   Detection d;
   d.curve = result.curveId;
   for (int c : d.curve) d.count = std::max(d.count, c + 1);

@@ -519,7 +519,22 @@ TEST(FeatureCurves, FoldsAreKeptWhereTheBordersSeeOutOnBothSides) {
   rays.openShare = 0.3;
   chooseFoldBorders(chosen, rays);
   EXPECT_FALSE(chosen.foldBorders);
+  EXPECT_EQ(chosen.foldSeeThroughShare, 0);
   EXPECT_EQ(foldBordersHint(rays, opening, "on"), "");
+  rays.openShare = 0.1;
+  chooseFoldBorders(chosen, rays);
+  rays.closedSurface = true;
+  chooseFoldBorders(chosen, rays);
+  EXPECT_TRUE(chosen.foldBorders);
+  EXPECT_EQ(chosen.foldSeeThroughShare, 0);
+  // Asked to test and finding no border: nothing taken (a closed box with no border at all).
+  RectangleSampler closedBox;
+  addBox(closedBox, 3000, true);
+  options.foldSeeThroughShare = kFoldSeeThroughShare;
+  const FeatureCurveResult none = detectFeatureCurves(closedBox.cloud(), options);
+  EXPECT_EQ(none.foldSeeThrough, -1);
+  EXPECT_FALSE(none.foldsApplied);
+  EXPECT_EQ(none.foldPoints, 0u);
 }
 
 TEST(FeatureCurves, InvalidOptionsAreRefused) {

@@ -200,8 +200,8 @@ std::vector<Vec3> positionsOf(const std::vector<Vec3>& from, const std::vector<I
 // labels of bench_features' models are the same but for 0-3 points.
 //
 // With FeatureCurveOptions::foldSeeThroughShare, they are kept only when enough of them see out on
-// both sides (`seeThrough`, the share, is set; -1 when no point was found). A mesh's vertices take
-// the normal of their nearest sample.
+// both sides (`seeThrough`, the share over those with a usable normal; -1, and none kept, when no
+// such point was found). A mesh's vertices take the normal of their nearest sample.
 std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex& cloudIndex,
                                      const std::vector<Vec3>& targets,
                                      const std::vector<std::uint8_t>& eligible, double e,
@@ -239,7 +239,7 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
   for (std::size_t i = 0; i < targets.size(); ++i)
     fold[i] = !skip[i] && share[i] >= options.foldBorderShare ? 1 : 0;
   seeThrough = -1;
-  if (!(options.foldSeeThroughShare > 0) || !cloud.hasNormals()) return fold;
+  if (!(options.foldSeeThroughShare > 0)) return fold;
   const OccupancyGrid grid(cloud.positions(), options.foldRayCell * e, std::size_t(1) << 27);
   std::size_t found = 0, through = 0;
   for (std::size_t i = 0; i < targets.size(); ++i) {
@@ -251,13 +251,12 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
       cloudIndex.knnSearch(targets[i], 1, near);
       if (!near.empty()) normal = cloud.normals()[near.front().index];
     }
+    if (!normal.allFinite() || !(normal.squaredNorm() > 0)) continue;  // no side to cast from
     ++found;
-    if (normal.allFinite() && normal.squaredNorm() > 0)
-      through += grid.seesOutBothSides(targets[i], normal.normalized()) ? 1 : 0;
+    through += grid.seesOutBothSides(targets[i], normal.normalized()) ? 1 : 0;
   }
-  if (found == 0) return fold;
-  seeThrough = double(through) / double(found);
-  if (seeThrough < options.foldSeeThroughShare) std::fill(fold.begin(), fold.end(), 0);
+  if (found > 0) seeThrough = double(through) / double(found);
+  if (!(seeThrough >= options.foldSeeThroughShare)) std::fill(fold.begin(), fold.end(), 0);
   return fold;
 }
 
@@ -609,7 +608,7 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     const std::vector<std::uint8_t> fold =
         foldPoints(cloud, *cloudIndex, targets, eligible, e, options, result.foldSeeThrough);
     result.foldsApplied =
-        !(result.foldSeeThrough >= 0) || result.foldSeeThrough >= options.foldSeeThroughShare;
+        !(options.foldSeeThroughShare > 0) || result.foldSeeThrough >= options.foldSeeThroughShare;
     for (std::size_t i = 0; i < n; ++i)
       if (fold[i]) {
         eligible[i] = 1;
