@@ -1041,6 +1041,25 @@ def test_a_nearly_closed_surface_gets_the_fold_hint(tmp_path):
     # Given normals, nothing was measured: null, None.
     assert ss.features(box_with_hole(0.8), normals=np.tile([0.0, 0.0, 1.0], (1, 1)).repeat(
         len(box_with_hole(0.8)), 0))["rays_open_share"] is None
+    # A box with a thin fin (a bracket's flange, one sheet 0.6 x 1 on a face): nearly closed too
+    # (the fin's points see out on both sides), and the fin's free rim does as well, so auto takes
+    # it as folds, through the CLI alike, and nothing is said.
+    rng = np.random.default_rng(6)
+    fin = np.column_stack([0.5 + 0.6 * rng.random(1800), np.zeros(1800), rng.uniform(-0.5, 0.5, 1800)])
+    bracket = np.vstack([box_with_hole(0.0, n=18200), fin])
+    result, said = hints(bracket)
+    assert 0.05 < result["rays_open_share"] < 0.15 and said == []
+    assert result["fold_borders"] is True and result["fold_see_through"] > 0.9
+    half = 0.5 * result["spacing"]  # the fin's free rim: its far edge and its top and bottom
+    on_rim = np.abs(bracket[:, 1]) < 0.01
+    on_rim &= (bracket[:, 0] > 1.1 - half) | ((bracket[:, 0] > 0.6) & (np.abs(bracket[:, 2]) > 0.5 - half))
+    assert result["fold_points"] > 100 and np.mean(result["convexity"][on_rim] == 1) > 0.8
+    np.savetxt(tmp_path / "bracket.xyz", bracket)
+    run = subprocess.run([CLI, "features", str(tmp_path / "bracket.xyz"), "-o", str(tmp_path / "bracket.ply")],
+                         capture_output=True, text=True)
+    assert run.returncode == 0 and "nearly closed and its borders thin" in run.stderr
+    summary = json.loads((tmp_path / "bracket.json").read_text())
+    assert summary["parameters"]["fold_borders"] is True and summary["fold_points"] == result["fold_points"]
     result, said = hints(box_with_hole(0.5))
     assert result["fold_borders"] is True and said == [] and result["rays_open_share"] <= 0.05
     assert result["fold_see_through"] is None  # closed: every border is a fold, nothing measured
