@@ -240,6 +240,7 @@ std::vector<std::uint8_t> foldPoints(const PointCloud& cloud, const SpatialIndex
     fold[i] = !skip[i] && share[i] >= options.foldBorderShare ? 1 : 0;
   seeThrough = -1;
   if (!(options.foldSeeThroughShare > 0)) return fold;
+  if (std::find(fold.begin(), fold.end(), 1) == fold.end()) return fold;  // nothing to test
   const OccupancyGrid grid(cloud.positions(), options.foldRayCell * e, std::size_t(1) << 27);
   std::size_t found = 0, through = 0;
   for (std::size_t i = 0; i < targets.size(); ++i) {
