@@ -14,6 +14,7 @@
 
 #include "cli/CliTestSupport.hpp"
 #include "scalespace/core/PipeScene.hpp"
+#include "scalespace/features/CylinderDetection.hpp"
 #include "scalespace/io/CloudIO.hpp"
 #include "scalespace/io/Polylines.hpp"
 
@@ -38,7 +39,7 @@ TEST_F(Cli, CylindersFindThePipesOfTheRack) {
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json result = readJson(path("out/components.json"));
   EXPECT_EQ(result["result"], "cylinders");
-  EXPECT_EQ(result["levels"].size(), 8u);
+  EXPECT_EQ(result["levels"].size(), std::size_t(CylinderOptions{}.scaleCount));
   const PointCloud cloud = readCloud(path("out/cloud.ply"));
   ASSERT_EQ(cloud.size(), 150000u);
   const AttributeColumn* id = cloud.findAttribute("cylinder_id");

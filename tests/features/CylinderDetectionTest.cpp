@@ -817,6 +817,10 @@ TEST(Cylinders, OptionsAreChecked) {
           "TubeTrimOptions::minRadiusScales");
   rejects([](CylinderOptions& o) { o.nestedLinkTolerance = 1; },
           "CylinderOptions::nestedLinkTolerance");
+  rejects([](CylinderOptions& o) { o.bridgeRadiusTolerance = -0.1; },
+          "CylinderOptions::bridgeRadiusTolerance");
+  rejects([](CylinderOptions& o) { o.bridgeRadiusTolerance = NAN; },
+          "CylinderOptions::bridgeRadiusTolerance");
   PointCloud bare;
   bare.setAbsolutePositions(cloud.positions());
   EXPECT_THROW(detectCylinders(bare, atScales({0.3})), OptionError);

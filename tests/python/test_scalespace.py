@@ -607,6 +607,7 @@ def test_cylinders_bad_options_and_cancel(pipes):
                          ({"max_face_sectors": -1}, "max_face_sectors"),
                          ({"min_face_lean": float("nan")}, "min_face_lean"),
                          ({"max_gap": -1}, "max_gap"),
+                         ({"bridge_radius_tolerance": 1}, "bridge_radius_tolerance"),
                          ({"nested_link_tolerance": 1}, "nested_link_tolerance"),
                          ({"narrow_min_arc": -1}, "narrow_min_arc"),
                          ({"narrow_min_persistence": -1}, "narrow_min_persistence"),

@@ -196,6 +196,10 @@ void addCylindersCommand(CLI::App& app) {
                   "a component bridges up to this many scales where its tube was not found (0: "
                   "consecutive scales only, as the thesis)")
       ->capture_default_str();
+  cmd->add_option("--bridge-radius-tolerance", args->cylinders.bridgeRadiusTolerance,
+                  "the tubes on both sides of such a gap agree in radius within this share of "
+                  "the larger (a real tube's fitted radius grows with the scale)")
+      ->capture_default_str();
   cmd->add_option("--nested-link-tolerance", args->cylinders.nestedLinkTolerance,
                   "tubes of two scales that fail the Jaccard rule but one of which holds over half "
                   "of the other's points, the smaller at least a quarter the size, are one "
@@ -334,6 +338,7 @@ void addCylindersCommand(CLI::App& app) {
           {"min_face_lean_degrees", o.tube.minFaceLeanDegrees},
           {"max_relative_rms", o.tube.maxRelativeRms},
           {"max_gap_levels", o.maxGapLevels},
+          {"bridge_radius_tolerance", o.bridgeRadiusTolerance},
           {"nested_link_tolerance", o.nestedLinkTolerance},
           {"axis_split", o.split.enabled},
           {"junction_trim", o.trim.enabled},

@@ -89,6 +89,7 @@ const std::pair<const char*, const char*> kFlagOfOption[] = {
     {"TubeFitOptions::maxFaceSectors", "--max-face-sectors"},
     {"TubeFitOptions::minFaceLeanDegrees", "--min-face-lean"},
     {"CylinderOptions::maxGapLevels", "--max-gap"},
+    {"CylinderOptions::bridgeRadiusTolerance", "--bridge-radius-tolerance"},
     {"CylinderOptions::nestedLinkTolerance", "--nested-link-tolerance"},
     {"TubeTrimOptions::keepFraction", "--trim-keep-fraction"},
     {"TubeTrimOptions::minRadiusScales", "--trim-min-radius"},

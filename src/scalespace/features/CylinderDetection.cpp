@@ -310,6 +310,8 @@ void validateCylinderOptions(const CylinderOptions& options) {
   require(options.minJaccard >= 0.5 && options.minJaccard < 1,
           "CylinderOptions::minJaccard must be in [0.5, 1)");
   require(options.maxGapLevels >= 0, "CylinderOptions::maxGapLevels must be >= 0");
+  require(options.bridgeRadiusTolerance >= 0 && options.bridgeRadiusTolerance < 1,
+          "CylinderOptions::bridgeRadiusTolerance must be in [0, 1)");
   require(options.nestedLinkTolerance >= 0 && options.nestedLinkTolerance < 1,
           "CylinderOptions::nestedLinkTolerance must be in [0, 1) (0: off)");
   validateLineFilterOptions(options.filter);
@@ -434,17 +436,18 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     if (progress && !progress(double(s + 1) / count, stage)) throw Cancelled();
   }
 
-  // Across a gap the two tubes of a J link must agree in radius (10%): a region that swallowed
-  // both walls of a thick pipe at one scale (radius between them) shares most of its points with
-  // the outer wall's tube of a later scale. A nested link is vouched for by its points instead:
-  // the walls of libcgal-demo's pipe.off lie at 0.17 and 0.31, so the outer wall's points lie
-  // (0.31 - r) / r off a tube of radius r between them, 24% for r = 0.25.
+  // Across a gap the two tubes of a J link must agree in radius (bridgeRadiusTolerance): a region
+  // that swallowed both walls of a thick pipe at one scale (radius between them) shares most of
+  // its points with the outer wall's tube of a later scale. A nested link is vouched for by its
+  // points instead: the walls of libcgal-demo's pipe.off lie at 0.17 and 0.31, so the outer
+  // wall's points lie (0.31 - r) / r off a tube of radius r between them, 24% for r = 0.25.
   RegionLinkOptions linking;
   linking.minJaccard = options.minJaccard;
   linking.maxGap = options.maxGapLevels;
   linking.bridgeAllowed = [&](const std::vector<RegionLevel>&, int j, int r, int k, int s) {
     return radiiAgree(result.levels[std::size_t(j)].tubes[std::size_t(r)],
-                      result.levels[std::size_t(k)].tubes[std::size_t(s)], 0.1);
+                      result.levels[std::size_t(k)].tubes[std::size_t(s)],
+                      options.bridgeRadiusTolerance);
   };
   if (options.nestedLinkTolerance > 0)
     linking.nestedAllowed = [&](const std::vector<RegionLevel>& regions, int j, int r, int k,

@@ -64,6 +64,13 @@ struct NarrowTubeOptions {
 struct CylinderOptions {
   /// The scales, increasing. Empty: scaleCount log-spaced scales in [tMin, tMax].
   std::vector<double> scales;
+  /// 12 (a ratio of 1.31 from one to the next with the default range, against 1.52) finds
+  /// bench_cylinders' twisted cable seen from one side whole at 6 of 6 seeds instead of 2 (it reads
+  /// as one tube over a narrow band of scales), for 1.3-1.4 x the time, but on real scans it gives
+  /// more single-scale components (python3-pcl's table scan 29 against 19, libcgal-demo's kitten 10
+  /// against 4), a persistent tube over libcgal-demo's ball.ply, and a weaker stereo mug (one
+  /// component of 4,680 points over 2 scales against 7,155 over 3); 10 loses the mug. So 8
+  /// (bench/README.md).
   int scaleCount = 8;
   /// 0: twice the median distance to the 10th nearest neighbour (the finest scale whose fits hold
   /// ~40 points) and a tenth of the bounding-box diagonal.
@@ -107,6 +114,14 @@ struct CylinderOptions {
   /// region at two middle scales and part again above them; without the bridge each wall was two
   /// components, the same tube reported twice. 0: the thesis' consecutive links only.
   int maxGapLevels = 2;
+  /// (Not in the thesis.) Across such a gap the two tubes must agree in radius within this share
+  /// of the larger: no region between them vouches for the link. The radius fitted to a real tube
+  /// grows with the scale: a leg of python3-pcl's table scan reads 0.0275 at t = 0.030 and 0.0312
+  /// at t = 0.055 (13%), its tube not found at the scale between; 0.1 left it two components at 12
+  /// scales, 0.2 one. pipe.off (its walls joined over the rim at middle scales), bench_cylinders'
+  /// rack (seeds 1-6) and libcgal-demo's other meshes at 8 scales keep their components with
+  /// either; at 12 scales joint.off's tube of radius 0.34 is one component, as at 8, not three.
+  double bridgeRadiusTolerance = 0.2;
   /// (Not in the thesis; 0: off.) Two tubes of linked levels (consecutive, or across a gap as
   /// above) whose regions do not pass the Jaccard rule but one of which holds more than minJaccard
   /// of the other's points, the smaller at least a quarter the size of the larger, also link when

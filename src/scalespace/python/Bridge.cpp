@@ -107,6 +107,7 @@ const std::pair<const char*, const char*> kKeywordOfOption[] = {
     {"TubeFitOptions::maxFaceSectors", "max_face_sectors"},
     {"TubeFitOptions::minFaceLeanDegrees", "min_face_lean"},
     {"CylinderOptions::maxGapLevels", "max_gap"},
+    {"CylinderOptions::bridgeRadiusTolerance", "bridge_radius_tolerance"},
     {"CylinderOptions::nestedLinkTolerance", "nested_link_tolerance"},
     {"TubeTrimOptions::keepFraction", "trim_keep_fraction"},
     {"TubeTrimOptions::minRadiusScales", "trim_min_radius"},

@@ -153,8 +153,8 @@ std::unique_ptr<Cylinders> cylindersPy(
     double minAnisotropy, double minArc, double minSectorFill, double maxSectionShape,
     double maxSectionShapeRms, int maxFaceSectors, double minFaceLean, double maxRms,
     bool oneCurvatureSign, bool splitByAxes, bool trimJunctions, bool narrowTubes, int maxGap,
-    double nestedLinkTolerance, double trimKeepFraction, double trimMinRadius,
-    double trimAgainstShare, double narrowMinArc, int narrowMinPersistence,
+    double bridgeRadiusTolerance, double nestedLinkTolerance, double trimKeepFraction,
+    double trimMinRadius, double trimAgainstShare, double narrowMinArc, int narrowMinPersistence,
     double narrowRadiusSpread, std::optional<int> threads, py::object progress) {
   // `scalespace cylinders`' options and checks, before any work.
   CylinderOptions options;
@@ -179,6 +179,7 @@ std::unique_ptr<Cylinders> cylindersPy(
   options.trim.enabled = trimJunctions;
   options.narrow.enabled = narrowTubes;
   options.maxGapLevels = maxGap;
+  options.bridgeRadiusTolerance = bridgeRadiusTolerance;
   options.nestedLinkTolerance = nestedLinkTolerance;
   options.trim.keepFraction = trimKeepFraction;
   options.trim.minRadiusScales = trimMinRadius;
@@ -247,31 +248,35 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
                std::to_string(c.levelCount()) + " scales, " + std::to_string(c.pointCount()) +
                " points>";
       });
-  m.def("cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
-        "viewpoint"_a = py::none(), "scales"_a = py::none(), "scale_count"_a = 8, "tmin"_a = 0.0,
-        "tmax"_a = 0.0, "min_line_length"_a = LineFilterOptions{}.minLengthFactor,
-        "max_line_curvature"_a = LineFilterOptions{}.maxCurvatureFactor,
-        "max_line_variation"_a = LineFilterOptions{}.maxMeanVariation, "epsilon"_a = 0.1,
-        "min_anisotropy"_a = 0.5, "min_arc"_a = TubeFitOptions{}.minArcDegrees,
-        "min_sector_fill"_a = TubeFitOptions{}.minSectorFill,
-        "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare,
-        "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms,
-        "max_face_sectors"_a = TubeFitOptions{}.maxFaceSectors,
-        "min_face_lean"_a = TubeFitOptions{}.minFaceLeanDegrees, "max_rms"_a = 0.25,
-        "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
-        "split_by_axes"_a = TubeSplitOptions{}.enabled,
-        "trim_junctions"_a = TubeTrimOptions{}.enabled,
-        "narrow_tubes"_a = NarrowTubeOptions{}.enabled,
-        "max_gap"_a = CylinderOptions{}.maxGapLevels,
-        "nested_link_tolerance"_a = CylinderOptions{}.nestedLinkTolerance,
-        "trim_keep_fraction"_a = TubeTrimOptions{}.keepFraction,
-        "trim_min_radius"_a = TubeTrimOptions{}.minRadiusScales,
-        "trim_against_share"_a = TubeTrimOptions{}.tubeMinAgainstShare,
-        "narrow_min_arc"_a = NarrowTubeOptions{}.minArcDegrees,
-        "narrow_min_persistence"_a = NarrowTubeOptions{}.minPersistence,
-        "narrow_radius_spread"_a = NarrowTubeOptions{}.maxRadiusSpread, "threads"_a = py::none(),
-        "progress"_a = py::none(),
-        R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
+  m.def(
+      "cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
+      "viewpoint"_a = py::none(), "scales"_a = py::none(),
+      "scale_count"_a = CylinderOptions{}.scaleCount, "tmin"_a = 0.0, "tmax"_a = 0.0,
+      "min_line_length"_a = LineFilterOptions{}.minLengthFactor,
+      "max_line_curvature"_a = LineFilterOptions{}.maxCurvatureFactor,
+      "max_line_variation"_a = LineFilterOptions{}.maxMeanVariation,
+      "epsilon"_a = CylinderOptions{}.epsilon, "min_anisotropy"_a = CylinderOptions{}.minAnisotropy,
+      "min_arc"_a = TubeFitOptions{}.minArcDegrees,
+      "min_sector_fill"_a = TubeFitOptions{}.minSectorFill,
+      "max_section_shape"_a = TubeFitOptions{}.maxSectionShapeShare,
+      "max_section_shape_rms"_a = TubeFitOptions{}.maxSectionShapeRms,
+      "max_face_sectors"_a = TubeFitOptions{}.maxFaceSectors,
+      "min_face_lean"_a = TubeFitOptions{}.minFaceLeanDegrees,
+      "max_rms"_a = TubeFitOptions{}.maxRelativeRms,
+      "one_curvature_sign"_a = CylinderOptions{}.oneCurvatureSign,
+      "split_by_axes"_a = TubeSplitOptions{}.enabled,
+      "trim_junctions"_a = TubeTrimOptions{}.enabled,
+      "narrow_tubes"_a = NarrowTubeOptions{}.enabled, "max_gap"_a = CylinderOptions{}.maxGapLevels,
+      "bridge_radius_tolerance"_a = CylinderOptions{}.bridgeRadiusTolerance,
+      "nested_link_tolerance"_a = CylinderOptions{}.nestedLinkTolerance,
+      "trim_keep_fraction"_a = TubeTrimOptions{}.keepFraction,
+      "trim_min_radius"_a = TubeTrimOptions{}.minRadiusScales,
+      "trim_against_share"_a = TubeTrimOptions{}.tubeMinAgainstShare,
+      "narrow_min_arc"_a = NarrowTubeOptions{}.minArcDegrees,
+      "narrow_min_persistence"_a = NarrowTubeOptions{}.minPersistence,
+      "narrow_radius_spread"_a = NarrowTubeOptions{}.maxRadiusSpread, "threads"_a = py::none(),
+      "progress"_a = py::none(),
+      R"doc(Cylinders across scales (Sec. 3.5), as `scalespace cylinders`.
 
 Regular minimal-curvature lines, their anisotropy, regions grown on it, a tube fitted to each
 (curved axis, radius profile), linked across scales into persistent components. scales: the
@@ -305,7 +310,8 @@ least trim_min_radius t; a tube is trimmed when trim_against_share of its points
 it. narrow_tubes: a region turned down for its arc alone (narrow_min_arc degrees or more) is kept
 where it is found over narrow_min_persistence scale steps or more with radii within
 narrow_radius_spread of one another (a cylinder seen from one side). max_gap: a component bridges up to this many
-levels where its tube was not found (0: consecutive levels only, as the thesis).
+levels where its tube was not found (0: consecutive levels only, as the thesis), where the tubes
+on both sides of the gap agree in radius within bridge_radius_tolerance of the larger.
 nested_link_tolerance: tubes of two levels that fail the Jaccard rule, one holding over half of
 the other's points, the smaller at least a quarter the size, are one component when the smaller
 one's points lie on the larger one's tube within this share of its radius (median; 0: off); a
