@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -204,7 +206,8 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
       largest = std::max(largest, radius);
     }
     if (!allNarrow) continue;
-    if (c.persistence() >= options.minPersistence) {
+    // The span, gaps included: the scales where the tube was found lie that many steps apart.
+    if (c.deathLevel - c.birthLevel >= options.minPersistence) {
       if (largest <= (1 + options.maxRadiusSpread) * smallest) continue;
       if (onTubeTolerance > 0 && liesOnItsBestTube(graph, c, positions, levels, onTubeTolerance))
         continue;
@@ -399,6 +402,15 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     level.rejections.assign(std::size_t(TubeRejection::Split) + 1, 0);
     for (const TubeFit& tube : tubes)
       if (!tube.isTube()) ++level.rejections[std::size_t(tube.rejection)];
+    if (std::getenv("SS_DBG"))
+      for (std::size_t r = 0; r < tubes.size(); ++r) {
+        if (seg.regions[r].size() < 500) continue;
+        Vec3 c = Vec3::Zero();
+        for (const Index i : seg.regions[r]) c += cloud.absolutePosition(i);
+        c /= double(seg.regions[r].size());
+        const TubeFit& f = tubes[r];
+        std::fprintf(stderr, "DBG t %.4f n %zu ctr %.3f %.3f %.3f why %s r %.4f arc %.0f rms %.3f dirs %.1f fill %.2f face %d lean %.1f len %.3f\n", t, seg.regions[r].size(), c.x(), c.y(), c.z(), tubeRejectionName(f.rejection), f.radius, f.arcDegrees, f.rms / f.radius, f.normalDirections, f.sectorFill, f.faceSectors, f.normalLean, f.length);
+      }
     RegionLevel regionLevel;
     regionLevel.t = t;
     TubeFitOptions narrowArc = options.tube;
