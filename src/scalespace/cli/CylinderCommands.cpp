@@ -237,8 +237,8 @@ void addCylindersCommand(CLI::App& app) {
                   "for it to be kept as a narrow tube")
       ->capture_default_str();
   cmd->add_option("--narrow-min-persistence", args->cylinders.narrow.minPersistence,
-                  "a component of narrow tubes alone is kept when it lives at least this many "
-                  "scale steps (with radii as --narrow-radius-spread)")
+                  "a component of narrow tubes alone is kept when it is found at scales at least "
+                  "this many steps apart (bridged gaps counted; radii as --narrow-radius-spread)")
       ->capture_default_str();
   cmd->add_option("--narrow-radius-spread", args->cylinders.narrow.maxRadiusSpread,
                   "the radii of a component of narrow tubes alone must lie within this share of "

@@ -4,8 +4,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -181,12 +179,53 @@ bool liesOnItsBestTube(const RegionGraph& graph, const GraphComponent& c,
   return best != nullptr;
 }
 
-/// Drops the narrow-arc tubes (CylinderLevel::narrow) of the components made of them alone that
-/// live under options.minPersistence steps, or whose radii spread over options.maxRadiusSpread
-/// unless every level's points lie on the chain's best-fitting tube within onTubeTolerance (0:
-/// never; a narrow arc's fitted radius is loose, its points are not), from `levels` and
-/// `regionLevels` alike; whether any was dropped (the graph is then stale). `regionLevels` may
-/// be graph.levels: it is changed only after every component was read.
+std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
+                                  const CylinderOptions& options) {
+  if (!options.scales.empty()) return options.scales;
+  double tMin = options.tMin, tMax = options.tMax;
+  if ((tMin == 0 || tMax == 0) && !(cloud.boundingBoxDiagonal() > 0))
+    throw OptionError("all " + std::to_string(cloud.size()) +
+                      " points coincide: there is no surface, and no automatic scale");
+  if (tMin == 0) {
+    if (graph.kthDistance.empty())
+      throw OptionError("the cloud has " + std::to_string(cloud.size()) +
+                        " points; the automatic CylinderOptions::tMin needs more than " +
+                        std::to_string(options.graphNeighbors) + " (a distance to the " +
+                        std::to_string(options.graphNeighbors) + "th neighbour)");
+    tMin = 2 * lowerMedian(graph.kthDistance);
+    if (!(tMin > 0))
+      throw OptionError("most points have " + std::to_string(options.graphNeighbors) +
+                        " duplicates: the automatic CylinderOptions::tMin is 0 (remove the "
+                        "duplicates or give CylinderOptions::tMin)");
+  }
+  if (tMax == 0) tMax = cloud.boundingBoxDiagonal() / 10;
+  if (!(tMax > tMin)) {
+    // Say which bound was computed, and from what: a user who gave neither reads two values
+    // they never set (a sparse cloud: its neighbour spacing is over a tenth of its diagonal).
+    const auto bound = [](const char* field, double value, bool automatic,
+                          const std::string& rule) {
+      std::string text = automatic ? "the automatic " : "";
+      text += field;
+      text += " (" + (automatic ? rule + ", " : std::string()) + std::to_string(value) + ")";
+      return text;
+    };
+    const bool autoMin = options.tMin == 0, autoMax = options.tMax == 0;
+    std::string message = bound("CylinderOptions::tMax", tMax, autoMax, "a tenth of the diagonal") +
+                          " must be > " +
+                          bound("CylinderOptions::tMin", tMin, autoMin,
+                                "twice the median distance to the " +
+                                    std::to_string(options.graphNeighbors) + "th neighbour");
+    if (autoMin || autoMax)
+      message +=
+          ": the points are too sparse for the automatic scales; give CylinderOptions::tMin and "
+          "CylinderOptions::tMax";
+    throw OptionError(message);
+  }
+  return scaleSeries(tMin, tMax, options.scaleCount, ScaleSpacing::Log);
+}
+
+}  // namespace
+
 bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOptions& options,
                                 const std::vector<Vec3>& positions, double onTubeTolerance,
                                 std::vector<CylinderLevel>& levels,
@@ -234,53 +273,6 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
   }
   return true;
 }
-
-std::vector<double> resolveScales(const PointCloud& cloud, const KnnGraph& graph,
-                                  const CylinderOptions& options) {
-  if (!options.scales.empty()) return options.scales;
-  double tMin = options.tMin, tMax = options.tMax;
-  if ((tMin == 0 || tMax == 0) && !(cloud.boundingBoxDiagonal() > 0))
-    throw OptionError("all " + std::to_string(cloud.size()) +
-                      " points coincide: there is no surface, and no automatic scale");
-  if (tMin == 0) {
-    if (graph.kthDistance.empty())
-      throw OptionError("the cloud has " + std::to_string(cloud.size()) +
-                        " points; the automatic CylinderOptions::tMin needs more than " +
-                        std::to_string(options.graphNeighbors) + " (a distance to the " +
-                        std::to_string(options.graphNeighbors) + "th neighbour)");
-    tMin = 2 * lowerMedian(graph.kthDistance);
-    if (!(tMin > 0))
-      throw OptionError("most points have " + std::to_string(options.graphNeighbors) +
-                        " duplicates: the automatic CylinderOptions::tMin is 0 (remove the "
-                        "duplicates or give CylinderOptions::tMin)");
-  }
-  if (tMax == 0) tMax = cloud.boundingBoxDiagonal() / 10;
-  if (!(tMax > tMin)) {
-    // Say which bound was computed, and from what: a user who gave neither reads two values
-    // they never set (a sparse cloud: its neighbour spacing is over a tenth of its diagonal).
-    const auto bound = [](const char* field, double value, bool automatic,
-                          const std::string& rule) {
-      std::string text = automatic ? "the automatic " : "";
-      text += field;
-      text += " (" + (automatic ? rule + ", " : std::string()) + std::to_string(value) + ")";
-      return text;
-    };
-    const bool autoMin = options.tMin == 0, autoMax = options.tMax == 0;
-    std::string message = bound("CylinderOptions::tMax", tMax, autoMax, "a tenth of the diagonal") +
-                          " must be > " +
-                          bound("CylinderOptions::tMin", tMin, autoMin,
-                                "twice the median distance to the " +
-                                    std::to_string(options.graphNeighbors) + "th neighbour");
-    if (autoMin || autoMax)
-      message +=
-          ": the points are too sparse for the automatic scales; give CylinderOptions::tMin and "
-          "CylinderOptions::tMax";
-    throw OptionError(message);
-  }
-  return scaleSeries(tMin, tMax, options.scaleCount, ScaleSpacing::Log);
-}
-
-}  // namespace
 
 OrientedNormalsOptions cylinderNormalOptions() {
   OrientedNormalsOptions options;
@@ -402,15 +394,6 @@ CylinderDetection detectCylinders(const PointCloud& cloud, const CylinderOptions
     level.rejections.assign(std::size_t(TubeRejection::Split) + 1, 0);
     for (const TubeFit& tube : tubes)
       if (!tube.isTube()) ++level.rejections[std::size_t(tube.rejection)];
-    if (std::getenv("SS_DBG"))
-      for (std::size_t r = 0; r < tubes.size(); ++r) {
-        if (seg.regions[r].size() < 500) continue;
-        Vec3 c = Vec3::Zero();
-        for (const Index i : seg.regions[r]) c += cloud.absolutePosition(i);
-        c /= double(seg.regions[r].size());
-        const TubeFit& f = tubes[r];
-        std::fprintf(stderr, "DBG t %.4f n %zu ctr %.3f %.3f %.3f why %s r %.4f arc %.0f rms %.3f dirs %.1f fill %.2f face %d lean %.1f len %.3f\n", t, seg.regions[r].size(), c.x(), c.y(), c.z(), tubeRejectionName(f.rejection), f.radius, f.arcDegrees, f.rms / f.radius, f.normalDirections, f.sectorFill, f.faceSectors, f.normalLean, f.length);
-      }
     RegionLevel regionLevel;
     regionLevel.t = t;
     TubeFitOptions narrowArc = options.tube;

@@ -45,15 +45,17 @@ struct TubeCoverageOptions {
 
 /// (Not in the thesis.) A region turned down for its arc alone, whose normals still turn by
 /// minArcDegrees around its axis, is a tube where it lives across scales: a component made of
-/// such tubes only is kept if it lives at least minPersistence scale steps with radii within
-/// maxRadiusSpread of one another (largest / smallest - 1), or whose points at every level lie on
-/// its best-fitting tube (lowest RMS over radius) within CylinderOptions::nestedLinkTolerance of
-/// its radius (median distance; a narrow arc's fitted radius is loose, its points are not: the
-/// inner wall of python3-pcl's mug read 0.042, 0.033 and 0.037 at three scales, its points
-/// within 2.7% of the 0.037 tube). One scan sees a cylinder from one side: a mug on a table
-/// (python3-pcl's stereo scan) reads 75-120 degrees at six scales from t = 0.008 to 0.027, with
-/// radii 0.036-0.045, under the 135 a single scale needs. The radius of a tube that the scale
-/// makes, the fits rounding an edge, grows with t instead.
+/// such tubes only is kept if it is found at scales at least minPersistence steps apart (its span
+/// from birth to death, bridged gaps included: at 12 scales python3-pcl's mug is found at levels 2
+/// and 5 only: between them its region is missing or grows into what lies beside it) with radii
+/// within maxRadiusSpread of one another (largest / smallest - 1), or whose points at every level
+/// lie on its best-fitting tube (lowest RMS over radius) within
+/// CylinderOptions::nestedLinkTolerance of its radius (median distance; a narrow arc's fitted
+/// radius is loose, its points are not: the inner wall of python3-pcl's mug read 0.042, 0.033 and
+/// 0.037 at three scales, its points within 2.7% of the 0.037 tube). One scan sees a cylinder from
+/// one side: a mug on a table (python3-pcl's stereo scan) reads 75-120 degrees at six scales from t
+/// = 0.008 to 0.027, with radii 0.036-0.045, under the 135 a single scale needs. The radius of a
+/// tube that the scale makes, the fits rounding an edge, grows with t instead.
 struct NarrowTubeOptions {
   bool enabled = true;
   double minArcDegrees = 75;
@@ -161,6 +163,19 @@ struct CylinderLevel {
   std::vector<float> anisotropy;  // per point, NaN where no regular line passes within t
   double seconds = 0;
 };
+
+/// Drops the narrow-arc tubes (CylinderLevel::narrow) of the components made of them alone that
+/// span under options.minPersistence steps (bridged gaps included), or whose radii spread over
+/// options.maxRadiusSpread unless every level's points lie on the chain's best-fitting tube within
+/// onTubeTolerance (0: never; a narrow arc's fitted radius is loose, its points are not), from
+/// `levels` and `regionLevels` alike; whether any was dropped (the graph is then stale).
+/// `regionLevels` may be graph.levels: it is changed only after every component was read.
+/// detectCylinders' step after linking, a piece of its own so that the rule can be checked on
+/// chains built by hand.
+bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOptions& options,
+                                const std::vector<Vec3>& positions, double onTubeTolerance,
+                                std::vector<CylinderLevel>& levels,
+                                std::vector<RegionLevel>& regionLevels);
 
 struct CylinderComponent {
   int id = 0;

@@ -308,7 +308,7 @@ standing on a plane, grown out onto the plane over the junction): the points cur
 most do by at least trim_keep_fraction of their median |kappa1| t, kept as a tube of radius at
 least trim_min_radius t; a tube is trimmed when trim_against_share of its points curve against
 it. narrow_tubes: a region turned down for its arc alone (narrow_min_arc degrees or more) is kept
-where it is found over narrow_min_persistence scale steps or more with radii within
+where it is found at scales narrow_min_persistence steps or more apart with radii within
 narrow_radius_spread of one another (a cylinder seen from one side). max_gap: a component bridges up to this many
 levels where its tube was not found (0: consecutive levels only, as the thesis), where the tubes
 on both sides of the gap agree in radius within bridge_radius_tolerance of the larger.
