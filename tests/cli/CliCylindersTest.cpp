@@ -135,6 +135,7 @@ TEST_F(Cli, CylindersRejectBadOptionsAndForeignFolders) {
                                                         {"--max-face-sectors", "-1"},
                                                         {"--min-face-lean", "-1"},
                                                         {"--max-gap", "-1"},
+                                                        {"--bridge-radius-tolerance", "1"},
                                                         {"--nested-link-tolerance", "1"}}) {
     r = run("cylinders " + path("c.ply") + " " + flag + " " + value + " -q -o " + path("o"));
     EXPECT_EQ(r.code, 2) << flag;

@@ -175,9 +175,9 @@ TEST(Cylinders, ANarrowArcIsATubeWhereItsRadiusHoldsAcrossScales) {
   EXPECT_TRUE(detectCylinders(cloud, options).components.empty());
 }
 
-// A narrow tube found at levels 0 and 2 and missing at 1 (its region grown into what lies beside
-// it there, as python3-pcl's mug at 12 scales) is one bridged chain of persistence 1 whose scales
-// lie 2 steps apart: kept with NarrowTubeOptions::minPersistence 2, dropped with 3.
+// A narrow tube found at levels 0 and 2 and missing at 1 (python3-pcl's mug at 12 scales misses
+// two levels between the two where it is found) is one bridged chain of persistence 1 whose
+// scales lie 2 steps apart: kept with NarrowTubeOptions::minPersistence 2, dropped with 3.
 TEST(Cylinders, ANarrowChainCountsTheStepsItSpansAcrossAGap) {
   std::vector<Index> points(100);
   std::iota(points.begin(), points.end(), Index(0));
@@ -209,6 +209,8 @@ TEST(Cylinders, ANarrowChainCountsTheStepsItSpansAcrossAGap) {
   narrow.minPersistence = 3;
   EXPECT_TRUE(dropUnconfirmedNarrowTubes(graph, narrow, {}, 0, levels, regions));
   EXPECT_TRUE(levels[0].tubes.empty() && levels[2].tubes.empty() && regions[0].regions.empty());
+  std::vector<CylinderLevel> fewer(2);
+  EXPECT_THROW(dropUnconfirmedNarrowTubes(graph, narrow, {}, 0, fewer, regions), OptionError);
 }
 
 // A tube whose two seams along the axis are rough: the fine scale finds its two halves as two

@@ -230,6 +230,18 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
                                 const std::vector<Vec3>& positions, double onTubeTolerance,
                                 std::vector<CylinderLevel>& levels,
                                 std::vector<RegionLevel>& regionLevels) {
+  const auto require = [](bool ok, const char* message) {
+    if (!ok) throw OptionError(message);
+  };
+  require(levels.size() == graph.levels.size() && regionLevels.size() == graph.levels.size(),
+          "dropUnconfirmedNarrowTubes: one CylinderLevel and one RegionLevel per graph level");
+  for (std::size_t j = 0; j < levels.size(); ++j)
+    require(levels[j].tubes.size() == graph.levels[j].regions.size() &&
+                levels[j].narrow.size() == levels[j].tubes.size() &&
+                regionLevels[j].regions.size() == levels[j].tubes.size(),
+            "dropUnconfirmedNarrowTubes: one tube and one narrow flag per region of each level");
+  require(onTubeTolerance <= 0 || !positions.empty(),
+          "dropUnconfirmedNarrowTubes: the points' positions are needed with onTubeTolerance");
   std::vector<std::vector<std::uint8_t>> drop(levels.size());
   for (std::size_t j = 0; j < levels.size(); ++j) drop[j].assign(levels[j].tubes.size(), 0);
   bool any = false;
@@ -245,7 +257,8 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
       largest = std::max(largest, radius);
     }
     if (!allNarrow) continue;
-    // The span, gaps included: the scales where the tube was found lie that many steps apart.
+    // The span, gaps included: its first and last scales lie at least that many steps apart
+    // (python3-pcl's mug at 12 scales: found at levels 2 and 5 only, persistence 1, span 3).
     if (c.deathLevel - c.birthLevel >= options.minPersistence) {
       if (largest <= (1 + options.maxRadiusSpread) * smallest) continue;
       if (onTubeTolerance > 0 && liesOnItsBestTube(graph, c, positions, levels, onTubeTolerance))

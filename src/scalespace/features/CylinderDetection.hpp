@@ -59,6 +59,8 @@ struct TubeCoverageOptions {
 struct NarrowTubeOptions {
   bool enabled = true;
   double minArcDegrees = 75;
+  /// The span, not the persistence: a chain kept for a span of 2 across a gap reports persistence
+  /// 1 (CylinderComponent::persistence), so `--min-persistence 2` does not label it.
   int minPersistence = 2;
   double maxRadiusSpread = 0.15;
 };
@@ -66,13 +68,12 @@ struct NarrowTubeOptions {
 struct CylinderOptions {
   /// The scales, increasing. Empty: scaleCount log-spaced scales in [tMin, tMax].
   std::vector<double> scales;
-  /// 12 (a ratio of 1.31 from one to the next with the default range, against 1.52) finds
-  /// bench_cylinders' twisted cable seen from one side whole at 6 of 6 seeds instead of 2 (it reads
-  /// as one tube over a narrow band of scales), for 1.3-1.4 x the time, but on real scans it gives
-  /// more single-scale components (python3-pcl's table scan 29 against 19, libcgal-demo's kitten 10
-  /// against 4), a persistent tube over libcgal-demo's ball.ply, and a weaker stereo mug (one
-  /// component of 4,680 points over 2 scales against 7,155 over 3); 10 loses the mug. So 8
-  /// (bench/README.md).
+  /// 12 (neighbouring scales 1.31 apart instead of 1.52 over the same range) finds
+  /// bench_cylinders' twisted cable seen from one side whole at 6 of 6 seeds instead of 2 (it
+  /// reads as one tube over a narrow band of scales), for 1.3-1.4 x the time, but on real scans it
+  /// gives more single-scale components (python3-pcl's table scan 30 against 19, libcgal-demo's
+  /// kitten 10 against 4) and a persistent tube over libcgal-demo's ball.ply; 10 loses the stereo
+  /// mug's wall. So 8 (bench/README.md).
   int scaleCount = 8;
   /// 0: twice the median distance to the 10th nearest neighbour (the finest scale whose fits hold
   /// ~40 points) and a tenth of the bounding-box diagonal.
@@ -171,7 +172,9 @@ struct CylinderLevel {
 /// `levels` and `regionLevels` alike; whether any was dropped (the graph is then stale).
 /// `regionLevels` may be graph.levels: it is changed only after every component was read.
 /// detectCylinders' step after linking, a piece of its own so that the rule can be checked on
-/// chains built by hand.
+/// chains built by hand. OptionError unless `levels` and `regionLevels` have one entry per graph
+/// level, each with one tube, narrow flag and region per graph region, and `positions` is given
+/// when onTubeTolerance > 0.
 bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOptions& options,
                                 const std::vector<Vec3>& positions, double onTubeTolerance,
                                 std::vector<CylinderLevel>& levels,

@@ -251,8 +251,8 @@ Labels are (N,) int32 component ids, -1 for none. Coordinates are absolute.)doc"
   m.def(
       "cylinders", &cylindersPy, "points"_a, "normals"_a = py::none(), py::kw_only(),
       "viewpoint"_a = py::none(), "scales"_a = py::none(),
-      "scale_count"_a = CylinderOptions{}.scaleCount, "tmin"_a = 0.0, "tmax"_a = 0.0,
-      "min_line_length"_a = LineFilterOptions{}.minLengthFactor,
+      "scale_count"_a = CylinderOptions{}.scaleCount, "tmin"_a = CylinderOptions{}.tMin,
+      "tmax"_a = CylinderOptions{}.tMax, "min_line_length"_a = LineFilterOptions{}.minLengthFactor,
       "max_line_curvature"_a = LineFilterOptions{}.maxCurvatureFactor,
       "max_line_variation"_a = LineFilterOptions{}.maxMeanVariation,
       "epsilon"_a = CylinderOptions{}.epsilon, "min_anisotropy"_a = CylinderOptions{}.minAnisotropy,
