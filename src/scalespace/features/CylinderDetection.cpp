@@ -23,6 +23,11 @@ namespace scalespace {
 
 namespace {
 
+/// OptionError(message) unless ok: the checks of the options and of the narrow-tube step's inputs.
+void require(bool ok, const std::string& message) {
+  if (!ok) throw OptionError(message);
+}
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -230,9 +235,6 @@ bool dropUnconfirmedNarrowTubes(const RegionGraph& graph, const NarrowTubeOption
                                 const std::vector<Vec3>& positions, double onTubeTolerance,
                                 std::vector<CylinderLevel>& levels,
                                 std::vector<RegionLevel>& regionLevels) {
-  const auto require = [](bool ok, const char* message) {
-    if (!ok) throw OptionError(message);
-  };
   require(levels.size() == graph.levels.size() && regionLevels.size() == graph.levels.size(),
           "dropUnconfirmedNarrowTubes: one CylinderLevel and one RegionLevel per graph level");
   for (std::size_t j = 0; j < levels.size(); ++j)
@@ -295,9 +297,6 @@ OrientedNormalsOptions cylinderNormalOptions() {
 }
 
 void validateCylinderOptions(const CylinderOptions& options) {
-  auto require = [](bool ok, const std::string& message) {
-    if (!ok) throw OptionError(message);
-  };
   for (std::size_t k = 0; k < options.scales.size(); ++k) {
     require(std::isfinite(options.scales[k]) && options.scales[k] > 0,
             "CylinderOptions::scales must be finite and > 0");
