@@ -28,6 +28,7 @@
 //                  [--band-half-width X] [--centreline-linearity X]
 //                  [--crease-reach X (0: off)] [--crease-half-width X] [--crease-flatness X]
 //                  (FeatureCurveOptions::creaseReach, creaseHalfWidth, creaseFlatness)
+//                  [--no-rim-lines] (FeatureCurveOptions::rimLines off)
 //                  [--max-turn DEG] [--collision X] [--beta X] [--border-offset X] [--curvature-gap
 //                  X] (CurvatureLineOptions: curvedSeedsFirst off, maxTurnDegrees,
 //                  collisionFraction, beta, borderOffset, minCurvatureGap)
@@ -1425,6 +1426,8 @@ static int run(int argc, char** argv) {
       ourOptions.creaseReach = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--crease-half-width" && hasValue) {
       ourOptions.creaseHalfWidth = scalespace::bench::numberArgument(argv, ++i);
+    } else if (a == "--no-rim-lines") {
+      ourOptions.rimLines = false;
     } else if (a == "--crease-flatness" && hasValue) {
       ourOptions.creaseFlatness = scalespace::bench::numberArgument(argv, ++i);
     } else if (a == "--centreline-linearity" && hasValue) {

@@ -158,3 +158,61 @@ TEST(CreaseLine, NoneBeyondTheEndOfAThinPart) {
   ASSERT_TRUE(beyond) << "without the gap check the faces' planes give a line";
   EXPECT_GT(beyond->point.y(), kSpacing) << "beyond the end";
 }
+
+// A thin part as above, its faces tilted by 5 degrees (within 2 spacings its points are one sheet,
+// RimLineOptions::maxVariation), its end sampled or not: the rim is the line through its outermost
+// points, in its mid-plane, along the end.
+TEST(CreaseLine, TheRimOfAThinPartIsItsOutermostPoints) {
+  const double thickness = 0.5 * kSpacing, tilt = 5 * M_PI / 180;
+  for (bool endSampled : {false, true}) {
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> along(-0.1, 0.1), depth(0.0, 0.1), unit(-0.5, 0.5);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 12000; ++i) {
+      const double d = depth(rng), side = i % 2 ? 1.0 : -1.0;
+      points.push_back(Vec3(along(rng), -d, side * (0.5 * thickness + d * std::tan(tilt))));
+    }
+    if (endSampled)
+      for (int i = 0; i < 300; ++i) points.push_back(Vec3(along(rng), 0, thickness * unit(rng)));
+    const auto index = makeSpatialIndex(points);
+    RimLineOptions o;
+    o.reach = 2 * kSpacing;
+    o.maxInset = kSpacing;
+    const Vec3 centre(0.01, -0.3 * kSpacing, 0.001);
+    // 1 degree off in the plane (the outermost point across it lies up to reach x sin(1 degree)
+    // out)
+    const Vec3 slanted = Vec3(1, 0.02, 0.3).normalized();
+    const auto rim = fitRimLine(points, *index, centre, slanted, o);
+    ASSERT_TRUE(rim) << "end sampled " << endSampled;
+    EXPECT_NEAR(rim->point.y(), 0, 0.05 * kSpacing);
+    EXPECT_NEAR(rim->point.z(), 0, 0.1 * kSpacing) << "in the mid-plane";
+    EXPECT_GT(std::abs(rim->direction.x()), std::cos(6 * M_PI / 180));
+    EXPECT_GT(rim->across.y(), 0.99) << "outward";
+    // Far inside the sheet the points surround the centre: no rim. Nor beyond maxInset of it.
+    EXPECT_FALSE(fitRimLine(points, *index, Vec3(0, -5 * kSpacing, 0), slanted, o));
+    RimLineOptions near = o;
+    near.maxInset = 0.4 * kSpacing;
+    EXPECT_FALSE(fitRimLine(points, *index, Vec3(0, -0.5 * kSpacing, 0), slanted, near));
+    EXPECT_TRUE(fitRimLine(points, *index, Vec3(0, -0.5 * kSpacing, 0), slanted, o));
+    // Salient vertices running across the sheet's plane are no rim's.
+    EXPECT_FALSE(fitRimLine(points, *index, centre, Vec3(1, 0, 1.1).normalized(), o));
+  }
+}
+
+// Points filling a ball are no sheet, and a crease of 90 degrees is two sheets: no rim.
+TEST(CreaseLine, NoRimInAVolumeNorOnARightAngle) {
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::vector<Vec3> ball;
+  while (ball.size() < 5000) {
+    const Vec3 p(unit(rng), unit(rng), unit(rng));
+    if (p.norm() <= 1) ball.push_back(0.05 * p);
+  }
+  RimLineOptions o;
+  o.reach = 2 * kSpacing;
+  o.maxInset = kSpacing;
+  EXPECT_FALSE(fitRimLine(ball, *makeSpatialIndex(ball), Vec3(0.045, 0, 0), Vec3::UnitY(), o));
+  const Sample edge = sharpEdge(90, 23);
+  EXPECT_FALSE(fitRimLine(edge.positions, *makeSpatialIndex(edge.positions),
+                          Vec3(0, 0, -0.3 * kSpacing), Vec3::UnitX(), o));
+}

@@ -1106,3 +1106,51 @@ def test_fold_borders_follow_the_rays_or_the_keyword(tmp_path):
         ss.features(sheet, fold_reach=0)
     with pytest.raises(ss.OptionError, match="fold_share"):
         ss.features(sheet, fold_share=2)
+
+
+def thin_rim_plate(rng):
+    """A unit square plate sloping by 10 degrees to a rim 4 mm thick, with exact normals (the C++
+    test TheBandOfAThinRimEndsAtItsOutermostPoints's)."""
+    xy = rng.random((16000, 2))
+    side = np.where(np.arange(16000) % 2 == 1, 1.0, -1.0)
+    to_x, to_y = np.minimum(xy[:, 0], 1 - xy[:, 0]), np.minimum(xy[:, 1], 1 - xy[:, 1])
+    slope = np.tan(np.radians(10))
+    points = np.column_stack([xy, side * (0.002 + slope * np.minimum(to_x, to_y))])
+    out = np.where((to_x < to_y)[:, None],
+                   np.column_stack([np.sign(xy[:, 0] - 0.5), np.zeros(16000), np.zeros(16000)]),
+                   np.column_stack([np.zeros(16000), np.sign(xy[:, 1] - 0.5), np.zeros(16000)]))
+    normals = np.column_stack([np.zeros(16000), np.zeros(16000), side]) + slope * out
+    # The rim itself, a strip 4 mm wide around the square.
+    t, z = rng.random(400), rng.uniform(-0.002, 0.002, 400)
+    k = np.arange(400) % 4
+    rim = np.column_stack([np.where(k < 2, t, k - 2), np.where(k < 2, k, t), z])
+    rim_normals = np.zeros((400, 3))
+    rim_normals[k < 2, 1] = np.where(k[k < 2] == 0, -1.0, 1.0)
+    rim_normals[k >= 2, 0] = np.where(k[k >= 2] == 2, -1.0, 1.0)
+    normals = normals / np.linalg.norm(normals, axis=1)[:, None]
+    return np.vstack([points, rim]), np.vstack([normals, rim_normals])
+
+
+def test_the_band_of_a_thin_rim_ends_at_its_outermost_points(tmp_path):
+    # The faces' planes meet beyond the rim, so no crease line is found there: rim_lines trims the
+    # band to the plate within crease_half_width x e of its outermost points (the default), and
+    # the CLI's summary says which was used.
+    points, normals = thin_rim_plate(np.random.default_rng(3))
+
+    def beyond(result):
+        labelled = points[result["curve_id"] >= 0]
+        near_x = np.minimum(labelled[:, 0], 1 - labelled[:, 0])
+        near_y = np.minimum(labelled[:, 1], 1 - labelled[:, 1])
+        away = near_x + near_y >= 4 * result["spacing"]  # not at a corner
+        return np.mean(np.minimum(near_x, near_y)[away] > result["spacing"])
+
+    rim = ss.features(points, normals)
+    centreline = ss.features(points, normals, rim_lines=False)
+    assert beyond(centreline) > 0.04 and beyond(rim) < 0.005
+    np.savetxt(tmp_path / "plate.xyz", np.column_stack([points, normals]),
+               header="x y z nx ny nz", comments="")
+    cli("features", tmp_path / "plate.xyz", "-o", tmp_path / "plate.ply", "--no-rim-lines")
+    summary = json.loads((tmp_path / "plate.json").read_text())
+    assert summary["parameters"]["rim_lines"] is False
+    written = ss.read(str(tmp_path / "plate.ply")).attributes["curve_id"]
+    np.testing.assert_array_equal(centreline["curve_id"].astype(written.dtype), written)

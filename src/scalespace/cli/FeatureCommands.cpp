@@ -298,6 +298,9 @@ void addFeaturesCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("!--crease-sides-by-normals", args->features.creaseSidesByPosition,
                 "tell the sides apart by their normals instead, which blend across the crease");
+  cmd->add_flag("!--no-rim-lines", args->features.rimLines,
+                "where no crease line is found, do not trim the band to the rim of a part "
+                "thinner than the crease reach (its outermost points)");
   cmd->add_option("--min-extent", args->features.minCurveExtent,
                   "drop curves spanning less than this x e, after the joining (0 keeps all)")
       ->capture_default_str();
@@ -485,6 +488,7 @@ void addFeaturesCommand(CLI::App& app) {
                                    {"crease_flatness", options.creaseFlatness},
                                    {"crease_sides_by_position", options.creaseSidesByPosition},
                                    {"crease_side_margin", options.creaseSideMargin},
+                                   {"rim_lines", options.rimLines},
                                    {"edge_reach", options.edgeReach},
                                    {"edge_rejoin_angle", options.edgeRejoinAngle},
                                    {"curved_seeds_first", options.lines.curvedSeedsFirst},

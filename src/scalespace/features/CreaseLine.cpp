@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace scalespace {
 
@@ -118,6 +119,49 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
     if (!met) return std::nullopt;
   }
   return line;
+}
+
+std::optional<RimLine> fitRimLine(const std::vector<Vec3>& positions, const SpatialIndex& index,
+                                  const Vec3& centre, const Vec3& along,
+                                  const RimLineOptions& options) {
+  std::vector<Neighbor> found;
+  index.radiusSearch(centre, options.reach, found);
+  if (found.size() < std::size_t(std::max(options.minPoints, 3))) return std::nullopt;
+  // In index order: the same sums whatever order the search returns.
+  std::sort(found.begin(), found.end(),
+            [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
+  Vec3 centroid = Vec3::Zero();
+  for (const Neighbor& nb : found) centroid += positions[nb.index];
+  centroid /= double(found.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Neighbor& nb : found) {
+    const Vec3 d = positions[nb.index] - centroid;
+    covariance += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+  const double trace = eigen.eigenvalues().sum();
+  if (!(trace > 0) || eigen.eigenvalues()(0) > options.maxVariation * trace) return std::nullopt;
+  const Vec3 normal = eigen.eigenvectors().col(0);
+  const Vec3 direction = along - along.dot(normal) * normal;
+  if (!(direction.norm() > std::sqrt(0.5))) return std::nullopt;  // `along` leaves the sheet
+  RimLine rim;
+  rim.direction = direction.normalized();
+  rim.across = normal.cross(rim.direction);
+  // Outward: from the centroid towards the centre, which lies at the sheet's border. (The
+  // salient vertices' direction, averaged over several scales, is steadier than the centroid's
+  // offset, which follows the sampling of a few dozen points.)
+  double inset = (centre - centroid).dot(rim.across);
+  if (inset < 0) {
+    rim.across = -rim.across;
+    inset = -inset;
+  }
+  if (inset < options.minBorderShare * options.reach) return std::nullopt;
+  double outermost = -std::numeric_limits<double>::infinity();
+  for (const Neighbor& nb : found)
+    outermost = std::max(outermost, (positions[nb.index] - centre).dot(rim.across));
+  if (outermost > options.maxInset) return std::nullopt;
+  rim.point = centre + outermost * rim.across + (centroid - centre).dot(normal) * normal;
+  return rim;
 }
 
 }  // namespace scalespace

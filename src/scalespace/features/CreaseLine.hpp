@@ -59,4 +59,36 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
                                         const CreaseLineOptions& options,
                                         const Vec3* centre = nullptr);
 
+struct RimLineOptions {
+  /// The sheet is the cloud points within `reach` of the centre.
+  double reach = 0;
+  /// Their covariance's smallest eigenvalue over its trace (surface variation) is at most this:
+  /// they sample one sheet, the two faces of a part thinner than the reach included.
+  double maxVariation = 0.1;
+  /// The centre lies off their centroid, in the sheet's plane across `along`, by at least this
+  /// share of the reach: the sheet stops beside it (core/SheetBorder reads 0.42 on a straight
+  /// border, 0.17 half the radius inside it).
+  double minBorderShare = 0.2;
+  /// The centre lies within maxInset of the sheet's outermost point across `along`.
+  double maxInset = 0;
+  int minPoints = 12;
+};
+
+/// The rim of a part thinner than the reach near `centre` (e.g. the salient vertices' mean), along
+/// `along` (unit, within 45 degrees of the sheet's plane): the line through the sheet's outermost
+/// point across `along`, in the sheet's mid-plane. Where a blade's two faces end in a narrow third
+/// face, their planes meet beyond the rim, so fitCreaseLine finds no line there; the rim itself is
+/// the sharp edge (both of its edges within a fraction of a spacing). None when the points are too
+/// few, not one sheet, or do not stop beside the centre. RimLine::across is the unit direction in
+/// the sheet's plane, outward: a point's distance to the rim is (line.point - x) . across.
+struct RimLine {
+  Vec3 point = Vec3::Zero();      // on the rim, in the sheet's mid-plane
+  Vec3 direction = Vec3::Zero();  // unit, along the rim
+  Vec3 across = Vec3::Zero();     // unit, in the sheet's plane, outward
+};
+
+std::optional<RimLine> fitRimLine(const std::vector<Vec3>& positions, const SpatialIndex& index,
+                                  const Vec3& centre, const Vec3& along,
+                                  const RimLineOptions& options);
+
 }  // namespace scalespace

@@ -129,6 +129,7 @@ struct CreaseBand {
   const SpatialIndex& index;
   CreaseLineOptions line;
   double halfWidth = 0;
+  RimLineOptions rim;  // its reach 0: never
 };
 
 void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>& salient,
@@ -166,6 +167,7 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
       const Vec3 direction = eigen.eigenvectors().col(2);
       Vec3 through = mean, along = direction;
       double width = halfWidth;
+      bool onCrease = false;
       if (crease.line.reach > 0)
         if (const auto line = fitCreaseLine(crease.positions, crease.normals, crease.index,
                                             targets[i], direction, crease.line, &mean);
@@ -175,6 +177,18 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
           through = line->point;
           along = line->direction;
           width = crease.halfWidth;
+          onCrease = true;
+        }
+      if (!onCrease && crease.rim.reach > 0)
+        if (const auto rim =
+                fitRimLine(crease.positions, crease.index, mean, direction, crease.rim)) {
+          // A thin part's rim: the band is the sheet within creaseHalfWidth of its border, both
+          // faces alike (a distance across the sheet, not to the line).
+          if ((rim->point - targets[i]).dot(rim->across) > crease.halfWidth) {
+            eligible[i] = 0;
+            sign[i] = 0;
+          }
+          continue;
         }
       if (distanceToLine(targets[i], through, along) > width) {
         eligible[i] = 0;
@@ -601,6 +615,10 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
     crease.line.sideMargin =
         std::max(0.0, options.creaseSideMargin * e - options.creaseSideNoise * result.noiseRms);
     crease.halfWidth = options.creaseHalfWidth * e;
+    if (creaseLines && options.rimLines) {
+      crease.rim.reach = options.creaseReach * e;
+      crease.rim.maxInset = options.creaseHalfWidth * e;
+    }
     trimToCentreline(targets, salient, salientSign, *salientIndex, options.centrelineReach * e,
                      options.bandHalfWidth * e, options.centrelineLinearity, crease, eligible,
                      result.convexity);

@@ -156,6 +156,11 @@ struct FeatureCurveOptions {
   double creaseReach = 2;
   double creaseHalfWidth = 1;
   double creaseFlatness = 0.1;
+  /// (Not in the thesis) where no crease line is found and the cloud points within creaseReach *
+  /// e of the salient vertices form one sheet that stops beside them (features/CreaseLine,
+  /// fitRimLine), the band is the sheet within creaseHalfWidth * e of its outermost point: the
+  /// rim of a part thinner than the reach, whose faces' planes meet beyond it.
+  bool rimLines = true;
   /// The two sides are the points on either side of the plane through the centreline holding
   /// their mean normal, leaving out those within max(0, creaseSideMargin * e - creaseSideNoise *
   /// sigma) of it (clean: 0.3 e, where the APSS's rounding of the edge leaves the sides; under

@@ -135,11 +135,11 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
                     double minPieceExtent, double joinGap, double centrelineReach,
                     double bandHalfWidth, double creaseReach, double creaseHalfWidth,
                     double creaseFlatness, double creaseSideMargin, bool creaseSidesByNormals,
-                    double edgeReach, double edgeRejoinAngle, bool allSalient, bool salientPerScale,
-                    double beta, double gamma, bool curvedSeedsFirst, bool withLines,
-                    const py::handle& triangles, std::size_t meshSamples, double sheetNormals,
-                    const std::string& foldBorders, double foldReach, double foldShare,
-                    std::optional<int> threads, py::object progress) {
+                    bool rimLines, double edgeReach, double edgeRejoinAngle, bool allSalient,
+                    bool salientPerScale, double beta, double gamma, bool curvedSeedsFirst,
+                    bool withLines, const py::handle& triangles, std::size_t meshSamples,
+                    double sheetNormals, const std::string& foldBorders, double foldReach,
+                    double foldShare, std::optional<int> threads, py::object progress) {
   if (foldBorders != "auto" && foldBorders != "on" && foldBorders != "off")
     throw OptionError("fold_borders takes 'auto', 'on' or 'off', got '" + foldBorders + "'");
   FeatureCurveOptions options;
@@ -164,6 +164,7 @@ py::dict featuresPy(const py::handle& points, const py::handle& normals,
   options.creaseFlatness = creaseFlatness;
   options.creaseSideMargin = creaseSideMargin;
   options.creaseSidesByPosition = !creaseSidesByNormals;
+  options.rimLines = rimLines;
   options.edgeReach = edgeReach;
   options.edgeRejoinAngle = edgeRejoinAngle;
   options.ridgeOnly = !allSalient;
@@ -299,6 +300,7 @@ vertices[offsets[l]:offsets[l + 1]]), closed (L,), seed (L,: the input point it 
         "crease_flatness"_a = FeatureCurveOptions{}.creaseFlatness,
         "crease_side_margin"_a = FeatureCurveOptions{}.creaseSideMargin,
         "crease_sides_by_normals"_a = !FeatureCurveOptions{}.creaseSidesByPosition,
+        "rim_lines"_a = FeatureCurveOptions{}.rimLines,
         "edge_reach"_a = FeatureCurveOptions{}.edgeReach,
         "edge_rejoin_angle"_a = FeatureCurveOptions{}.edgeRejoinAngle, "all_salient"_a = false,
         "salient_per_scale"_a = false, "beta"_a = 0.5, "gamma"_a = 0.5,
@@ -329,7 +331,10 @@ band_half_width x e of the centreline fitted to the salient vertices within cent
 where the points within crease_reach x e form two flat sides (RMS within crease_flatness x e or
 twice the noise) the line where their planes meet replaces it, with crease_half_width (0: never);
 the sides are the points beyond crease_side_margin x e, less 3 noise RMS, of the plane through
-the centreline holding their mean normal (crease_sides_by_normals=True: by their normals).
+the centreline holding their mean normal (crease_sides_by_normals=True: by their normals);
+where none is found and those points form one sheet stopping beside the curve (the rim of a part
+thinner than crease_reach x e), the curve keeps the sheet within crease_half_width x e of its
+outermost points (rim_lines=False: the centreline).
 triangles (T, 3): points are a mesh's vertices (read_mesh), sampled with mesh_samples points per
 vertex by area and labelled on the mesh edges (Sec. 3.4.1). sheet_normals: without normals, each
 is estimated as the plane through the point and two neighbours that the most neighbours lie within
