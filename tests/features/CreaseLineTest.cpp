@@ -199,7 +199,9 @@ TEST(CreaseLine, TheRimOfAThinPartIsItsOutermostPoints) {
   }
 }
 
-// Points filling a ball are no sheet, and a crease of 90 degrees is two sheets: no rim.
+// Points filling a ball are no sheet (surface variation 0.17), nor points along a line; beside a
+// crease of 90 degrees (variation about 0.09: nearly one sheet) the points do not stop across the
+// salient vertices' direction: no rim.
 TEST(CreaseLine, NoRimInAVolumeNorOnARightAngle) {
   std::mt19937_64 rng(19);
   std::uniform_real_distribution<double> unit(-1, 1);
@@ -212,7 +214,24 @@ TEST(CreaseLine, NoRimInAVolumeNorOnARightAngle) {
   o.reach = 2 * kSpacing;
   o.maxInset = kSpacing;
   EXPECT_FALSE(fitRimLine(ball, *makeSpatialIndex(ball), Vec3(0.045, 0, 0), Vec3::UnitY(), o));
+  std::vector<Vec3> line;
+  for (int i = 0; i < 200; ++i) line.push_back(Vec3(0.0002 * i, 0, 0));
+  EXPECT_FALSE(fitRimLine(line, *makeSpatialIndex(line), Vec3(0.02, 0, 0), Vec3::UnitX(), o));
   const Sample edge = sharpEdge(90, 23);
   EXPECT_FALSE(fitRimLine(edge.positions, *makeSpatialIndex(edge.positions),
                           Vec3(0, 0, -0.3 * kSpacing), Vec3::UnitX(), o));
+}
+
+// The band around a rim: inset, beyond and off the mid-plane, each by at most the half-width.
+TEST(CreaseLine, WithinTheRimIsOnTheSheetNearItsBorder) {
+  RimLine rim;
+  rim.point = Vec3(0, 0, 0);
+  rim.direction = Vec3::UnitX();
+  rim.across = Vec3::UnitY();
+  rim.normal = Vec3::UnitZ();
+  EXPECT_TRUE(withinRim(rim, Vec3(5, -0.9, 0.2), 1));
+  EXPECT_TRUE(withinRim(rim, Vec3(-5, 0.5, -0.9), 1));
+  EXPECT_FALSE(withinRim(rim, Vec3(0, -1.1, 0), 1)) << "too far inside";
+  EXPECT_FALSE(withinRim(rim, Vec3(0, 1.1, 0), 1)) << "beyond the rim";
+  EXPECT_FALSE(withinRim(rim, Vec3(0, -0.2, 1.1), 1)) << "another surface beside the sheet";
 }

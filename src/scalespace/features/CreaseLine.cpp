@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "scalespace/core/PointMoments.hpp"
+
 namespace scalespace {
 
 namespace {
@@ -130,27 +132,23 @@ std::optional<RimLine> fitRimLine(const std::vector<Vec3>& positions, const Spat
   // In index order: the same sums whatever order the search returns.
   std::sort(found.begin(), found.end(),
             [](const Neighbor& a, const Neighbor& b) { return a.index < b.index; });
-  Vec3 centroid = Vec3::Zero();
-  for (const Neighbor& nb : found) centroid += positions[nb.index];
-  centroid /= double(found.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Neighbor& nb : found) {
-    const Vec3 d = positions[nb.index] - centroid;
-    covariance += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+  PointMoments moments;
+  for (const Neighbor& nb : found) moments.add(positions[nb.index]);
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(moments.covariance());
   const double trace = eigen.eigenvalues().sum();
-  if (!(trace > 0) || eigen.eigenvalues()(0) > options.maxVariation * trace) return std::nullopt;
-  const Vec3 normal = eigen.eigenvectors().col(0);
-  const Vec3 direction = along - along.dot(normal) * normal;
-  if (!(direction.norm() > std::sqrt(0.5))) return std::nullopt;  // `along` leaves the sheet
+  if (!(trace > 0) || eigen.eigenvalues()(0) > options.maxVariation * trace ||
+      eigen.eigenvalues()(1) < options.minSpread * trace)
+    return std::nullopt;
   RimLine rim;
+  rim.normal = eigen.eigenvectors().col(0);
+  // Along the salient vertices' direction, averaged over several scales: steadier than the
+  // centroid's offset, which follows the sampling of a few dozen points.
+  const Vec3 direction = along - along.dot(rim.normal) * rim.normal;
+  if (!(direction.norm() > std::sqrt(0.5))) return std::nullopt;  // `along` leaves the sheet
   rim.direction = direction.normalized();
-  rim.across = normal.cross(rim.direction);
-  // Outward: from the centroid towards the centre, which lies at the sheet's border. (The
-  // salient vertices' direction, averaged over several scales, is steadier than the centroid's
-  // offset, which follows the sampling of a few dozen points.)
-  double inset = (centre - centroid).dot(rim.across);
+  rim.across = rim.normal.cross(rim.direction);
+  // Outward: from the centroid towards the centre, which lies at the sheet's border.
+  double inset = (centre - moments.mean).dot(rim.across);
   if (inset < 0) {
     rim.across = -rim.across;
     inset = -inset;
@@ -160,8 +158,15 @@ std::optional<RimLine> fitRimLine(const std::vector<Vec3>& positions, const Spat
   for (const Neighbor& nb : found)
     outermost = std::max(outermost, (positions[nb.index] - centre).dot(rim.across));
   if (outermost > options.maxInset) return std::nullopt;
-  rim.point = centre + outermost * rim.across + (centroid - centre).dot(normal) * normal;
+  rim.point =
+      centre + outermost * rim.across + (moments.mean - centre).dot(rim.normal) * rim.normal;
   return rim;
+}
+
+bool withinRim(const RimLine& rim, const Vec3& x, double halfWidth) {
+  const Vec3 offset = rim.point - x;
+  return std::abs(offset.dot(rim.across)) <= halfWidth &&
+         std::abs(offset.dot(rim.normal)) <= halfWidth;
 }
 
 }  // namespace scalespace

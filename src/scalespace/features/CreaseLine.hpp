@@ -62,14 +62,17 @@ std::optional<CreaseLine> fitCreaseLine(const std::vector<Vec3>& positions,
 struct RimLineOptions {
   /// The sheet is the cloud points within `reach` of the centre.
   double reach = 0;
-  /// Their covariance's smallest eigenvalue over its trace (surface variation) is at most this:
-  /// they sample one sheet, the two faces of a part thinner than the reach included.
+  /// Their covariance's smallest eigenvalue over its trace (surface variation) is at most this,
+  /// and its middle one at least minSpread of the trace: they sample one sheet (the two faces of a
+  /// part thinner than the reach included), not a volume nor a line.
   double maxVariation = 0.1;
+  double minSpread = 0.05;
   /// The centre lies off their centroid, in the sheet's plane across `along`, by at least this
   /// share of the reach: the sheet stops beside it (core/SheetBorder reads 0.42 on a straight
   /// border, 0.17 half the radius inside it).
   double minBorderShare = 0.2;
-  /// The centre lies within maxInset of the sheet's outermost point across `along`.
+  /// The sheet's outermost point across `along` lies at most maxInset outward of the centre (a
+  /// centre beyond every point passes: the rim is then the outermost point).
   double maxInset = 0;
   int minPoints = 12;
 };
@@ -80,12 +83,18 @@ struct RimLineOptions {
 /// face, their planes meet beyond the rim, so fitCreaseLine finds no line there; the rim itself is
 /// the sharp edge (both of its edges within a fraction of a spacing). None when the points are too
 /// few, not one sheet, or do not stop beside the centre. RimLine::across is the unit direction in
-/// the sheet's plane, outward: a point's distance to the rim is (line.point - x) . across.
+/// the sheet's plane, outward: a point's inset from the rim is (rim.point - x) . across.
 struct RimLine {
   Vec3 point = Vec3::Zero();      // on the rim, in the sheet's mid-plane
   Vec3 direction = Vec3::Zero();  // unit, along the rim
   Vec3 across = Vec3::Zero();     // unit, in the sheet's plane, outward
+  Vec3 normal = Vec3::Zero();     // unit, the sheet's
 };
+
+/// Whether x lies on the sheet within `halfWidth` of the rim: inset from it by at most halfWidth,
+/// out of the sheet's mid-plane by at most halfWidth (the faces of a thin part, not another
+/// surface beside it) and not beyond it by more than halfWidth.
+bool withinRim(const RimLine& rim, const Vec3& x, double halfWidth);
 
 std::optional<RimLine> fitRimLine(const std::vector<Vec3>& positions, const SpatialIndex& index,
                                   const Vec3& centre, const Vec3& along,

@@ -184,7 +184,7 @@ void trimToCentreline(const std::vector<Vec3>& targets, const std::vector<Vec3>&
                 fitRimLine(crease.positions, crease.index, mean, direction, crease.rim)) {
           // A thin part's rim: the band is the sheet within creaseHalfWidth of its border, both
           // faces alike (a distance across the sheet, not to the line).
-          if ((rim->point - targets[i]).dot(rim->across) > crease.halfWidth) {
+          if (!withinRim(*rim, targets[i], crease.halfWidth)) {
             eligible[i] = 0;
             sign[i] = 0;
           }
@@ -607,7 +607,7 @@ FeatureCurveResult detectFeatureCurves(const PointCloud& cloud, const FeatureCur
   if (options.centrelineReach > 0 && !salient.empty()) {
     const auto salientIndex = makeSpatialIndex(salient);
     CreaseBand crease{
-        cloud.positions(), cloud.normals(), creaseLines ? *cloudIndex : *salientIndex, {}, 0};
+        cloud.positions(), cloud.normals(), creaseLines ? *cloudIndex : *salientIndex, {}, 0, {}};
     crease.line.reach = options.creaseReach * e;
     crease.line.maxRms = std::max(options.creaseFlatness * e, 2 * result.noiseRms);
     crease.line.maxGap = 0.25 * e;
